@@ -1,0 +1,61 @@
+# Spinneret's front door. `make demo` and `make test` are all a new machine needs:
+# both install missing Debian packages first (as root; otherwise they say what to install).
+#   make deps     install missing Debian packages
+#   make          build (build/)
+#   make test     build, run the suite, then run it again under ASan+UBSan (build-asan/)
+#   make demo     build and write the showcase into out/
+#   make bench    run the benchmarks, write bench/results/<machine>.json
+#   make install  install into PREFIX (default /usr/local)
+
+PREFIX ?= /usr/local
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+BUILD_TYPE ?= RelWithDebInfo
+CMAKE_FLAGS ?=
+WERROR ?= ON
+
+DEPS := cmake pkg-config gcc make libcmocka-dev libcairo2-dev libcjson-dev fonts-dejavu-core \
+        libassimp-dev libglfw3-dev libgl-dev libgl1-mesa-dri xvfb xauth ffmpeg povray clang
+BENCH_DEPS := libbullet-dev g++ libsuitesparse-dev
+
+.PHONY: all deps deps-bench build test test-fast test-asan demo bench install clean
+
+all: build
+
+deps:
+	@scripts/install-deps.sh $(DEPS)
+
+deps-bench:
+	@scripts/install-deps.sh $(DEPS) $(BENCH_DEPS)
+
+build/CMakeCache.txt:
+	cmake -S . -B build -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) -DSPN_WERROR=$(WERROR) $(CMAKE_FLAGS)
+
+build: deps build/CMakeCache.txt
+	cmake --build build -j $(JOBS)
+
+build-asan/CMakeCache.txt:
+	cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DSPN_SANITIZE=ON -DSPN_WERROR=$(WERROR) -DSPN_VIEWER=OFF $(CMAKE_FLAGS)
+
+test-fast: build
+	cd build && ctest --output-on-failure -j $(JOBS)
+
+test-asan: deps build-asan/CMakeCache.txt
+	cmake --build build-asan -j $(JOBS)
+	cd build-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+	  ctest --output-on-failure -j $(JOBS)
+
+test: test-fast test-asan
+
+demo: build
+	@scripts/demo.sh build/spinneret out
+
+bench: deps-bench
+	cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DSPN_WERROR=$(WERROR) $(CMAKE_FLAGS)
+	cmake --build build -j $(JOBS)
+	@scripts/bench.sh build
+
+install: build
+	cmake --install build --prefix $(PREFIX)
+
+clean:
+	rm -rf build build-asan out

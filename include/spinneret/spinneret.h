@@ -1,0 +1,11 @@
+/* Spinneret: build, simulate, animate and render spider webs. Include this
+ * one header for the whole public API. */
+#ifndef SPINNERET_H
+#define SPINNERET_H
+
+#include "core.h"
+#include "world.h"
+#include "web.h"
+#include "io.h"
+
+#endif

@@ -1,0 +1,251 @@
+/* The spring world: particles joined by springs, stepped by one of several
+ * integrators. Build it (add particles and springs), then step it; the world
+ * compiles itself into flat arrays on the first step after any addition.
+ *
+ * Units are SI. A particle with mass 0 or `fixed` set does not move.
+ * Spring force on particle a from b (Mehla 2005, eq. 4.14), l = x_a - x_b:
+ *   f_a = -[k(|l| - r) + kd (l' . l)/|l|] l/|l|,   f_b = -f_a
+ * A tension-only spring exerts nothing while |l| < r. */
+#ifndef SPINNERET_WORLD_H
+#define SPINNERET_WORLD_H
+
+#include "core.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct spn_world spn_world;
+
+typedef enum spn_integrator {
+    SPN_INTEGRATOR_EULER = 0,      ///< explicit (forward) Euler
+    SPN_INTEGRATOR_SYMPLECTIC,     ///< semi-implicit Euler: v first, then x with the new v
+    SPN_INTEGRATOR_RK4,            ///< classical Runge-Kutta, Mehla's method
+    SPN_INTEGRATOR_ADAPTIVE,       ///< energy-stable adaptive sub-stepping (Juhasz & Bercovici)
+    SPN_INTEGRATOR_IMPLICIT,       ///< linearised backward Euler (Baraff & Witkin 1998), CG solve
+    SPN_INTEGRATOR_COUNT
+} spn_integrator;
+
+/// "euler", "symplectic", "rk4", "adaptive", "implicit".
+SPN_API const char *spn_integrator_name(spn_integrator integrator);
+/// Parse a name as above; SPN_ERR_INVALID naming the choices otherwise.
+SPN_API spn_status spn_integrator_parse(const char *name, spn_integrator *out);
+
+/// How a world is made. Start from spn_world_def_default(): zero is a real
+/// value for gravity and drag, so zero never means "default".
+typedef struct spn_world_def {
+    spn_vec3 gravity;          ///< m/s^2, default (0, -9.81, 0)
+    double drag;               ///< viscous drag per unit mass [1/s]: f = -drag * m * v; default 0
+    spn_integrator integrator; ///< default SPN_INTEGRATOR_SYMPLECTIC
+    double dt_min;             ///< adaptive: smallest sub-step [s], default 1e-7
+    double dt_factor;          ///< adaptive: growth / halving factor, default 2
+    double energy_jump;        ///< blow-up bound: total energy may not grow by more than this
+                               ///< factor (relative to the larger of |E| and the elastic scale) in one step; default 1e3
+    int threads;               ///< 0: OpenMP's default; 1: single-threaded; n: n threads
+    bool breakage;             ///< break springs that leave [break_min, break_max]; default true
+    double cg_tolerance;       ///< implicit: relative residual of the CG solve, default 1e-10
+    int cg_max_iterations;     ///< implicit: default 1000
+    double provot_max_strain;  ///< Provot deformation limit (0 = off), e.g. 0.1 = 10%
+    int provot_iterations;     ///< Provot passes per step, default 4
+    uint64_t seed;             ///< for anything random in the world, default 1
+} spn_world_def;
+
+SPN_API spn_world_def spn_world_def_default(void);
+
+/// A particle to add.
+typedef struct spn_particle_def {
+    spn_vec3 position;
+    spn_vec3 velocity;
+    double mass;      ///< kg; 0 means fixed
+    bool fixed;       ///< does not move (inverse mass 0)
+    uint32_t tag;     ///< user tag (web builders: anchor, hub, ...)
+} spn_particle_def;
+
+SPN_API spn_particle_def spn_particle_def_default(void);
+
+/// A spring to add.
+typedef struct spn_spring_def {
+    uint32_t a, b;       ///< particle ids
+    double k;            ///< stiffness [N/m]
+    double kd;           ///< axial damping [N s/m]
+    double rest;         ///< rest length [m]; negative: the current distance
+    double break_min;    ///< breaks when shorter than this [m] (0: never)
+    double break_max;    ///< breaks when longer than this [m] (INFINITY: never)
+    bool tension_only;   ///< silk: goes slack, never pushes
+    uint32_t tag;        ///< user tag (web builders: thread kind, see web.h)
+    uint32_t stage;      ///< construction stage (web builders: frame, radii, ...)
+    uint32_t order;      ///< construction order within the world
+} spn_spring_def;
+
+SPN_API spn_spring_def spn_spring_def_default(void);
+
+/// A spring as it is now.
+typedef struct spn_spring_info {
+    uint32_t a, b;
+    double k, kd, rest, break_min, break_max;
+    bool tension_only, broken;
+    uint32_t tag, stage, order;
+    double length;   ///< current length [m]
+    double tension;  ///< current elastic force k(|l| - r), 0 if broken or slack [N]
+} spn_spring_info;
+
+SPN_API spn_world *spn_world_create(const spn_world_def *def);
+SPN_API void spn_world_destroy(spn_world *w);
+/// A deep copy (particles, springs, state, settings; callbacks too).
+SPN_API spn_world *spn_world_clone(const spn_world *w);
+SPN_API const spn_world_def *spn_world_get_def(const spn_world *w);
+
+/* ---- construction ---------------------------------------------------- */
+
+/// Add a particle; its id is written to `id` (ids are dense from 0).
+SPN_API spn_status spn_world_add_particle(spn_world *w, const spn_particle_def *def, uint32_t *id);
+/// Add a spring between existing particles; its id is written to `id`.
+SPN_API spn_status spn_world_add_spring(spn_world *w, const spn_spring_def *def, uint32_t *id);
+/// Remove the springs whose `remove[i]` is true; the others keep their order
+/// and are renumbered densely. Particles are kept.
+SPN_API spn_status spn_world_remove_springs(spn_world *w, const bool *remove);
+/// Build the flat stepping arrays now (stepping does it when needed).
+SPN_API spn_status spn_world_compile(spn_world *w);
+
+/* ---- reading and writing state --------------------------------------- */
+
+SPN_API uint32_t spn_world_particle_count(const spn_world *w);
+SPN_API uint32_t spn_world_spring_count(const spn_world *w);
+/// Arrays of particle_count entries, valid until the next addition.
+SPN_API const spn_vec3 *spn_world_positions(const spn_world *w);
+SPN_API const spn_vec3 *spn_world_velocities(const spn_world *w);
+SPN_API spn_vec3 spn_world_position(const spn_world *w, uint32_t i);
+SPN_API spn_vec3 spn_world_velocity(const spn_world *w, uint32_t i);
+SPN_API double spn_world_mass(const spn_world *w, uint32_t i);
+SPN_API bool spn_world_is_fixed(const spn_world *w, uint32_t i);
+SPN_API uint32_t spn_world_particle_tag(const spn_world *w, uint32_t i);
+SPN_API void spn_world_set_position(spn_world *w, uint32_t i, spn_vec3 p);
+SPN_API void spn_world_set_velocity(spn_world *w, uint32_t i, spn_vec3 v);
+/// Pin (fixed = true) or free a particle. Freeing one with mass 0 keeps it fixed.
+SPN_API void spn_world_set_fixed(spn_world *w, uint32_t i, bool fixed);
+SPN_API void spn_world_set_mass(spn_world *w, uint32_t i, double mass);
+SPN_API void spn_world_set_particle_tag(spn_world *w, uint32_t i, uint32_t tag);
+
+SPN_API spn_spring_info spn_world_spring(const spn_world *w, uint32_t s);
+SPN_API void spn_world_set_spring_rest(spn_world *w, uint32_t s, double rest);
+SPN_API void spn_world_set_spring_stiffness(spn_world *w, uint32_t s, double k, double kd);
+SPN_API void spn_world_set_spring_tag(spn_world *w, uint32_t s, uint32_t tag);
+/// Break a spring by hand (k = 0, flagged); no callback.
+SPN_API void spn_world_break_spring(spn_world *w, uint32_t s);
+
+SPN_API void spn_world_set_integrator(spn_world *w, spn_integrator integrator);
+SPN_API void spn_world_set_gravity(spn_world *w, spn_vec3 g);
+SPN_API void spn_world_set_drag(spn_world *w, double drag);
+SPN_API double spn_world_time(const spn_world *w);
+SPN_API void spn_world_set_time(spn_world *w, double t);
+SPN_API uint64_t spn_world_step_count(const spn_world *w);
+
+/// Free-form metadata (a JSON object as text) carried into web files.
+SPN_API spn_status spn_world_set_metadata(spn_world *w, const char *json_object);
+SPN_API const char *spn_world_metadata(const spn_world *w);
+
+/* ---- forces and events ------------------------------------------------ */
+
+/// External force callback, called once per force evaluation (RK4 calls it
+/// four times a step) with the state being evaluated. Add to `f`; do not
+/// overwrite. `x`, `v`, `f` have particle_count entries.
+typedef void (*spn_force_fn)(void *user, const spn_world *w, double t,
+                             const spn_vec3 *x, const spn_vec3 *v, spn_vec3 *f);
+SPN_API void spn_world_set_force_callback(spn_world *w, spn_force_fn fn, void *user);
+
+/// Air velocity at a point and time [m/s], for aerodynamic drag on threads.
+typedef spn_vec3 (*spn_air_fn)(void *user, double t, spn_vec3 position);
+/// Air and its properties: segments whose tag has a diameter (below) feel drag
+/// from the air velocity relative to them, normal component only, with a drag
+/// coefficient from the cylinder Reynolds number. rho [kg/m^3], mu [Pa s].
+SPN_API void spn_world_set_air(spn_world *w, spn_air_fn fn, void *user, double rho, double mu);
+/// Thread diameter [m] for springs with `tag` (0: no aerodynamic drag).
+SPN_API void spn_world_set_tag_diameter(spn_world *w, uint32_t tag, double diameter);
+/// Drag coefficient of a cylinder in cross-flow at Reynolds number `re`.
+SPN_API double spn_cylinder_drag_coefficient(double re);
+
+/// Called after the step in which spring `s` broke, with the time and length.
+typedef void (*spn_break_fn)(void *user, uint32_t s, double t, double length);
+SPN_API void spn_world_set_break_callback(spn_world *w, spn_break_fn fn, void *user);
+
+/// Per-particle collision callback (Juhasz & Bercovici): the particle `i`
+/// moves from `from` to `to` this step. Return the fraction of the move
+/// allowed, in [0, 1] (1: no contact). On contact set `normal` (unit) and
+/// `keep`: the normal velocity is reversed and multiplied by `keep`.
+typedef double (*spn_collide_fn)(void *user, uint32_t i, spn_vec3 from, spn_vec3 to,
+                                 spn_vec3 *normal, double *keep);
+SPN_API void spn_world_set_collide_callback(spn_world *w, spn_collide_fn fn, void *user);
+
+/// Built-in colliders. Restitution in [0, 1] keeps that fraction of the normal
+/// speed; friction in [0, 1] removes that fraction of the tangential speed on contact.
+SPN_API spn_status spn_world_add_plane(spn_world *w, spn_vec3 normal, double offset,
+                                       double restitution, double friction);
+SPN_API spn_status spn_world_add_sphere(spn_world *w, spn_vec3 centre, double radius,
+                                        double restitution, double friction);
+
+/* ---- stepping --------------------------------------------------------- */
+
+/// What the last call to spn_world_step did.
+typedef struct spn_step_report {
+    double dt;            ///< outer step asked for
+    int substeps;         ///< sub-steps taken (adaptive; 1 otherwise)
+    int halvings;         ///< times a sub-step was halved (adaptive)
+    int cg_iterations;    ///< implicit: CG iterations summed over sub-steps
+    int breaks;           ///< springs broken in this step
+} spn_step_report;
+
+/// Advance by dt seconds. On SPN_ERR_UNSTABLE the world keeps its state from
+/// before the step and the message names the step and the particle.
+SPN_API spn_status spn_world_step(spn_world *w, double dt);
+SPN_API spn_step_report spn_world_last_step(const spn_world *w);
+
+/* ---- energy and equilibrium ------------------------------------------ */
+
+typedef struct spn_energy {
+    double kinetic;       ///< sum 1/2 m v^2 [J]
+    double elastic;       ///< sum 1/2 k (|l| - r)^2 over intact, non-slack springs
+    double gravitational; ///< sum -m g . x
+    double external_work; ///< work done so far by the force callback and air
+    double dissipated;    ///< energy removed so far by damping, drag and collisions
+} spn_energy;
+
+SPN_API spn_energy spn_world_energy(const spn_world *w);
+/// Kinetic + elastic + gravitational.
+SPN_API double spn_world_total_energy(const spn_world *w);
+/// Largest net static force (springs, gravity, callback at zero velocity) on a
+/// free particle [N]; its id in `which` when not NULL.
+SPN_API double spn_world_max_residual(spn_world *w, uint32_t *which);
+
+typedef struct spn_settle_def {
+    double dt;             ///< step [s], default 1e-3
+    double max_kinetic;    ///< kinetic energy threshold [J], default 1e-9
+    double max_residual;   ///< residual force threshold [N], default 1e-6
+    double max_time;       ///< give up after this much simulated time [s], default 60
+    double min_time;       ///< do not test before this time [s], default 0
+    double check_interval; ///< simulated seconds between tests, default 10*dt
+} spn_settle_def;
+
+SPN_API spn_settle_def spn_settle_def_default(void);
+
+typedef enum spn_settle_reason {
+    SPN_SETTLE_CONVERGED = 0, ///< both thresholds met
+    SPN_SETTLE_TIMEOUT        ///< max_time passed first
+} spn_settle_reason;
+
+typedef struct spn_settle_report {
+    spn_settle_reason reason;
+    double time;         ///< simulated time spent [s]
+    uint64_t steps;
+    double kinetic;      ///< at the end [J]
+    double residual;     ///< largest residual force at the end [N]
+    double total_energy; ///< at the end [J]
+} spn_settle_report;
+
+/// Step until at rest or out of time. SPN_OK on both outcomes (read the
+/// report's reason); SPN_ERR_UNSTABLE when the run blew up.
+SPN_API spn_status spn_world_settle(spn_world *w, const spn_settle_def *def, spn_settle_report *report);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# Runs every benchmark program (build/bench_*), collects their JSON lines into
+# bench/results/<machine>.json and prints them.
+set -eu
+build=$1
+machine=$(hostname -s 2>/dev/null || echo machine)
+cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//' || echo unknown)
+mkdir -p bench/results
+tmp=$(mktemp bench/results/.tmp.XXXXXX)
+printf '{"machine":"%s","cpu":"%s","cores":%s,"date":"%s"}\n' "$machine" "$cpu" "$(nproc)" "$(date -u +%F)" >"$tmp"
+for b in "$build"/bench_*; do
+  [ -x "$b" ] || continue
+  echo "== $b" >&2
+  "$b" | tee -a "$tmp"
+done
+mv "$tmp" "bench/results/$machine.json"
+echo "written bench/results/$machine.json" >&2

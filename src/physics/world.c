@@ -1,0 +1,498 @@
+/* The spring world: construction, compilation to flat arrays, accessors.
+ * Construction appends to growable arrays; compiling builds the CSR adjacency
+ * and scratch buffers. Adding anything invalidates the compiled data, and the
+ * next step compiles again (cheap: one counting sort over the springs). */
+#include "world_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+spn_world_def spn_world_def_default(void)
+{
+    spn_world_def d;
+    memset(&d, 0, sizeof d);
+    d.gravity = spn_v3(0, -9.81, 0);
+    d.drag = 0;
+    d.integrator = SPN_INTEGRATOR_SYMPLECTIC;
+    d.dt_min = 1e-7;
+    d.dt_factor = 2;
+    d.energy_jump = 1e3;
+    d.threads = 0;
+    d.breakage = true;
+    d.cg_tolerance = 1e-10;
+    d.cg_max_iterations = 1000;
+    d.provot_max_strain = 0;
+    d.provot_iterations = 4;
+    d.seed = 1;
+    return d;
+}
+
+spn_particle_def spn_particle_def_default(void)
+{
+    spn_particle_def p;
+    memset(&p, 0, sizeof p);
+    p.mass = 1;
+    return p;
+}
+
+spn_spring_def spn_spring_def_default(void)
+{
+    spn_spring_def s;
+    memset(&s, 0, sizeof s);
+    s.k = 1;
+    s.rest = -1;
+    s.break_min = 0;
+    s.break_max = INFINITY;
+    return s;
+}
+
+static const char *const integrator_names[SPN_INTEGRATOR_COUNT] = {"euler", "symplectic", "rk4", "adaptive",
+                                                                    "implicit"};
+
+const char *spn_integrator_name(spn_integrator integrator)
+{
+    return (unsigned)integrator < SPN_INTEGRATOR_COUNT ? integrator_names[integrator] : "unknown";
+}
+
+spn_status spn_integrator_parse(const char *name, spn_integrator *out)
+{
+    for (int i = 0; i < SPN_INTEGRATOR_COUNT; i++)
+        if (name && strcmp(name, integrator_names[i]) == 0) {
+            *out = (spn_integrator)i;
+            return SPN_OK;
+        }
+    return spn_error(SPN_ERR_INVALID,
+                     "unknown solver '%s' (choose euler, symplectic, rk4, adaptive or implicit)", name ? name : "");
+}
+
+spn_world *spn_world_create(const spn_world_def *def)
+{
+    spn_world *w = calloc(1, sizeof *w);
+    if (!w) return NULL;
+    w->def = def ? *def : spn_world_def_default();
+    w->air_rho = 1.204;
+    w->air_mu = 1.81e-5;
+    return w;
+}
+
+static void free_compiled(spn_world *w)
+{
+    free(w->adj_start);
+    free(w->adj);
+    free(w->fs);
+    free(w->fair);
+    free(w->sdiam);
+    free(w->f);
+    free(w->x0);
+    free(w->v0);
+    free(w->xt);
+    free(w->vt);
+    for (int i = 0; i < 4; i++) {
+        free(w->kx[i]);
+        free(w->kv[i]);
+        w->kx[i] = w->kv[i] = NULL;
+    }
+    w->adj_start = w->adj = NULL;
+    w->fs = w->fair = w->f = w->x0 = w->v0 = w->xt = w->vt = NULL;
+    w->sdiam = NULL;
+    w->compiled = false;
+}
+
+void spn_world_destroy(spn_world *w)
+{
+    if (!w) return;
+    free_compiled(w);
+    free(w->x);
+    free(w->v);
+    free(w->mass);
+    free(w->inv_mass);
+    free(w->ptag);
+    free(w->sa);
+    free(w->sb);
+    free(w->k);
+    free(w->kd);
+    free(w->rest);
+    free(w->bmin);
+    free(w->bmax);
+    free(w->sflags);
+    free(w->stag);
+    free(w->sstage);
+    free(w->sorder);
+    free(w->diam);
+    free(w->colliders);
+    free(w->metadata);
+    free(w);
+}
+
+const spn_world_def *spn_world_get_def(const spn_world *w) { return &w->def; }
+
+/* Grow one array to `cap` elements of `size` bytes. */
+static bool grow(void **p, size_t cap, size_t size)
+{
+    void *q = realloc(*p, cap * size);
+    if (!q) return false;
+    *p = q;
+    return true;
+}
+
+static bool reserve_particles(spn_world *w, uint32_t need)
+{
+    if (need <= w->cap_p) return true;
+    size_t cap = w->cap_p ? w->cap_p : 64;
+    while (cap < need) cap *= 2;
+    if (cap > UINT32_MAX) return false;
+    bool ok = grow((void **)&w->x, cap, sizeof *w->x) && grow((void **)&w->v, cap, sizeof *w->v) &&
+              grow((void **)&w->mass, cap, sizeof *w->mass) && grow((void **)&w->inv_mass, cap, sizeof *w->inv_mass) &&
+              grow((void **)&w->ptag, cap, sizeof *w->ptag);
+    if (ok) w->cap_p = (uint32_t)cap;
+    return ok;
+}
+
+static bool reserve_springs(spn_world *w, uint32_t need)
+{
+    if (need <= w->cap_s) return true;
+    size_t cap = w->cap_s ? w->cap_s : 64;
+    while (cap < need) cap *= 2;
+    if (cap > UINT32_MAX) return false;
+    bool ok = grow((void **)&w->sa, cap, sizeof *w->sa) && grow((void **)&w->sb, cap, sizeof *w->sb) &&
+              grow((void **)&w->k, cap, sizeof *w->k) && grow((void **)&w->kd, cap, sizeof *w->kd) &&
+              grow((void **)&w->rest, cap, sizeof *w->rest) && grow((void **)&w->bmin, cap, sizeof *w->bmin) &&
+              grow((void **)&w->bmax, cap, sizeof *w->bmax) && grow((void **)&w->sflags, cap, sizeof *w->sflags) &&
+              grow((void **)&w->stag, cap, sizeof *w->stag) && grow((void **)&w->sstage, cap, sizeof *w->sstage) &&
+              grow((void **)&w->sorder, cap, sizeof *w->sorder);
+    if (ok) w->cap_s = (uint32_t)cap;
+    return ok;
+}
+
+spn_status spn_world_add_particle(spn_world *w, const spn_particle_def *def, uint32_t *id)
+{
+    if (!spn_v3_finite(def->position) || !spn_v3_finite(def->velocity))
+        return spn_error(SPN_ERR_INVALID, "particle %u: position and velocity must be finite", w->np);
+    if (!(def->mass >= 0) || !isfinite(def->mass))
+        return spn_error(SPN_ERR_INVALID, "particle %u: mass must be finite and not negative", w->np);
+    if (w->np == UINT32_MAX || !reserve_particles(w, w->np + 1)) return spn_error(SPN_ERR_NOMEM, "out of memory");
+    uint32_t i = w->np++;
+    w->x[i] = def->position;
+    w->v[i] = def->fixed ? spn_v3(0, 0, 0) : def->velocity;
+    w->mass[i] = def->mass;
+    w->inv_mass[i] = (def->fixed || def->mass == 0) ? 0 : 1.0 / def->mass;
+    w->ptag[i] = def->tag;
+    w->compiled = false;
+    if (id) *id = i;
+    return SPN_OK;
+}
+
+spn_status spn_world_add_spring(spn_world *w, const spn_spring_def *def, uint32_t *id)
+{
+    uint32_t s = w->ns;
+    if (def->a >= w->np || def->b >= w->np)
+        return spn_error(SPN_ERR_INVALID, "spring %u: particle %u does not exist", s, def->a >= w->np ? def->a : def->b);
+    if (def->a == def->b) return spn_error(SPN_ERR_INVALID, "spring %u: both ends are particle %u", s, def->a);
+    if (!(def->k >= 0) || !isfinite(def->k) || !(def->kd >= 0) || !isfinite(def->kd))
+        return spn_error(SPN_ERR_INVALID, "spring %u: stiffness and damping must be finite and not negative", s);
+    if (isnan(def->rest) || isinf(def->rest) || isnan(def->break_min) || isnan(def->break_max))
+        return spn_error(SPN_ERR_INVALID, "spring %u: rest and break lengths must be numbers", s);
+    if (s == UINT32_MAX || !reserve_springs(w, s + 1)) return spn_error(SPN_ERR_NOMEM, "out of memory");
+    w->sa[s] = def->a;
+    w->sb[s] = def->b;
+    w->k[s] = def->k;
+    w->kd[s] = def->kd;
+    w->rest[s] = def->rest >= 0 ? def->rest : spn_v3_len(spn_v3_sub(w->x[def->a], w->x[def->b]));
+    w->bmin[s] = def->break_min;
+    w->bmax[s] = def->break_max;
+    w->sflags[s] = def->tension_only ? SPN_SPRING_TENSION_ONLY : 0;
+    w->stag[s] = def->tag;
+    w->sstage[s] = def->stage;
+    w->sorder[s] = def->order;
+    w->ns++;
+    w->compiled = false;
+    if (id) *id = s;
+    return SPN_OK;
+}
+
+spn_status spn_world_remove_springs(spn_world *w, const bool *remove)
+{
+    uint32_t n = 0;
+    for (uint32_t s = 0; s < w->ns; s++) {
+        if (remove[s]) continue;
+        w->sa[n] = w->sa[s];
+        w->sb[n] = w->sb[s];
+        w->k[n] = w->k[s];
+        w->kd[n] = w->kd[s];
+        w->rest[n] = w->rest[s];
+        w->bmin[n] = w->bmin[s];
+        w->bmax[n] = w->bmax[s];
+        w->sflags[n] = w->sflags[s];
+        w->stag[n] = w->stag[s];
+        w->sstage[n] = w->sstage[s];
+        w->sorder[n] = w->sorder[s];
+        n++;
+    }
+    w->ns = n;
+    w->compiled = false;
+    return SPN_OK;
+}
+
+static double tag_diameter(const spn_world *w, uint32_t tag)
+{
+    for (uint32_t i = 0; i < w->ndiam; i++)
+        if (w->diam[i].tag == tag) return w->diam[i].diameter;
+    return 0;
+}
+
+spn_status spn_world_compile(spn_world *w)
+{
+    if (w->compiled) return SPN_OK;
+    free_compiled(w);
+    size_t np = w->np ? w->np : 1, ns = w->ns ? w->ns : 1;
+    w->adj_start = calloc(np + 1, sizeof *w->adj_start);
+    w->adj = malloc(2 * ns * sizeof *w->adj);
+    w->fs = malloc(ns * sizeof *w->fs);
+    w->fair = calloc(ns, sizeof *w->fair);
+    w->sdiam = malloc(ns * sizeof *w->sdiam);
+    w->f = malloc(np * sizeof *w->f);
+    w->x0 = malloc(np * sizeof *w->x0);
+    w->v0 = malloc(np * sizeof *w->v0);
+    w->xt = malloc(np * sizeof *w->xt);
+    w->vt = malloc(np * sizeof *w->vt);
+    bool ok = w->adj_start && w->adj && w->fs && w->fair && w->sdiam && w->f && w->x0 && w->v0 && w->xt && w->vt;
+    for (int i = 0; i < 4 && ok; i++) {
+        w->kx[i] = malloc(np * sizeof **w->kx);
+        w->kv[i] = malloc(np * sizeof **w->kv);
+        ok = w->kx[i] && w->kv[i];
+    }
+    if (!ok) {
+        free_compiled(w);
+        return spn_error(SPN_ERR_NOMEM, "out of memory compiling a world of %u particles and %u springs", w->np, w->ns);
+    }
+    for (uint32_t s = 0; s < w->ns; s++) {
+        w->adj_start[w->sa[s] + 1]++;
+        w->adj_start[w->sb[s] + 1]++;
+        w->sdiam[s] = tag_diameter(w, w->stag[s]);
+    }
+    for (uint32_t i = 0; i < w->np; i++) w->adj_start[i + 1] += w->adj_start[i];
+    uint32_t *fill = calloc(np, sizeof *fill);
+    if (!fill) {
+        free_compiled(w);
+        return spn_error(SPN_ERR_NOMEM, "out of memory");
+    }
+    for (uint32_t s = 0; s < w->ns; s++) {
+        w->adj[w->adj_start[w->sa[s]] + fill[w->sa[s]]++] = s << 1;
+        w->adj[w->adj_start[w->sb[s]] + fill[w->sb[s]]++] = (s << 1) | 1u;
+    }
+    free(fill);
+    w->compiled = true;
+    return SPN_OK;
+}
+
+uint32_t spn_world_particle_count(const spn_world *w) { return w->np; }
+uint32_t spn_world_spring_count(const spn_world *w) { return w->ns; }
+const spn_vec3 *spn_world_positions(const spn_world *w) { return w->x; }
+const spn_vec3 *spn_world_velocities(const spn_world *w) { return w->v; }
+spn_vec3 spn_world_position(const spn_world *w, uint32_t i) { return w->x[i]; }
+spn_vec3 spn_world_velocity(const spn_world *w, uint32_t i) { return w->v[i]; }
+double spn_world_mass(const spn_world *w, uint32_t i) { return w->mass[i]; }
+bool spn_world_is_fixed(const spn_world *w, uint32_t i) { return w->inv_mass[i] == 0; }
+uint32_t spn_world_particle_tag(const spn_world *w, uint32_t i) { return w->ptag[i]; }
+void spn_world_set_position(spn_world *w, uint32_t i, spn_vec3 p) { w->x[i] = p; }
+void spn_world_set_velocity(spn_world *w, uint32_t i, spn_vec3 v) { w->v[i] = v; }
+void spn_world_set_particle_tag(spn_world *w, uint32_t i, uint32_t tag) { w->ptag[i] = tag; }
+
+void spn_world_set_fixed(spn_world *w, uint32_t i, bool fixed)
+{
+    w->inv_mass[i] = (fixed || w->mass[i] == 0) ? 0 : 1.0 / w->mass[i];
+    if (fixed) w->v[i] = spn_v3(0, 0, 0);
+}
+
+void spn_world_set_mass(spn_world *w, uint32_t i, double mass)
+{
+    bool fixed = w->inv_mass[i] == 0 && w->mass[i] != 0;
+    w->mass[i] = mass;
+    w->inv_mass[i] = (fixed || mass == 0) ? 0 : 1.0 / mass;
+}
+
+spn_spring_info spn_world_spring(const spn_world *w, uint32_t s)
+{
+    spn_spring_info info;
+    info.a = w->sa[s];
+    info.b = w->sb[s];
+    info.k = w->k[s];
+    info.kd = w->kd[s];
+    info.rest = w->rest[s];
+    info.break_min = w->bmin[s];
+    info.break_max = w->bmax[s];
+    info.tension_only = (w->sflags[s] & SPN_SPRING_TENSION_ONLY) != 0;
+    info.broken = (w->sflags[s] & SPN_SPRING_BROKEN) != 0;
+    info.tag = w->stag[s];
+    info.stage = w->sstage[s];
+    info.order = w->sorder[s];
+    info.length = spn_v3_len(spn_v3_sub(w->x[info.a], w->x[info.b]));
+    double stretch = info.length - info.rest;
+    info.tension = (info.broken || (info.tension_only && stretch < 0)) ? 0 : info.k * stretch;
+    return info;
+}
+
+void spn_world_set_spring_rest(spn_world *w, uint32_t s, double rest) { w->rest[s] = rest; }
+void spn_world_set_spring_stiffness(spn_world *w, uint32_t s, double k, double kd)
+{
+    w->k[s] = k;
+    w->kd[s] = kd;
+}
+void spn_world_set_spring_tag(spn_world *w, uint32_t s, uint32_t tag)
+{
+    w->stag[s] = tag;
+    if (w->compiled) w->sdiam[s] = tag_diameter(w, tag);
+}
+void spn_world_break_spring(spn_world *w, uint32_t s) { w->sflags[s] |= SPN_SPRING_BROKEN; }
+
+void spn_world_set_integrator(spn_world *w, spn_integrator integrator) { w->def.integrator = integrator; }
+void spn_world_set_gravity(spn_world *w, spn_vec3 g) { w->def.gravity = g; }
+void spn_world_set_drag(spn_world *w, double drag) { w->def.drag = drag; }
+double spn_world_time(const spn_world *w) { return w->t; }
+void spn_world_set_time(spn_world *w, double t) { w->t = t; }
+uint64_t spn_world_step_count(const spn_world *w) { return w->steps; }
+spn_step_report spn_world_last_step(const spn_world *w) { return w->last; }
+
+spn_status spn_world_set_metadata(spn_world *w, const char *json_object)
+{
+    char *copy = NULL;
+    if (json_object) {
+        size_t n = strlen(json_object) + 1;
+        copy = malloc(n);
+        if (!copy) return spn_error(SPN_ERR_NOMEM, "out of memory");
+        memcpy(copy, json_object, n);
+    }
+    free(w->metadata);
+    w->metadata = copy;
+    return SPN_OK;
+}
+
+const char *spn_world_metadata(const spn_world *w) { return w->metadata ? w->metadata : "{}"; }
+
+void spn_world_set_force_callback(spn_world *w, spn_force_fn fn, void *user)
+{
+    w->force_fn = fn;
+    w->force_user = user;
+}
+
+void spn_world_set_break_callback(spn_world *w, spn_break_fn fn, void *user)
+{
+    w->break_fn = fn;
+    w->break_user = user;
+}
+
+void spn_world_set_collide_callback(spn_world *w, spn_collide_fn fn, void *user)
+{
+    w->collide_fn = fn;
+    w->collide_user = user;
+}
+
+void spn_world_set_air(spn_world *w, spn_air_fn fn, void *user, double rho, double mu)
+{
+    w->air_fn = fn;
+    w->air_user = user;
+    w->air_rho = rho;
+    w->air_mu = mu;
+}
+
+void spn_world_set_tag_diameter(spn_world *w, uint32_t tag, double diameter)
+{
+    for (uint32_t i = 0; i < w->ndiam; i++)
+        if (w->diam[i].tag == tag) {
+            w->diam[i].diameter = diameter;
+            w->compiled = false;
+            return;
+        }
+    spn_tag_diameter *d = realloc(w->diam, (w->ndiam + 1) * sizeof *d);
+    if (!d) return;
+    w->diam = d;
+    w->diam[w->ndiam].tag = tag;
+    w->diam[w->ndiam].diameter = diameter;
+    w->ndiam++;
+    w->compiled = false;
+}
+
+static spn_status add_collider(spn_world *w, spn_collider c)
+{
+    if (!spn_v3_finite(c.p) || !isfinite(c.d) || !(c.restitution >= 0 && c.restitution <= 1) ||
+        !(c.friction >= 0 && c.friction <= 1))
+        return spn_error(SPN_ERR_INVALID, "collider: values must be finite, restitution and friction in [0, 1]");
+    spn_collider *p = realloc(w->colliders, (w->ncolliders + 1) * sizeof *p);
+    if (!p) return spn_error(SPN_ERR_NOMEM, "out of memory");
+    w->colliders = p;
+    w->colliders[w->ncolliders++] = c;
+    return SPN_OK;
+}
+
+spn_status spn_world_add_plane(spn_world *w, spn_vec3 normal, double offset, double restitution, double friction)
+{
+    if (spn_v3_len(normal) == 0) return spn_error(SPN_ERR_INVALID, "plane: normal is zero");
+    spn_collider c = {0, spn_v3_norm(normal), offset, restitution, friction};
+    return add_collider(w, c);
+}
+
+spn_status spn_world_add_sphere(spn_world *w, spn_vec3 centre, double radius, double restitution, double friction)
+{
+    if (!(radius > 0)) return spn_error(SPN_ERR_INVALID, "sphere: radius must be positive");
+    spn_collider c = {1, centre, radius, restitution, friction};
+    return add_collider(w, c);
+}
+
+static bool dup_array(void **dst, const void *src, size_t n, size_t size)
+{
+    if (n == 0) {
+        *dst = NULL;
+        return true;
+    }
+    *dst = malloc(n * size);
+    if (!*dst) return false;
+    memcpy(*dst, src, n * size);
+    return true;
+}
+
+spn_world *spn_world_clone(const spn_world *w)
+{
+    spn_world *c = calloc(1, sizeof *c);
+    if (!c) return NULL;
+    *c = *w;
+    c->compiled = false;
+    c->adj_start = c->adj = NULL;
+    c->fs = c->fair = c->f = c->x0 = c->v0 = c->xt = c->vt = NULL;
+    c->sdiam = NULL;
+    for (int i = 0; i < 4; i++) c->kx[i] = c->kv[i] = NULL;
+    /* Nothing may alias w's arrays if a copy below fails and c is destroyed. */
+    c->x = c->v = NULL;
+    c->mass = c->inv_mass = c->k = c->kd = c->rest = c->bmin = c->bmax = NULL;
+    c->ptag = c->sa = c->sb = c->stag = c->sstage = c->sorder = NULL;
+    c->sflags = NULL;
+    c->diam = NULL;
+    c->colliders = NULL;
+    c->metadata = NULL;
+    c->cap_p = w->np;
+    c->cap_s = w->ns;
+    bool ok = dup_array((void **)&c->x, w->x, w->np, sizeof *w->x) &&
+              dup_array((void **)&c->v, w->v, w->np, sizeof *w->v) &&
+              dup_array((void **)&c->mass, w->mass, w->np, sizeof *w->mass) &&
+              dup_array((void **)&c->inv_mass, w->inv_mass, w->np, sizeof *w->inv_mass) &&
+              dup_array((void **)&c->ptag, w->ptag, w->np, sizeof *w->ptag) &&
+              dup_array((void **)&c->sa, w->sa, w->ns, sizeof *w->sa) &&
+              dup_array((void **)&c->sb, w->sb, w->ns, sizeof *w->sb) &&
+              dup_array((void **)&c->k, w->k, w->ns, sizeof *w->k) &&
+              dup_array((void **)&c->kd, w->kd, w->ns, sizeof *w->kd) &&
+              dup_array((void **)&c->rest, w->rest, w->ns, sizeof *w->rest) &&
+              dup_array((void **)&c->bmin, w->bmin, w->ns, sizeof *w->bmin) &&
+              dup_array((void **)&c->bmax, w->bmax, w->ns, sizeof *w->bmax) &&
+              dup_array((void **)&c->sflags, w->sflags, w->ns, sizeof *w->sflags) &&
+              dup_array((void **)&c->stag, w->stag, w->ns, sizeof *w->stag) &&
+              dup_array((void **)&c->sstage, w->sstage, w->ns, sizeof *w->sstage) &&
+              dup_array((void **)&c->sorder, w->sorder, w->ns, sizeof *w->sorder) &&
+              dup_array((void **)&c->diam, w->diam, w->ndiam, sizeof *w->diam) &&
+              dup_array((void **)&c->colliders, w->colliders, w->ncolliders, sizeof *w->colliders) &&
+              dup_array((void **)&c->metadata, w->metadata, w->metadata ? strlen(w->metadata) + 1 : 0, 1);
+    if (!ok) {
+        spn_world_destroy(c);
+        return NULL;
+    }
+    return c;
+}

@@ -1,0 +1,145 @@
+#include "cli.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <ctype.h>
+
+static void vprint(const char *cmd, const char *fmt, va_list ap)
+{
+    fprintf(stderr, "spinneret%s%s: ", cmd ? " " : "", cmd ? cmd : "");
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+}
+
+int cli_usage(const char *cmd, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vprint(cmd, fmt, ap);
+    va_end(ap);
+    fprintf(stderr, "try 'spinneret %s --help'\n", cmd ? cmd : "");
+    return CLI_EXIT_USAGE;
+}
+
+int cli_fail(const char *cmd, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vprint(cmd, fmt, ap);
+    va_end(ap);
+    return CLI_EXIT_FAIL;
+}
+
+int cli_fail_status(const char *cmd, spn_status st)
+{
+    const char *msg = spn_last_error();
+    if (st == SPN_ERR_INVALID) return cli_usage(cmd, "%s", *msg ? msg : "invalid input");
+    return cli_fail(cmd, "%s", *msg ? msg : spn_status_name(st));
+}
+
+bool cli_double(const char *cmd, const char *opt, const char *text, double lo, double hi, double *out)
+{
+    char *end = NULL;
+    errno = 0;
+    double v = text ? strtod(text, &end) : NAN;
+    if (!text || end == text || *end != '\0' || !isfinite(v) || v < lo || v > hi) {
+        cli_usage(cmd, "%s: expected a number in [%g, %g], got '%s'", opt, lo, hi, text ? text : "");
+        return false;
+    }
+    *out = v;
+    return true;
+}
+
+bool cli_int(const char *cmd, const char *opt, const char *text, long lo, long hi, long *out)
+{
+    char *end = NULL;
+    errno = 0;
+    long v = text ? strtol(text, &end, 10) : 0;
+    if (!text || end == text || *end != '\0' || errno == ERANGE || v < lo || v > hi) {
+        cli_usage(cmd, "%s: expected a whole number in [%ld, %ld], got '%s'", opt, lo, hi, text ? text : "");
+        return false;
+    }
+    *out = v;
+    return true;
+}
+
+bool cli_u64(const char *cmd, const char *opt, const char *text, uint64_t *out)
+{
+    char *end = NULL;
+    errno = 0;
+    unsigned long long v = (text && *text != '-') ? strtoull(text, &end, 10) : 0;
+    if (!text || *text == '-' || end == text || *end != '\0' || errno == ERANGE) {
+        cli_usage(cmd, "%s: expected a whole number in [0, 18446744073709551615], got '%s'", opt, text ? text : "");
+        return false;
+    }
+    *out = (uint64_t)v;
+    return true;
+}
+
+bool cli_vec3(const char *cmd, const char *opt, const char *text, bool allow_2d, spn_vec3 *out)
+{
+    double c[3] = {0, 0, 0};
+    int n = 0;
+    const char *p = text ? text : "";
+    while (n < 3) {
+        char *end = NULL;
+        double v = strtod(p, &end);
+        if (end == p || !isfinite(v)) break;
+        c[n++] = v;
+        while (isspace((unsigned char)*end)) end++;
+        if (*end != ',') {
+            p = end;
+            break;
+        }
+        p = end + 1;
+    }
+    if (*p != '\0' || n < (allow_2d ? 2 : 3)) {
+        cli_usage(cmd, "%s: expected %s of finite numbers, got '%s'", opt, allow_2d ? "X,Y or X,Y,Z" : "X,Y,Z",
+                  text ? text : "");
+        return false;
+    }
+    *out = spn_v3(c[0], c[1], c[2]);
+    return true;
+}
+
+bool cli_size(const char *cmd, const char *opt, const char *text, int max_side, int *w, int *h)
+{
+    char *end = NULL;
+    long a = text ? strtol(text, &end, 10) : 0, b = 0;
+    bool ok = text && end != text && (*end == 'x' || *end == 'X');
+    if (ok) {
+        const char *q = end + 1;
+        b = strtol(q, &end, 10);
+        ok = end != q && *end == '\0';
+    }
+    if (!ok || a < 1 || b < 1 || a > max_side || b > max_side) {
+        cli_usage(cmd, "%s: expected WxH with each side in [1, %d], got '%s'", opt, max_side, text ? text : "");
+        return false;
+    }
+    *w = (int)a;
+    *h = (int)b;
+    return true;
+}
+
+const char *cli_extension(const char *path)
+{
+    static char ext[16];
+    const char *dot = strrchr(path, '.');
+    const char *slash = strrchr(path, '/');
+    if (!dot || (slash && dot < slash) || strlen(dot + 1) >= sizeof ext) return "";
+    size_t i = 0;
+    for (const char *p = dot + 1; *p; p++) ext[i++] = (char)tolower((unsigned char)*p);
+    ext[i] = '\0';
+    return ext;
+}
+
+bool cli_wants_help(int argc, char **argv)
+{
+    for (int i = 1; i < argc; i++)
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) return true;
+    return false;
+}
