@@ -7,5 +7,6 @@
 #include "world.h"
 #include "web.h"
 #include "io.h"
+#include "scenes.h"
 
 #endif
