@@ -134,6 +134,15 @@ SPN_API spn_dew_def spn_dew_def_default(void);
 /// Check a render definition; SPN_ERR_INVALID naming the first bad field.
 SPN_API spn_status spn_render_def_check(const spn_render_def *def);
 
+/// A perspective camera looking at the centre of the web's bounding box from
+/// `yaw_degrees` to the right and `pitch_degrees` above the front (+z) view,
+/// far enough back that the whole box fits in the vertical field of view.
+SPN_API spn_camera spn_camera_orbit(const spn_world *w, double yaw_degrees, double pitch_degrees, double fov_degrees);
+
+/// Width and height of a PNG file, reading it fully so a damaged file is
+/// refused here (SPN_ERR_IO: unreadable, SPN_ERR_FORMAT: not a PNG).
+SPN_API spn_status spn_png_size(const char *path, int *width, int *height);
+
 /// Is the ffmpeg program on PATH (or $SPN_FFMPEG)? Frame sequences to .mp4/.gif need it.
 SPN_API bool spn_frames_have_ffmpeg(void);
 /// The frame size a sequence was opened with.

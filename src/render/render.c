@@ -199,3 +199,19 @@ spn_status spn_render_file(const spn_world *w, const spn_render_def *def, const 
         return spn_error(SPN_ERR_INVALID, "%s: unknown output type (use .png, .svg or .pdf)", path ? path : "(null)");
     return type == OUT_PNG ? write_png(w, def, path) : write_vector(w, def, path, type);
 }
+
+spn_status spn_png_size(const char *path, int *width, int *height)
+{
+    if (!path || !*path) return spn_error(SPN_ERR_INVALID, "image path is empty");
+    cairo_surface_t *s = cairo_image_surface_create_from_png(path);
+    cairo_status_t cs = cairo_surface_status(s);
+    if (cs != CAIRO_STATUS_SUCCESS) {
+        cairo_surface_destroy(s);
+        return spn_error(cs == CAIRO_STATUS_FILE_NOT_FOUND || cs == CAIRO_STATUS_READ_ERROR ? SPN_ERR_IO : SPN_ERR_FORMAT,
+                         "%s: cannot read image: %s", path, cairo_status_to_string(cs));
+    }
+    *width = cairo_image_surface_get_width(s);
+    *height = cairo_image_surface_get_height(s);
+    cairo_surface_destroy(s);
+    return SPN_OK;
+}
