@@ -134,8 +134,8 @@ void render_options_help(FILE *out)
             "      --no-legend            no legend for --colour-by\n"
             "dew (droplets on the capture spiral):\n"
             "      --dew                  bead the capture threads with water drops\n"
-            "      --dew-spacing M        mean distance between drops [m] (default 0.004)\n"
-            "      --dew-radius M         mean drop radius [m] (default 0.0007)\n"
+            "      --dew-spacing M        mean distance between drops [m] (default 0.006)\n"
+            "      --dew-radius M         mean drop radius [m] (default 0.0013)\n"
             "      --dew-jitter F         relative spread of radii and gaps, 0..1 (default 0.35)\n"
             "      --dew-seed N           seed for the drops (default 1)\n");
 }

@@ -16,7 +16,7 @@
 
 spn_dew_def spn_dew_def_default(void)
 {
-    spn_dew_def d = {false, 4e-3, 0.7e-3, 0.35, 1};
+    spn_dew_def d = {false, 6e-3, 1.3e-3, 0.35, 1};
     return d;
 }
 
