@@ -89,6 +89,11 @@ int render_options_parse(const char *cmd, int c, const char *arg, render_options
     case RO_ALPHA: ok = cli_double(cmd, "--alpha", arg, 0, 1, &d->alpha); break;
     case RO_WIDTH_SCALE: ok = cli_double(cmd, "--width-scale", arg, 0.01, 100, &d->width_scale); break;
     case RO_GLOW: ok = cli_double(cmd, "--glow", arg, 0, 1, &d->glow); break;
+    case RO_SHEEN: ok = cli_double(cmd, "--sheen", arg, 0, 1, &d->sheen); break;
+    case RO_LIGHT:
+        ok = cli_vec3(cmd, "--light", arg, false, &d->light);
+        if (ok && spn_v3_len(d->light) == 0) ok = cli_usage(cmd, "--light: the direction must not be 0,0,0") < 0;
+        break;
     case RO_DEW: case RO_DEW_SPACING: case RO_DEW_RADIUS: case RO_DEW_JITTER: case RO_DEW_SEED:
         ok = parse_dew(cmd, c, arg, &d->dew);
         break;
@@ -130,6 +135,9 @@ void render_options_help(FILE *out)
             "      --alpha A              thread opacity 0..1 (default 1; the thesis used 0.7)\n"
             "      --width-scale S        multiply every thread width, 0.01..100 (default 1)\n"
             "      --glow G               soft halo around threads, 0..1 (default 0)\n"
+            "      --sheen S              glints where threads reflect the light, 0..1 (default 0)\n"
+            "      --light X,Y,Z          direction towards the light (default -0.4,0.5,-0.75: a low\n"
+            "                             sun behind the web)\n"
             "      --colour-by MODE       tension, strain or kind: colour scale with a legend\n"
             "      --no-legend            no legend for --colour-by\n"
             "dew (droplets on the capture spiral):\n"

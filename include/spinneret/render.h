@@ -52,6 +52,9 @@ typedef struct spn_render_def {
     spn_dew_def dew;
     bool legend;                   ///< draw the legend for colour_by modes, default true
     double glow;                   ///< soft halo around threads 0..1, default 0 (the thesis look)
+    double sheen;                  ///< glints where a thread reflects the light 0..1, default 0
+    spn_vec3 light;                ///< direction towards the (distant) light, default (-0.4, 0.5, -0.75):
+                                   ///< a low sun behind the web, which makes silk glint in arcs
 } spn_render_def;
 
 SPN_API spn_render_def spn_render_def_default(void);
@@ -98,6 +101,7 @@ typedef struct spn_strand {
     double rgb[3];               ///< colour of the whole strand (shade or kind colour)
     const double *segment_rgb;   ///< colour_by tension/strain: 3 values per segment, else NULL
     double alpha;                ///< opacity 0..1
+    const double *segment_glint; ///< sheen > 0: specular glint 0..1 per segment, else NULL
 } spn_strand;
 
 /// A dew droplet: a small water sphere.

@@ -39,6 +39,8 @@ spn_render_def spn_render_def_default(void)
     d.dew = spn_dew_def_default();
     d.legend = true;
     d.glow = 0;
+    d.sheen = 0;
+    d.light = spn_v3(-0.4, 0.5, -0.75);
     return d;
 }
 
@@ -91,6 +93,9 @@ spn_status spn_render_def_check(const spn_render_def *d)
     if (st != SPN_OK) return st;
     if (!in01(d->alpha)) return spn_error(SPN_ERR_INVALID, "render: alpha must be in [0, 1], got %g", d->alpha);
     if (!in01(d->glow)) return spn_error(SPN_ERR_INVALID, "render: glow must be in [0, 1], got %g", d->glow);
+    if (!in01(d->sheen)) return spn_error(SPN_ERR_INVALID, "render: sheen must be in [0, 1], got %g", d->sheen);
+    if (!spn_v3_finite(d->light) || spn_v3_len(d->light) == 0)
+        return spn_error(SPN_ERR_INVALID, "render: light must be a finite, non-zero direction");
     if (!(d->width_scale > 0 && d->width_scale <= 1000))
         return spn_error(SPN_ERR_INVALID, "render: width_scale must be in (0, 1000], got %g", d->width_scale);
     if ((unsigned)d->colour_by > SPN_COLOUR_STRAIN)
