@@ -16,8 +16,6 @@ int main(int argc, char **argv)
     spn_world_def wd = spn_world_def_default();
     wd.drag = 25; /* 1/s: damps the swing in a fraction of a second */
     spn_orb_scene_def od = spn_orb_scene_def_default();
-    od.rings = 14;
-    od.radials = 18;
     od.linear_density = 1e-4;
     spn_world *w;
     if (spn_scene_orb(&wd, &od, &w) != SPN_OK) {

@@ -143,7 +143,12 @@ static spn_status backdrop(spn_sink *s, const spn_render_def *d, const pov_view 
         double dist = spn_v3_len(spn_v3_sub(d->camera.target, d->camera.eye)) + behind;
         view_h = 2 * dist * tan(0.5 * d->camera.fov_degrees * SPN_PI / 180);
     }
-    st = spn_sink_printf(s,
+    /* What refracting drops and glinting silk see: a sky like the backdrop's
+     * (the camera itself only sees the backdrop). */
+    st = spn_sink_printf(s, "sky_sphere { pigment { gradient y color_map { [0 srgb <0.75, 0.65, 0.5>] "
+                            "[0.5 srgb <0.45, 0.52, 0.6>] [1 srgb <0.12, 0.16, 0.26>] } scale 2 translate -y } }\n");
+    if (st == SPN_OK)
+        st = spn_sink_printf(s,
                          "// Backdrop: the image covers the view and is cropped, never stretched.\n"
                          "#declare Back_View_H = %.9g;\n#declare Back_View_W = Back_View_H * image_width / image_height;\n"
                          "#declare Back_Aspect = %.9g;\n"
