@@ -55,10 +55,12 @@ case "$FLAGS" in *"$PREFIX"*) ;; *) fail "pkg-config flags do not point into the
 cc -std=c11 -Wall -Werror $EXTRA "$T/app/main.c" -o "$T/app/pc" $FLAGS 2>"$T/err" || fail "compile with pkg-config: $(cat "$T/err")"
 LD_LIBRARY_PATH=$(PKG_CONFIG_PATH=$PCDIR pkg-config --variable=libdir spinneret) "$T/app/pc" "$T/app/pc.json" \
     | grep -q 'round trip ok' || fail "pkg-config program failed"
-# ... and statically, with the private dependencies.
+# ... and statically, with the private dependencies (the archive in place of
+# -lspinneret, which the linker would otherwise resolve to the shared library).
 SFLAGS=$(PKG_CONFIG_PATH=$PCDIR pkg-config --static --cflags --libs spinneret)
 LIBDIR=$(PKG_CONFIG_PATH=$PCDIR pkg-config --variable=libdir spinneret)
-cc -std=c11 $EXTRA "$T/app/main.c" -o "$T/app/pc-static" "$LIBDIR/libspinneret.a" $SFLAGS 2>"$T/err" \
+SFLAGS=${SFLAGS//-lspinneret/$LIBDIR/libspinneret.a}
+cc -std=c11 $EXTRA "$T/app/main.c" -o "$T/app/pc-static" $SFLAGS 2>"$T/err" \
     || fail "static link with pkg-config --static: $(cat "$T/err")"
 "$T/app/pc-static" "$T/app/st.json" | grep -q 'round trip ok' || fail "static pkg-config program failed"
 
@@ -69,12 +71,9 @@ project(app LANGUAGES C)
 find_package(spinneret 0.1 REQUIRED)
 add_executable(app main.c)
 target_link_libraries(app PRIVATE spinneret::spinneret)
-if("$EXTRA")
-  target_compile_options(app PRIVATE $EXTRA)
-  target_link_options(app PRIVATE $EXTRA)
-endif()
 CM
-cmake -S "$T/app" -B "$T/app/build" -DCMAKE_PREFIX_PATH="$PREFIX" >"$T/cmake.log" 2>&1 \
+cmake -S "$T/app" -B "$T/app/build" -DCMAKE_PREFIX_PATH="$PREFIX" -DCMAKE_C_FLAGS="$EXTRA" \
+      -DCMAKE_EXE_LINKER_FLAGS="$EXTRA" >"$T/cmake.log" 2>&1 \
     || fail "find_package(spinneret): $(tail -15 "$T/cmake.log")"
 cmake --build "$T/app/build" >"$T/build.log" 2>&1 || fail "build with find_package: $(tail -15 "$T/build.log")"
 "$T/app/build/app" "$T/app/cm.json" | grep -q 'round trip ok' || fail "find_package program failed"
