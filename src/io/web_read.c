@@ -43,13 +43,17 @@ static const char *type_name(const cJSON *j)
     return "an invalid value";
 }
 
-/* Every key of `obj` must be one of `allowed` (NULL-terminated). */
+/* Every key of `obj` must be one of `allowed` (NULL-terminated), once: cJSON
+ * would quietly take the first of two equal keys. */
 static spn_status check_keys(const reader *r, const cJSON *obj, const char *path, const char *const *allowed)
 {
     for (const cJSON *c = obj->child; c; c = c->next) {
         bool known = false;
         for (const char *const *k = allowed; *k && !known; k++) known = strcmp(*k, c->string) == 0;
         if (!known) return bad(r, "%s%s%s: unknown field", path, *path ? "." : "", c->string);
+        for (const cJSON *d = obj->child; d != c; d = d->next)
+            if (strcmp(d->string, c->string) == 0)
+                return bad(r, "%s%s%s: field appears twice", path, *path ? "." : "", c->string);
     }
     return SPN_OK;
 }
