@@ -40,7 +40,7 @@ static const struct {
     {"position_short.json", "particles.position: has 11 entries, expected 12"},
     {"k_short.json", "springs.k: has 2 entries, expected 3"},
     {"tag_long.json", "particles.tag: has more than 4 entries"},
-    {"position_inf.json", "particles.position[4]: number out of range"},
+    {"position_inf.json", "particles.position[4] (particle 1, y): number out of range"},
     {"mass_negative.json", "particles.mass[2]: negative mass"},
     {"mass_string.json", "particles.mass[1]: expected a number, got a string"},
     {"fixed_two.json", "particles.fixed[3]: expected 0, 1, true or false, got 2"},

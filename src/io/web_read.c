@@ -91,6 +91,7 @@ typedef struct column {
     const cJSON *next; /* entry to read next; NULL for a missing optional column */
     char path[64];     /* "particles.mass" */
     uint32_t index;    /* entry index of `next` */
+    int width;         /* entries per item: 3 for vectors */
 } column;
 
 static spn_status column_open(const reader *r, const cJSON *section, const char *sect, const char *key,
@@ -99,6 +100,7 @@ static spn_status column_open(const reader *r, const cJSON *section, const char 
     snprintf(col->path, sizeof col->path, "%s.%s", sect, key);
     col->next = NULL;
     col->index = 0;
+    col->width = width;
     const cJSON *arr = cJSON_GetObjectItemCaseSensitive(section, key);
     if (!arr) return required ? bad(r, "missing field '%s'", col->path) : SPN_OK;
     if (!cJSON_IsArray(arr)) return bad(r, "%s: expected an array, got %s", col->path, type_name(arr));
@@ -119,7 +121,10 @@ static spn_status col_number(const reader *r, column *col, double dflt, double *
         return SPN_OK;
     }
     char field[96];
-    snprintf(field, sizeof field, "%s[%u]", col->path, col->index);
+    if (col->width == 3)
+        snprintf(field, sizeof field, "%s[%u] (particle %u, %c)", col->path, col->index, col->index / 3,
+                 "xyz"[col->index % 3]);
+    else snprintf(field, sizeof field, "%s[%u]", col->path, col->index);
     spn_status st = finite_number(r, col->next, field, out);
     col->next = col->next->next;
     col->index++;
