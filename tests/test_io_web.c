@@ -57,6 +57,8 @@ static const struct {
     {"gravity_short.json", "world.gravity: expected 3 numbers, got 2"},
     {"drag_negative.json", "world.drag: -1 is out of range"},
     {"particles_array.json", "particles: expected an object, got an array"},
+    {"seed_negative.json", "world.seed: expected a whole number"},      /* found by fuzz_web_json */
+    {"count_huge_number.json", "springs.count: expected a whole number"}, /* found by fuzz_web_json */
 };
 #define CORPUS_SIZE (sizeof corpus / sizeof corpus[0])
 

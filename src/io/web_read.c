@@ -74,12 +74,17 @@ static spn_status finite_number(const reader *r, const cJSON *j, const char *fie
     return SPN_OK;
 }
 
+/* On failure *out is 0, so callers may convert it to an integer type
+ * unconditionally (a refused value can be outside that type's range). */
 static spn_status whole_number(const reader *r, const cJSON *j, const char *field, double max, double *out)
 {
-    spn_status st = finite_number(r, j, field, out);
+    double v = 0;
+    *out = 0;
+    spn_status st = finite_number(r, j, field, &v);
     if (st != SPN_OK) return st;
-    if (*out < 0 || *out > max || floor(*out) != *out)
-        return bad(r, "%s: expected a whole number in [0, %.0f], got %.17g", field, max, *out);
+    if (v < 0 || v > max || floor(v) != v)
+        return bad(r, "%s: expected a whole number in [0, %.0f], got %.17g", field, max, v);
+    *out = v;
     return SPN_OK;
 }
 
