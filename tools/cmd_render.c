@@ -55,5 +55,6 @@ int cmd_render(int argc, char **argv)
     render_options_finish(&ro, w);
     spn_status st = spn_render_file(w, &ro.def, out);
     spn_world_destroy(w);
+    spn_render_release_caches();
     return st == SPN_OK ? 0 : cli_fail_status(CMD, st);
 }

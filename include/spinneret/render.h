@@ -153,6 +153,12 @@ SPN_API bool spn_frames_have_ffmpeg(void);
 /// The frame size a sequence was opened with.
 SPN_API void spn_frames_size(const spn_frames *frames, int *width, int *height);
 
+/// Release the font and surface caches cairo and fontconfig keep for the
+/// life of the process (legend text fills them), so leak checkers see a clean
+/// exit. Call once, just before exiting, when nothing else uses cairo; the
+/// commands that draw do.
+SPN_API void spn_render_release_caches(void);
+
 /* ---- progress on stderr ------------------------------------------------ */
 
 /// A one-line progress bar on stderr, shown only when stderr is a terminal

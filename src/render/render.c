@@ -220,3 +220,16 @@ spn_status spn_png_size(const char *path, int *width, int *height)
     cairo_surface_destroy(s);
     return SPN_OK;
 }
+
+#if defined(__GNUC__)
+/* fontconfig is cairo's dependency, not ours: resolved at run time if loaded. */
+extern void FcFini(void) __attribute__((weak));
+#endif
+
+void spn_render_release_caches(void)
+{
+    cairo_debug_reset_static_data();
+#if defined(__GNUC__)
+    if (FcFini) FcFini();
+#endif
+}
