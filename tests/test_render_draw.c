@@ -307,6 +307,92 @@ static void test_colour_by_tension(void **state)
     spn_world_destroy(w);
 }
 
+/* A pinhole at (0, 0, 1) with a 90 degree field of view: focal length half the
+ * canvas, so the segment from (-0.5, 0, 0) to (0.5, 0, 0) spans the middle
+ * half of the middle row. */
+static void test_perspective_projection(void **state)
+{
+    (void)state;
+    const double seg[1][4] = {{-0.5, 0.0, 0.5, 0.0}};
+    spn_world *w = segments_world(seg, 1, SPN_THREAD_GENERIC);
+    spn_render_def d = known_def(3);
+    d.camera.kind = SPN_CAMERA_PERSPECTIVE;
+    d.camera.eye = spn_v3(0, 0, 1);
+    d.camera.target = spn_v3(0, 0, 0);
+    d.camera.fov_degrees = 90;
+    uint8_t *px = malloc(SIDE * SIDE * 4);
+    assert_int_equal(spn_render_rgba(w, &d, px), SPN_OK);
+    int first = -1, last = -1;
+    for (int x = 0; x < SIDE; x++)
+        if (px[(100 * SIDE + x) * 4] > 128) {
+            if (first < 0) first = x;
+            last = x;
+        }
+    /* 50 .. 150 plus the round caps (1.5 px) */
+    assert_true(abs(first - 49) <= 1 && abs(last - 150) <= 1);
+    assert_int_equal(px[(90 * SIDE + 100) * 4], 0);
+    free(px);
+    spn_world_destroy(w);
+}
+
+/* Sheen lights the thread lying across the half vector, not the one along it:
+ * light from +x behind, eye on +z: h ~ (1, 0, 0) + (0, 0, 1) minus the light's
+ * z, so a vertical thread glints and a horizontal one does not. */
+static void test_sheen_glints_across_half_vector(void **state)
+{
+    (void)state;
+    const double seg[2][4] = {{-0.4, 0.3, 0.4, 0.3}, {0.0, -0.45, 0.0, 0.1}};
+    spn_world *w = segments_world(seg, 2, SPN_THREAD_GENERIC);
+    spn_render_def d = known_def(3);
+    for (int c = 0; c < 3; c++) d.shade_rgb[c] = 0.5;
+    uint8_t *plain = malloc(SIDE * SIDE * 4), *lit = malloc(SIDE * SIDE * 4);
+    assert_int_equal(spn_render_rgba(w, &d, plain), SPN_OK);
+    d.sheen = 1;
+    d.light = spn_v3(1, 0, -1);
+    assert_int_equal(spn_render_rgba(w, &d, lit), SPN_OK);
+    int horizontal = (40 * SIDE + 100) * 4, vertical = (150 * SIDE + 100) * 4;
+    assert_true(lit[vertical] > plain[vertical] + 60);   /* across h: glints */
+    assert_true(lit[horizontal] < plain[horizontal]);    /* along h: fades */
+    free(plain);
+    free(lit);
+    spn_world_destroy(w);
+}
+
+static spn_status keep_bead(void *user, const spn_bead *b)
+{
+    *(spn_bead *)user = *b;
+    return SPN_OK;
+}
+
+/* A dew drop reads as water: a near-white highlight towards the light (upper
+ * left), a body much darker than it, a rim, and no ink beyond its radius. */
+static void test_dew_drop_is_lit(void **state)
+{
+    (void)state;
+    const double seg[1][4] = {{-0.5, 0.0, 0.5, 0.0}};
+    spn_world *w = segments_world(seg, 1, SPN_THREAD_CAPTURE);
+    spn_render_def d = known_def(0.01);
+    d.dew.enabled = true;
+    d.dew.spacing = 0.9;  /* the first drop within 0.9 m, the next beyond the 1 m thread */
+    d.dew.radius = 0.1;   /* 20 px at 200 px/m */
+    d.dew.radius_jitter = 0;
+    spn_bead b = {{0, 0, 0}, 0, 0};
+    spn_draw_fns fns = {NULL, keep_bead, NULL};
+    assert_int_equal(spn_draw_world(w, &d, &fns, &b), SPN_OK);
+    assert_true(fabs(b.radius - 0.1) < 1e-12);
+    uint8_t *px = malloc(SIDE * SIDE * 4);
+    assert_int_equal(spn_render_rgba(w, &d, px), SPN_OK);
+    double cx = 100 + 200 * b.centre.x, cy = 100 - 200 * b.centre.y, r = 20;
+#define G(x, y) px[((int)(y) * SIDE + (int)(x)) * 4 + 1]
+    assert_true(G(cx - 0.36 * r, cy - 0.38 * r) > 230);       /* highlight */
+    assert_true(G(cx, cy) < 120);                              /* clear body */
+    assert_true(G(cx - 0.95 * r, cy) > G(cx - 0.5 * r, cy));   /* brighter rim on a dark backdrop */
+    assert_true(G(cx, cy - 1.3 * r) == 0 && G(cx + 1.3 * r, cy - 0.5 * r) == 0);
+#undef G
+    free(px);
+    spn_world_destroy(w);
+}
+
 static void test_bad_definitions(void **state)
 {
     (void)state;
@@ -364,7 +450,8 @@ int main(void)
         cmocka_unit_test(test_background_shows_where_no_thread), cmocka_unit_test(test_orb_web_strands),
         cmocka_unit_test(test_dew_spacing_and_radius),  cmocka_unit_test(test_deterministic_pixels),
         cmocka_unit_test(test_colour_by_tension),       cmocka_unit_test(test_bad_definitions),
-        cmocka_unit_test(test_vector_outputs),
+        cmocka_unit_test(test_vector_outputs),          cmocka_unit_test(test_perspective_projection),
+        cmocka_unit_test(test_sheen_glints_across_half_vector), cmocka_unit_test(test_dew_drop_is_lit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
