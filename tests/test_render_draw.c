@@ -93,6 +93,35 @@ static void test_ink_where_expected(void **state)
     spn_world_destroy(w);
 }
 
+/* Widths follow the kind: anchor 2.4 / capture 1.0 / generic 1.3 (and an
+ * unknown tag draws like generic), measured as ink per unit length. */
+static void test_kind_widths(void **state)
+{
+    (void)state;
+    const uint32_t tags[4] = {SPN_THREAD_ANCHOR, SPN_THREAD_CAPTURE, SPN_THREAD_GENERIC, 999};
+    double ink[4];
+    for (int k = 0; k < 4; k++) {
+        const double seg[1][4] = {{-0.4, 0.0, 0.4, 0.0}};
+        spn_world *w = segments_world(seg, 1, tags[k]);
+        spn_render_def d = known_def(5);  /* generic: 5 px */
+        for (int c = 0; c < 3; c++) d.shade_rgb[c] = 1;
+        uint8_t *px = malloc(SIDE * SIDE * 4);
+        assert_int_equal(spn_render_rgba(w, &d, px), SPN_OK);
+        ink[k] = 0;
+        for (int y = 0; y < SIDE; y++)
+            for (int x = 40; x < 160; x++) ink[k] += px[(y * SIDE + x) * 4] / 255.0; /* away from the caps */
+        ink[k] /= spn_thread_kind_shade(tags[k]); /* capture is drawn a little greyer */
+        free(px);
+        spn_world_destroy(w);
+    }
+    double generic = 5 * 120;
+    assert_true(fabs(ink[2] - generic) < 0.02 * generic);
+    assert_true(fabs(ink[0] / ink[2] - spn_thread_kind_width(SPN_THREAD_ANCHOR) / 1.3) < 0.03);
+    assert_true(fabs(ink[1] / ink[2] - spn_thread_kind_width(SPN_THREAD_CAPTURE) / 1.3) < 0.03);
+    assert_true(spn_thread_kind_width(SPN_THREAD_ANCHOR) > spn_thread_kind_width(SPN_THREAD_CAPTURE));
+    assert_true(fabs(ink[3] - ink[2]) < 1e-9);
+}
+
 /* A bent chain of three springs: one strand, so its joints blend like its middle. */
 static void test_alpha_blend_and_joints(void **state)
 {
@@ -446,7 +475,8 @@ static void test_vector_outputs(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_ink_where_expected),      cmocka_unit_test(test_alpha_blend_and_joints),
+        cmocka_unit_test(test_ink_where_expected),      cmocka_unit_test(test_kind_widths),
+        cmocka_unit_test(test_alpha_blend_and_joints),
         cmocka_unit_test(test_background_shows_where_no_thread), cmocka_unit_test(test_orb_web_strands),
         cmocka_unit_test(test_dew_spacing_and_radius),  cmocka_unit_test(test_deterministic_pixels),
         cmocka_unit_test(test_colour_by_tension),       cmocka_unit_test(test_bad_definitions),
