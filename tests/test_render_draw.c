@@ -364,6 +364,46 @@ static void test_perspective_projection(void **state)
     spn_world_destroy(w);
 }
 
+/* --smooth: a closed hexagon of one kind becomes a Catmull-Rom curve through
+ * its corners; midway between two corners it passes (-P0 + 9 P1 + 9 P2 - P3)
+ * / 16 (equal spacing), outside the straight chord. */
+static void test_smooth_strands(void **state)
+{
+    (void)state;
+    spn_world *w = spn_world_create(NULL);
+    const double r = 0.4;
+    for (int i = 0; i < 6; i++) {
+        spn_particle_def p = spn_particle_def_default();
+        p.position = spn_v3(r * cos(i * SPN_PI / 3), r * sin(i * SPN_PI / 3), 0);
+        assert_int_equal(spn_world_add_particle(w, &p, NULL), SPN_OK);
+    }
+    for (uint32_t i = 0; i < 6; i++) {
+        spn_spring_def sd = spn_spring_def_default();
+        sd.a = i;
+        sd.b = (i + 1) % 6;
+        sd.k = 1;
+        sd.rest = -1;
+        assert_int_equal(spn_world_add_spring(w, &sd, NULL), SPN_OK);
+    }
+    /* Along the 30 degree bisector: the chord at r cos 30, the curve at
+     * (9 + 9) r cos 30 / 16 - 2 r cos 90 / 16 (P0 and P3 at -60 and 120 degrees). */
+    double chord = r * cos(SPN_PI / 6), curve = 18 * r * cos(SPN_PI / 6) / 16 - 2 * r * cos(SPN_PI / 2) / 16;
+    uint8_t *px = malloc(SIDE * SIDE * 4);
+    spn_render_def d = known_def(2);
+    for (int smooth = 0; smooth < 2; smooth++) {
+        d.smooth = smooth;
+        assert_int_equal(spn_render_rgba(w, &d, px), SPN_OK);
+        int xc = (int)(100 + 200 * chord * cos(SPN_PI / 6)), yc = (int)(100 - 200 * chord * sin(SPN_PI / 6));
+        int xs = (int)(100 + 200 * curve * cos(SPN_PI / 6)), ys = (int)(100 - 200 * curve * sin(SPN_PI / 6));
+        uint8_t on_chord = px[(yc * SIDE + xc) * 4], on_curve = px[(ys * SIDE + xs) * 4];
+        assert_true(smooth ? (on_curve > 100 && on_chord == 0) : (on_chord > 100 && on_curve == 0));
+        /* Both pass through the corners. */
+        assert_true(px[(100 * SIDE + (int)(100 + 200 * r) - 1) * 4] > 100);
+    }
+    free(px);
+    spn_world_destroy(w);
+}
+
 /* Sheen lights the thread lying across the half vector, not the one along it:
  * light from +x behind, eye on +z: h ~ (1, 0, 0) + (0, 0, 1) minus the light's
  * z, so a vertical thread glints and a horizontal one does not. */
@@ -482,6 +522,7 @@ int main(void)
         cmocka_unit_test(test_colour_by_tension),       cmocka_unit_test(test_bad_definitions),
         cmocka_unit_test(test_vector_outputs),          cmocka_unit_test(test_perspective_projection),
         cmocka_unit_test(test_sheen_glints_across_half_vector), cmocka_unit_test(test_dew_drop_is_lit),
+        cmocka_unit_test(test_smooth_strands),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -104,6 +104,7 @@ int render_options_parse(const char *cmd, int c, const char *arg, render_options
         break;
     case RO_COLOUR_BY: ok = colour_by(cmd, arg, &d->colour_by); break;
     case RO_NO_LEGEND: d->legend = false; break;
+    case RO_SMOOTH: d->smooth = true; break;
     default: return 0;
     }
     return ok ? 1 : -1;
@@ -147,6 +148,7 @@ void render_options_help(FILE *out)
             "      --sheen S              glints where threads reflect the light, 0..1 (default 0)\n"
             "      --light X,Y,Z          direction towards the light (default -0.4,0.5,-0.75: a low\n"
             "                             sun behind the web)\n"
+            "      --smooth               strands as smooth curves through their particles\n"
             "      --colour-by MODE       tension, strain or kind: colour scale with a legend\n"
             "      --no-legend            no legend for --colour-by\n"
             "dew (droplets on the capture spiral):\n"

@@ -55,6 +55,8 @@ typedef struct spn_render_def {
     double sheen;                  ///< glints where a thread reflects the light 0..1, default 0
     spn_vec3 light;                ///< direction towards the (distant) light, default (-0.4, 0.5, -0.75):
                                    ///< a low sun behind the web, which makes silk glint in arcs
+    bool smooth;                   ///< draw strands as centripetal Catmull-Rom curves through their
+                                   ///< particles instead of straight segments, default false
 } spn_render_def;
 
 SPN_API spn_render_def spn_render_def_default(void);

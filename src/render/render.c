@@ -42,6 +42,7 @@ spn_render_def spn_render_def_default(void)
     d.glow = 0;
     d.sheen = 0;
     d.light = spn_v3(-0.4, 0.5, -0.75);
+    d.smooth = false;
     return d;
 }
 
