@@ -121,7 +121,7 @@ int cmd_render(int argc, char **argv)
     int code = parse(argc, argv, &o);
     if (code >= 0) return code;
     spn_world *w;
-    if ((code = load_world(CMD, o.in, &w)) != 0) return code;
+    if ((code = render_load_world(CMD, o.in, &w)) != 0) return code;
     render_options_finish(&o.ro, w);
     if (o.turntable > 0) {
         code = turntable(&o, w);

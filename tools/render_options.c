@@ -182,7 +182,7 @@ static int load_scene(const char *cmd, const char *spec, spn_world **w)
     return st == SPN_OK ? 0 : cli_fail(cmd, "scene:%s: %s", spec, spn_last_error());
 }
 
-int load_world(const char *cmd, const char *spec, spn_world **w)
+int render_load_world(const char *cmd, const char *spec, spn_world **w)
 {
     *w = NULL;
     if (strncmp(spec, "scene:", 6) == 0) return load_scene(cmd, spec + 6, w);

@@ -51,6 +51,6 @@ void render_options_help(FILE *out);
 /* Load a world from a web file, or build a shared scene: "scene:orb",
  * "scene:orb:RINGSxRADIALS", "scene:chain", "scene:cloth". Returns 0, or
  * prints the failure (naming the file) and returns the exit code. */
-int load_world(const char *cmd, const char *spec, spn_world **w);
+int render_load_world(const char *cmd, const char *spec, spn_world **w);
 
 #endif
