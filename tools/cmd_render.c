@@ -89,8 +89,6 @@ static int turntable(cmd_options *o, const spn_world *w)
     spn_frames *frames;
     if (spn_frames_open(o->out, d->width, d->height, o->fps, &frames) != SPN_OK)
         return cli_fail(CMD, "%s", spn_last_error());
-    uint8_t *rgba = malloc((size_t)d->width * d->height * 4);
-    if (!rgba) return spn_frames_close(frames, false), cli_fail(CMD, "out of memory");
     spn_progress *bar = spn_progress_begin("render", (uint64_t)o->turntable, o->quiet);
     double swing = o->ro.yaw != 0 ? o->ro.yaw : 25;
     spn_status st = SPN_OK;
@@ -99,12 +97,10 @@ static int turntable(cmd_options *o, const spn_world *w)
         spn_camera cam = spn_camera_orbit(w, yaw, o->ro.pitch, d->camera.fov_degrees);
         d->camera.eye = cam.eye;
         d->camera.target = cam.target;
-        st = spn_render_rgba(w, d, rgba);
-        if (st == SPN_OK) st = spn_frames_add(frames, rgba);
+        st = spn_frames_add_world(frames, w, d);
         spn_progress_update(bar, (uint64_t)i + 1);
     }
     spn_progress_end(bar);
-    free(rgba);
     if (st != SPN_OK) {
         spn_frames_close(frames, false);
         return cli_fail_status(CMD, st);

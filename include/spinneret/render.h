@@ -152,6 +152,9 @@ SPN_API spn_status spn_png_size(const char *path, int *width, int *height);
 
 /// Is the ffmpeg program on PATH (or $SPN_FFMPEG)? Frame sequences to .mp4/.gif need it.
 SPN_API bool spn_frames_have_ffmpeg(void);
+/// Render `w` with `def` (its size must be the sequence's) and add it as the
+/// next frame: the one call an animation loop needs.
+SPN_API spn_status spn_frames_add_world(spn_frames *frames, const spn_world *w, const spn_render_def *def);
 /// The frame size a sequence was opened with.
 SPN_API void spn_frames_size(const spn_frames *frames, int *width, int *height);
 
