@@ -3,13 +3,14 @@
 # its corpus seeded from the globs in fuzz/seeds/<harness>. Prints one JSON line
 # per harness (executions, corpus size, crashes) and fails if any crashed;
 # crashing inputs are kept in BUILD/fuzz-crashes/ (make each one a test in
-# tests/data/bad/ before fixing it).
+# tests/data/bad/ before fixing it). FUZZ_ONLY=fuzz_cli runs one harness.
 set -u
-build=$1
 seconds=${FUZZ_SECONDS:-60}
+# Absolute: a harness may work in a folder of its own (fuzz_cli does).
+build=$(cd "$1" && pwd) || exit 2
 cd "$(dirname "$0")/.."
 crashed=0
-for h in "$build"/fuzz/fuzz_*; do
+for h in "$build"/fuzz/${FUZZ_ONLY:-fuzz_*}; do
   [ -x "$h" ] || continue
   name=$(basename "$h")
   corpus="$build/fuzz-corpus/$name"
@@ -24,8 +25,23 @@ for h in "$build"/fuzz/fuzz_*; do
       for f in $glob; do [ -f "$f" ] && cp "$f" "$corpus/" 2>/dev/null; done
     done < "fuzz/seeds/$name"
   fi
+  # A dictionary: fuzz/<harness>.dict if there is one; for the command-line
+  # harness also every subcommand's name and the options its --help names.
+  dict="$build/fuzz-$name.dict"
+  : >"$dict"
+  [ -f "fuzz/$name.dict" ] && cat "fuzz/$name.dict" >>"$dict"
+  if [ "$name" = fuzz_cli ] && [ -x "$build/spinneret" ]; then
+    for cmd in $("$build/spinneret" --help | awk '/^commands:/{on=1;next} on&&NF{print $1}'); do
+      printf '"%s\\x0a"\n' "$cmd" >>"$dict"
+      "$build/spinneret" "$cmd" --help 2>/dev/null | grep -oE -- '--[a-z][a-z0-9-]*' | sort -u |
+        sed 's/.*/"\\x0a&\\x0a"/' >>"$dict"
+    done
+    sort -u -o "$dict" "$dict"
+  fi
+  dictarg=()
+  [ -s "$dict" ] && dictarg=(-dict="$dict")
   log="$build/fuzz-$name.log"
-  "$h" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=1024 \
+  "$h" "${dictarg[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=1024 \
        -print_final_stats=1 -artifact_prefix="$crashes/$name-" "$corpus" >"$log" 2>&1
   rc=$?
   runs=$(grep -o 'Done [0-9]* runs' "$log" | tail -1 | grep -o '[0-9]*')
