@@ -144,3 +144,49 @@ bool cli_wants_help(int argc, char **argv)
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) return true;
     return false;
 }
+
+static bool max_particles(const char *cmd, const char *text)
+{
+    long n;
+    if (!cli_int(cmd, "--max-particles", text, 1, (long)UINT32_MAX - 1, &n)) return false;
+    spn_set_max_particles((uint32_t)n);
+    return true;
+}
+
+int cli_global_options(const char *cmd, int *argc, char **argv)
+{
+    static const char opt[] = "--max-particles";
+    int out = 0;
+    for (int i = 0; i < *argc; i++) {
+        if (strcmp(argv[i], "--") == 0) { /* operands from here on */
+            while (i < *argc) argv[out++] = argv[i++];
+            break;
+        }
+        if (strncmp(argv[i], opt, sizeof opt - 1) != 0 || (argv[i][sizeof opt - 1] && argv[i][sizeof opt - 1] != '=')) {
+            argv[out++] = argv[i];
+            continue;
+        }
+        const char *value = argv[i][sizeof opt - 1] == '=' ? argv[i] + sizeof opt : (i + 1 < *argc ? argv[++i] : NULL);
+        if (!value) return cli_usage(cmd, "--max-particles: missing value");
+        if (!max_particles(cmd, value)) return CLI_EXIT_USAGE;
+    }
+    argv[out] = NULL;
+    *argc = out;
+    return -1;
+}
+
+void cli_interruptible(uint64_t total)
+{
+    spn_interrupt_progress(0, total);
+    spn_interrupt_graceful(true);
+}
+
+int cli_report_interrupt(const char *cmd, uint64_t done, uint64_t total, const char *kept, int code)
+{
+    int sig = spn_interrupted();
+    spn_interrupt_graceful(false);
+    if (!sig) return code;
+    fprintf(stderr, "spinneret %s: interrupted (%s) after %llu of %llu; %s\n", cmd, spn_signal_name(sig),
+            (unsigned long long)done, (unsigned long long)total, kept);
+    return 128 + sig;
+}

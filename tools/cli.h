@@ -25,6 +25,21 @@ bool cli_u64(const char *cmd, const char *opt, const char *text, uint64_t *out);
 bool cli_vec3(const char *cmd, const char *opt, const char *text, bool allow_2d, spn_vec3 *out);
 /* "WxH" with 1 <= W, H <= max_side. */
 bool cli_size(const char *cmd, const char *opt, const char *text, int max_side, int *w, int *h);
+/* Options every subcommand takes, removed from argv before the command sees
+ * them: --max-particles N (or --max-particles=N) sets the library's particle
+ * limit (spn_set_max_particles). Returns -1 to go on, else an exit code. */
+int cli_global_options(const char *cmd, int *argc, char **argv);
+#define CLI_GLOBAL_HELP                                                                                     \
+    "global options (any command):\n"                                                                       \
+    "  --max-particles N   refuse worlds with more than N particles (default 4000000; springs 8 per particle)\n"
+
+/* A long loop that can stop between frames: turn graceful interrupts on
+ * (see spinneret/interrupt.h), and after the loop call cli_report_interrupt. */
+void cli_interruptible(uint64_t total);
+/* When a signal stopped the loop after `done` units: print how far it got and
+ * what was kept, and return 128 + the signal; otherwise return `code`. */
+int cli_report_interrupt(const char *cmd, uint64_t done, uint64_t total, const char *kept, int code);
+
 /* Lower-case file extension of a path ("png"), or "" when none. */
 const char *cli_extension(const char *path);
 /* True when argv has --help or -h (print usage then). */

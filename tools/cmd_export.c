@@ -102,6 +102,10 @@ static int export_one(export_options *o, const char *in)
     int code = render_load_world(CMD, in, &w);
     if (code) return code;
     render_options_finish(&o->ro, w);
+    if ((code = render_options_check(CMD, &o->ro)) >= 0) {
+        spn_world_destroy(w);
+        return code;
+    }
     o->def.render = o->ro.def;
     spn_status st = strcmp(cli_extension(o->out), "json") == 0 ? spn_web_save(w, o->out)
                                                                : spn_export_file(w, &o->def, o->out);
@@ -136,19 +140,27 @@ static int export_frames(export_options *o, char **files, int n)
         cam->fixed_bounds = true;
     }
     spn_progress *bar = spn_progress_begin("export", (uint64_t)n, o->quiet);
-    for (int i = 0; i < n; i++) {
+    int i = 0;
+    cli_interruptible((uint64_t)n);
+    for (; i < n && !spn_interrupted(); i++) {
         spn_world *w;
         int code = render_load_world(CMD, files[i], &w);
         if (code) return spn_progress_end(bar), code;
         if (i == 0) render_options_finish(&o->ro, w); /* the first frame fixes a perspective camera */
+        if (i == 0 && (code = render_options_check(CMD, &o->ro)) >= 0) {
+            spn_world_destroy(w);
+            spn_interrupt_graceful(false);
+            return spn_progress_end(bar), code;
+        }
         o->def.render = o->ro.def;
         spn_status st = spn_export_pov_frame(w, &o->def, o->frames, i);
         spn_world_destroy(w);
         if (st != SPN_OK) return spn_progress_end(bar), cli_fail_status(CMD, st);
         spn_progress_update(bar, (uint64_t)i + 1);
+        spn_interrupt_progress((uint64_t)i + 1, (uint64_t)n);
     }
     spn_progress_end(bar);
-    return 0;
+    return cli_report_interrupt(CMD, (uint64_t)i, (uint64_t)n, "the complete frames are kept", 0);
 }
 
 int cmd_export(int argc, char **argv)

@@ -92,20 +92,27 @@ static int turntable(cmd_options *o, const spn_world *w)
     spn_progress *bar = spn_progress_begin("render", (uint64_t)o->turntable, o->quiet);
     double swing = o->ro.yaw != 0 ? o->ro.yaw : 25;
     spn_status st = SPN_OK;
-    for (long i = 0; i < o->turntable && st == SPN_OK; i++) {
+    long i = 0;
+    cli_interruptible((uint64_t)o->turntable);
+    for (; i < o->turntable && st == SPN_OK && !spn_interrupted(); i++) {
         double yaw = swing * sin(2 * SPN_PI * (double)i / (double)o->turntable);
         spn_camera cam = spn_camera_orbit(w, yaw, o->ro.pitch, d->camera.fov_degrees);
         d->camera.eye = cam.eye;
         d->camera.target = cam.target;
         st = spn_frames_add_world(frames, w, d);
         spn_progress_update(bar, (uint64_t)i + 1);
+        spn_interrupt_progress((uint64_t)i + 1, (uint64_t)o->turntable);
     }
     spn_progress_end(bar);
     if (st != SPN_OK) {
+        spn_interrupt_graceful(false);
         spn_frames_close(frames, false);
         return cli_fail_status(CMD, st);
     }
-    return spn_frames_close(frames, true) == SPN_OK ? 0 : cli_fail(CMD, "%s", spn_last_error());
+    /* Interrupted or not, the complete frames are kept (a shorter video). */
+    int code = spn_frames_close(frames, true) == SPN_OK ? 0 : cli_fail(CMD, "%s", spn_last_error());
+    return cli_report_interrupt(CMD, (uint64_t)i, (uint64_t)o->turntable,
+                                code ? "nothing kept" : "the complete frames are kept", code);
 }
 
 int cmd_render(int argc, char **argv)
@@ -119,6 +126,10 @@ int cmd_render(int argc, char **argv)
     spn_world *w;
     if ((code = render_load_world(CMD, o.in, &w)) != 0) return code;
     render_options_finish(&o.ro, w);
+    if ((code = render_options_check(CMD, &o.ro)) >= 0) {
+        spn_world_destroy(w);
+        return code;
+    }
     if (o.turntable > 0) {
         code = turntable(&o, w);
     } else {

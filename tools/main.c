@@ -28,6 +28,7 @@ static void usage(FILE *out)
                  "       spinneret COMMAND --help\n"
                  "       spinneret --version\n\ncommands:\n");
     for (const command *c = commands; c->name; c++) fprintf(out, "  %-10s %s\n", c->name, c->summary);
+    fprintf(out, "\n" CLI_GLOBAL_HELP);
 }
 
 int main(int argc, char **argv)
@@ -46,7 +47,13 @@ int main(int argc, char **argv)
     }
     for (const command *c = commands; c->name; c++)
         if (strcmp(argv[1], c->name) == 0) {
-            int rc = c->fn(argc - 1, argv + 1);
+            int n = argc - 1, rc = cli_global_options(c->name, &n, argv + 1);
+            if (rc >= 0) return rc;
+            /* A signal removes the output being written (see interrupt.h). */
+            char label[64];
+            snprintf(label, sizeof label, "spinneret %s", c->name);
+            spn_interrupt_catch(label, NULL);
+            rc = c->fn(n, argv + 1);
             spn_render_release_caches(); /* font caches: keeps leak checkers quiet */
             return rc;
         }

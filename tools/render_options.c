@@ -1,6 +1,7 @@
 /* Options shared by the commands that draw or export a web; see render_options.h. */
 #include "render_options.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -60,8 +61,33 @@ static bool background(const char *cmd, const char *arg, spn_render_def *d)
 static bool light(const char *cmd, const char *arg, spn_vec3 *dir)
 {
     if (!cli_vec3(cmd, "--light", arg, false, dir)) return false;
-    if (spn_v3_len(*dir) > 0) return true;
-    cli_usage(cmd, "--light: a direction, not 0,0,0");
+    if (spn_v3_len(*dir) > 0 && isfinite(spn_v3_len(*dir))) return true;
+    cli_usage(cmd, "--light: expected a direction X,Y,Z (not 0,0,0, length finite), got '%s'", arg);
+    return false;
+}
+
+/* Camera points and directions: coordinates within a thousand kilometres,
+ * so differences and cross products stay finite. */
+#define RO_MAX_COORD 1e6
+
+static bool point(const char *cmd, const char *opt, const char *arg, spn_vec3 *out)
+{
+    spn_vec3 p;
+    if (!cli_vec3(cmd, opt, arg, false, &p)) return false;
+    if (fabs(p.x) > RO_MAX_COORD || fabs(p.y) > RO_MAX_COORD || fabs(p.z) > RO_MAX_COORD) {
+        cli_usage(cmd, "%s: expected X,Y,Z with each in [%g, %g] m, got '%s'", opt, -RO_MAX_COORD, RO_MAX_COORD, arg);
+        return false;
+    }
+    *out = p;
+    return true;
+}
+
+static bool size(const char *cmd, const char *arg, spn_render_def *d)
+{
+    if (!cli_size(cmd, "--size", arg, 16384, &d->width, &d->height)) return false;
+    if ((double)d->width * d->height <= RO_MAX_PIXELS) return true;
+    cli_usage(cmd, "--size: expected WxH of at most %.0f million pixels (each side in [1, 16384]), got '%s'",
+              RO_MAX_PIXELS / 1e6, arg);
     return false;
 }
 
@@ -82,11 +108,11 @@ int render_options_parse(const char *cmd, int c, const char *arg, render_options
     spn_render_def *d = &o->def;
     bool ok = true;
     switch (c) {
-    case RO_SIZE: ok = cli_size(cmd, "--size", arg, 16384, &d->width, &d->height); break;
+    case RO_SIZE: ok = size(cmd, arg, d); break;
     case RO_CAMERA: ok = camera_kind(cmd, arg, &d->camera.kind); break;
-    case RO_EYE: ok = o->eye_set = cli_vec3(cmd, "--eye", arg, false, &d->camera.eye); break;
-    case RO_TARGET: ok = o->target_set = cli_vec3(cmd, "--target", arg, false, &d->camera.target); break;
-    case RO_UP: ok = cli_vec3(cmd, "--up", arg, false, &d->camera.up); break;
+    case RO_EYE: ok = o->eye_set = point(cmd, "--eye", arg, &d->camera.eye); break;
+    case RO_TARGET: ok = o->target_set = point(cmd, "--target", arg, &d->camera.target); break;
+    case RO_UP: ok = point(cmd, "--up", arg, &d->camera.up); break;
     case RO_FOV: ok = cli_double(cmd, "--fov", arg, 1, 170, &d->camera.fov_degrees); break;
     case RO_YAW: ok = cli_double(cmd, "--yaw", arg, -360, 360, &o->yaw); break;
     case RO_PITCH: ok = cli_double(cmd, "--pitch", arg, -89, 89, &o->pitch); break;
@@ -122,6 +148,20 @@ void render_options_finish(render_options *o, const spn_world *w)
     }
     c->eye = orbit.eye;
     c->target = orbit.target;
+}
+
+int render_options_check(const char *cmd, const render_options *o)
+{
+    const spn_camera *c = &o->def.camera;
+    if (c->kind != SPN_CAMERA_PERSPECTIVE) return -1;
+    spn_vec3 forward = spn_v3_sub(c->target, c->eye);
+    double dist = spn_v3_len(forward);
+    if (!(dist > 0) || !isfinite(dist))
+        return cli_usage(cmd, "--eye, --target: expected two different points, got the eye at the target");
+    spn_vec3 up = spn_v3_len(c->up) > 0 ? c->up : spn_v3(0, 1, 0);
+    if (!(spn_v3_len(spn_v3_cross(spn_v3_norm(forward), spn_v3_norm(up))) > 1e-9))
+        return cli_usage(cmd, "--up: expected a direction not along the line from --eye to --target");
+    return -1;
 }
 
 void render_options_help(FILE *out)

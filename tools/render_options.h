@@ -45,6 +45,12 @@ int render_options_parse(const char *cmd, int c, const char *arg, render_options
 /* Settle what depends on the world: the perspective camera's default eye and
  * target frame the web. */
 void render_options_finish(render_options *o, const spn_world *w);
+/* After render_options_finish: a perspective camera whose eye sits on its
+ * target or looks along its up is refused naming the options. Returns -1 to
+ * go on, else the exit code (2) after printing the usage line. */
+int render_options_check(const char *cmd, const render_options *o);
+/* The library's picture limit (spn_render_def_check), checked with --size. */
+#define RO_MAX_PIXELS (100.0 * 1000 * 1000)
 /* The help text for these options. */
 void render_options_help(FILE *out);
 

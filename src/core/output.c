@@ -3,6 +3,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "spinneret/core.h"
 
+#include "core_internal.h"
+
 #include <errno.h>
 #include <stdarg.h>
 #include <stdlib.h>
@@ -32,10 +34,12 @@ spn_status spn_atomic_open(spn_atomic_file *f, const char *path, bool open_strea
     const char *slash = strrchr(path, '/');
     const char *base = slash ? slash + 1 : path;
     snprintf(f->tmp_path, n, "%.*s.tmp%ld-%s", (int)(base - path), path, (long)getpid(), base);
+    spn__temp_track(f->tmp_path);
     if (open_stream) {
         f->fp = fopen(f->tmp_path, "wb");
         if (!f->fp) {
             spn_status st = spn_error(SPN_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
+            spn__temp_untrack(f->tmp_path);
             free(f->path);
             free(f->tmp_path);
             memset(f, 0, sizeof *f);
@@ -57,6 +61,7 @@ spn_status spn_atomic_commit(spn_atomic_file *f)
     if (st == SPN_OK && rename(f->tmp_path, f->path) != 0)
         st = spn_error(SPN_ERR_IO, "%s: cannot write: %s", f->path, strerror(errno));
     if (st != SPN_OK) remove(f->tmp_path);
+    spn__temp_untrack(f->tmp_path);
     free(f->path);
     free(f->tmp_path);
     memset(f, 0, sizeof *f);
@@ -67,6 +72,7 @@ void spn_atomic_abort(spn_atomic_file *f)
 {
     if (f->fp) fclose(f->fp);
     if (f->tmp_path) remove(f->tmp_path);
+    spn__temp_untrack(f->tmp_path);
     free(f->path);
     free(f->tmp_path);
     memset(f, 0, sizeof *f);

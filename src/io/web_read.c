@@ -10,6 +10,8 @@
  * otherwise be silently ignored); free-form data belongs in "metadata". */
 #include "io_internal.h"
 
+#include "spinneret/limits.h"
+
 #include <cjson/cJSON.h>
 #include <errno.h>
 #include <math.h>
@@ -443,6 +445,7 @@ static spn_status read_document(const reader *r, const cJSON *root, spn_world **
     if (st == SPN_OK) st = read_count(r, ss, "springs", &ns);
     if (st == SPN_OK) st = open_particles(r, ps, np, &pc);
     if (st == SPN_OK) st = open_springs(r, ss, ns, &sc);
+    if (st == SPN_OK) st = spn_check_counts(r->name, np, ns); /* before the world grows */
     if (st != SPN_OK) return st;
 
     spn_world *w = spn_world_create(&def);

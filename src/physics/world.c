@@ -4,6 +4,8 @@
  * next step compiles again (cheap: one counting sort over the springs). */
 #include "world_internal.h"
 
+#include "spinneret/limits.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -171,7 +173,8 @@ spn_status spn_world_add_particle(spn_world *w, const spn_particle_def *def, uin
         return spn_error(SPN_ERR_INVALID, "particle %u: position and velocity must be finite", w->np);
     if (!(def->mass >= 0) || !isfinite(def->mass))
         return spn_error(SPN_ERR_INVALID, "particle %u: mass must be finite and not negative", w->np);
-    if (w->np == UINT32_MAX || !reserve_particles(w, w->np + 1)) return spn_error(SPN_ERR_NOMEM, "out of memory");
+    if (w->np >= spn_max_particles()) return spn_check_counts("world", (uint64_t)w->np + 1, 0);
+    if (!reserve_particles(w, w->np + 1)) return spn_error(SPN_ERR_NOMEM, "out of memory");
     uint32_t i = w->np++;
     w->x[i] = def->position;
     w->v[i] = def->fixed ? spn_v3(0, 0, 0) : def->velocity;
@@ -193,7 +196,8 @@ spn_status spn_world_add_spring(spn_world *w, const spn_spring_def *def, uint32_
         return spn_error(SPN_ERR_INVALID, "spring %u: stiffness and damping must be finite and not negative", s);
     if (isnan(def->rest) || isinf(def->rest) || isnan(def->break_min) || isnan(def->break_max))
         return spn_error(SPN_ERR_INVALID, "spring %u: rest and break lengths must be numbers", s);
-    if (s == UINT32_MAX || !reserve_springs(w, s + 1)) return spn_error(SPN_ERR_NOMEM, "out of memory");
+    if (s >= spn_max_springs()) return spn_check_counts("world", 0, (uint64_t)s + 1);
+    if (!reserve_springs(w, s + 1)) return spn_error(SPN_ERR_NOMEM, "out of memory");
     w->sa[s] = def->a;
     w->sb[s] = def->b;
     w->k[s] = def->k;

@@ -121,6 +121,9 @@ static spn_status start_ffmpeg(spn_frames *f, const char *out)
     }
     pid_t pid = fork();
     if (pid == 0) {
+        /* A Ctrl-C reaches the whole process group: ffmpeg ignores it, so the
+         * program can stop between frames and close the video cleanly. */
+        signal(SIGINT, SIG_IGN);
         dup2(fds[0], 0);
         close(fds[0]);
         close(fds[1]);

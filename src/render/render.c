@@ -65,6 +65,11 @@ static spn_status check_camera(const spn_camera *c)
             return spn_error(SPN_ERR_INVALID, "render: camera.fov_degrees must be in (0, 180), got %g", c->fov_degrees);
         if (!spn_v3_finite(c->eye) || !spn_v3_finite(c->target) || !spn_v3_finite(c->up))
             return spn_error(SPN_ERR_INVALID, "render: camera eye, target and up must be finite");
+        /* Finite points can still be too far apart for a finite distance
+         * (1e300 each way): the POV export would write inf. */
+        double dist = spn_v3_len(spn_v3_sub(c->target, c->eye));
+        if (!(dist > 0) || !isfinite(dist))
+            return spn_error(SPN_ERR_INVALID, "render: camera eye and target must be apart by a finite distance");
     } else if (c->kind != SPN_CAMERA_FRONT) {
         return spn_error(SPN_ERR_INVALID, "render: camera.kind %d is unknown", (int)c->kind);
     }
