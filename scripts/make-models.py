@@ -172,7 +172,7 @@ def scenes(d):
         fp.write(mesh2("Floor", fv, ff, FIXED, FLOOR_TEX))
         fp.write(mesh2("Table", tv, tf, FIXED,
                        "texture { pigment { color rgb <0.55, 0.35, 0.2> } finish { diffuse 0.8 } }"))
-        fp.write(mesh2("Cloth", cloth_v, cloth_f, free(600, 60, 1, 0.2, 0.3, 0), CLOTH_TEX))
+        fp.write(mesh2("Cloth", cloth_v, cloth_f, free(600, 60, 0.1, 0.02, 0.3, 0), CLOTH_TEX))
     sv, sf = icosphere(0.2, (0, 0.9, 0), 2)
     with open(os.path.join(d, "ball_floor.pov"), "w") as fp:
         fp.write(HEADER % ("ball_floor", "0, 0.7, -2.6", "0, 0.45, 0"))
@@ -186,7 +186,7 @@ def scenes(d):
         with open(os.path.join(d, name), "w") as fp:
             fp.write(HEADER % (name[:-4], "0, 1.5, -2.6", "0, 0.9, 0"))
             fp.write(mesh2("Floor", fv, ff, FIXED, FLOOR_TEX))
-            fp.write(mesh2("Cloth", cv, cf, free(600, 60, 1, 0.2, 0.3, 0, [("fixed_vertices", arr)]), CLOTH_TEX))
+            fp.write(mesh2("Cloth", cv, cf, free(600, 60, 0.1, 0.02, 0.3, 0, [("fixed_vertices", arr)]), CLOTH_TEX))
 
 
 def main():

@@ -28,8 +28,8 @@ object { Floor }
 #declare Cloth = mesh2 {
   #local spring_system_ks = 600;
   #local spring_system_kb = 60;
-  #local spring_system_ds = 1;
-  #local spring_system_db = 0.2;
+  #local spring_system_ds = 0.1;
+  #local spring_system_db = 0.02;
   #local spring_system_mass = 0.3;
   #local spring_system_vicinity = 0;
   #local spring_system_fixed_vertices = array[2] {0, 20};

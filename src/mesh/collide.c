@@ -24,7 +24,11 @@ struct spn_tri_collider {
     double skin, restitution, friction;
     uint32_t ntri, cap_tri, cap_obj;
     uint32_t *tri, *tri_obj; /* 3 particle ids per triangle; its object */
-    bool moving, built;
+    bool built;
+    bool *obj_moving; /* per object id */
+    uint32_t nobj_cap, nobj;
+    bool follow; /* the grid holds moving triangles: rebuild every sub-step */
+    uint32_t *active, nactive; /* triangles some particle can hit */
     uint32_t *owner, cap_owner;
     /* hash grid: cell size, bucket CSR over triangles, per-triangle boxes */
     double cell;
@@ -50,6 +54,8 @@ void spn__tri_collider_destroy(spn_tri_collider *c)
     free(c->tri);
     free(c->tri_obj);
     free(c->owner);
+    free(c->obj_moving);
+    free(c->active);
     free(c->start);
     free(c->items);
     free(c->big);
@@ -71,13 +77,17 @@ spn_status spn__tri_collider_add(spn_tri_collider *c, const uint32_t *tris, uint
         c->tri_obj[c->ntri + t] = object;
     }
     c->ntri = n;
-    c->moving |= moving;
+    if (!spn__grow((void **)&c->obj_moving, &c->nobj_cap, object + 1, sizeof *c->obj_moving))
+        return spn_error(SPN_ERR_NOMEM, "collisions: out of memory");
+    c->obj_moving[object] = moving;
+    if (object + 1 > c->nobj) c->nobj = object + 1;
     c->built = false;
     free(c->lo);
     free(c->hi);
     free(c->big);
+    free(c->active);
     c->lo = c->hi = NULL;
-    c->big = NULL;
+    c->big = c->active = NULL;
     c->cell = 0;
     free(c->stamp);
     c->stamp = calloc(n, sizeof *c->stamp);
@@ -121,9 +131,30 @@ static double box_cells(const spn_tri_collider *c, spn_vec3 lo, spn_vec3 hi)
                 body                                                                          \
             }
 
+/* Only triangles that a free particle of another object can reach go into
+ * the grid: with one moving object (a cloth over a table) its own triangles
+ * are left out, the grid holds obstacles only and is built once. True when
+ * the grid must follow moving triangles (rebuilt every sub-step). */
+static bool select_active(spn_tri_collider *c, uint32_t nobj)
+{
+    uint32_t moving = 0, last = 0;
+    for (uint32_t o = 0; o < nobj; o++)
+        if (c->obj_moving[o]) moving++, last = o;
+    bool follow = false;
+    c->nactive = 0;
+    for (uint32_t t = 0; t < c->ntri; t++) {
+        uint32_t o = c->tri_obj[t];
+        if (moving == 0 || (moving == 1 && last == o)) continue;
+        c->active[c->nactive++] = t;
+        follow |= c->obj_moving[o];
+    }
+    return follow;
+}
+
 static void triangle_boxes(spn_tri_collider *c, const spn_vec3 *x)
 {
-    for (uint32_t t = 0; t < c->ntri; t++) {
+    for (uint32_t q = 0; q < c->nactive; q++) {
+        uint32_t t = c->active[q];
         spn_vec3 a = x[c->tri[3 * t]], b = x[c->tri[3 * t + 1]], d = x[c->tri[3 * t + 2]];
         double s = c->skin;
         c->lo[t] = spn_v3(fmin(a.x, fmin(b.x, d.x)) - s, fmin(a.y, fmin(b.y, d.y)) - s, fmin(a.z, fmin(b.z, d.z)) - s);
@@ -131,11 +162,11 @@ static void triangle_boxes(spn_tri_collider *c, const spn_vec3 *x)
     }
     if (c->cell > 0) return;
     double sum = 0; /* the cell is chosen once: the mean triangle box side */
-    for (uint32_t t = 0; t < c->ntri; t++) {
-        spn_vec3 e = spn_v3_sub(c->hi[t], c->lo[t]);
+    for (uint32_t q = 0; q < c->nactive; q++) {
+        spn_vec3 e = spn_v3_sub(c->hi[c->active[q]], c->lo[c->active[q]]);
         sum += fmax(e.x, fmax(e.y, e.z));
     }
-    c->cell = fmax(sum / (c->ntri ? c->ntri : 1), 4 * c->skin);
+    c->cell = fmax(sum / (c->nactive ? c->nactive : 1), 4 * c->skin);
     if (!(c->cell > 0)) c->cell = 1;
 }
 
@@ -145,11 +176,14 @@ static bool build(spn_tri_collider *c, const spn_vec3 *x)
         c->lo = malloc((c->ntri + 1) * sizeof *c->lo);
         c->hi = malloc((c->ntri + 1) * sizeof *c->hi);
         c->big = malloc((c->ntri + 1) * sizeof *c->big);
-        if (!c->lo || !c->hi || !c->big) return false;
+        c->active = malloc((c->ntri + 1) * sizeof *c->active);
+        if (!c->lo || !c->hi || !c->big || !c->active) return false;
+        c->follow = select_active(c, c->nobj);
     }
     triangle_boxes(c, x);
     size_t entries = 0;
-    for (uint32_t t = 0; t < c->ntri; t++) {
+    for (uint32_t q = 0; q < c->nactive; q++) {
+        uint32_t t = c->active[q];
         double n = box_cells(c, c->lo[t], c->hi[t]);
         if (n <= MAX_CELLS) entries += (size_t)n;
     }
@@ -169,13 +203,16 @@ static bool build(spn_tri_collider *c, const spn_vec3 *x)
     c->mask = size - 1;
     memset(c->start, 0, (size + 1) * sizeof *c->start);
     c->nbig = 0;
-    for (uint32_t t = 0; t < c->ntri; t++) {
+    for (uint32_t q = 0; q < c->nactive; q++) {
+        uint32_t t = c->active[q];
         if (box_cells(c, c->lo[t], c->hi[t]) > MAX_CELLS) c->big[c->nbig++] = t;
         else FOR_CELLS(c, c->lo[t], c->hi[t], c->start[b_ + 1]++;)
     }
     for (uint32_t b = 0; b < size; b++) c->start[b + 1] += c->start[b];
-    for (uint32_t t = c->ntri; t-- > 0;) /* fill backwards: each bucket ends up in triangle order */
+    for (uint32_t q = c->nactive; q-- > 0;) { /* fill backwards: each bucket ends up in triangle order */
+        uint32_t t = c->active[q];
         if (box_cells(c, c->lo[t], c->hi[t]) <= MAX_CELLS) FOR_CELLS(c, c->lo[t], c->hi[t], c->items[--c->start[b_ + 1]] = t;)
+    }
     /* start[b + 1] was decremented to the bucket's beginning: shift back. */
     memmove(c->start, c->start + 1, size * sizeof *c->start);
     c->start[size] = (uint32_t)entries;
@@ -225,11 +262,19 @@ static bool test_triangle(const spn_tri_collider *c, const spn_vec3 *x, uint32_t
     return true;
 }
 
-static void consider(spn_tri_collider *c, const spn_vec3 *x, uint32_t p, uint32_t t, spn_vec3 x0, spn_vec3 x1,
-                     contact *best)
+typedef struct segment {
+    spn_vec3 x0, x1, lo, hi; /* the move and its box grown by the skin */
+} segment;
+
+static inline void consider(spn_tri_collider *c, const spn_vec3 *x, uint32_t p, uint32_t t, const segment *sg,
+                            contact *best)
 {
     if (c->stamp[t] == c->query) return;
     c->stamp[t] = c->query;
+    const spn_vec3 lo = c->lo[t], hi = c->hi[t]; /* boxes first: most candidates end here */
+    if (sg->hi.x < lo.x || sg->lo.x > hi.x || sg->hi.y < lo.y || sg->lo.y > hi.y || sg->hi.z < lo.z || sg->lo.z > hi.z)
+        return;
+    spn_vec3 x0 = sg->x0, x1 = sg->x1;
     if (c->owner && p < c->cap_owner && c->owner[p] != NO_OWNER && c->owner[p] == c->tri_obj[t]) return;
     contact k;
     if (test_triangle(c, x, t, x0, x1, &k) && k.t < best->t) *best = k;
@@ -243,13 +288,13 @@ static bool find_contact(spn_tri_collider *c, const spn_vec3 *x, uint32_t p, spn
     }
     best->t = INFINITY;
     double s = c->skin;
-    spn_vec3 lo = spn_v3(fmin(x0.x, x1.x) - s, fmin(x0.y, x1.y) - s, fmin(x0.z, x1.z) - s);
-    spn_vec3 hi = spn_v3(fmax(x0.x, x1.x) + s, fmax(x0.y, x1.y) + s, fmax(x0.z, x1.z) + s);
-    if (box_cells(c, lo, hi) > MAX_CELLS) {
-        for (uint32_t t = 0; t < c->ntri; t++) consider(c, x, p, t, x0, x1, best);
+    segment sg = {x0, x1, spn_v3(fmin(x0.x, x1.x) - s, fmin(x0.y, x1.y) - s, fmin(x0.z, x1.z) - s),
+                  spn_v3(fmax(x0.x, x1.x) + s, fmax(x0.y, x1.y) + s, fmax(x0.z, x1.z) + s)};
+    if (box_cells(c, sg.lo, sg.hi) > MAX_CELLS) {
+        for (uint32_t q = 0; q < c->nactive; q++) consider(c, x, p, c->active[q], &sg, best);
     } else {
-        FOR_CELLS(c, lo, hi, for (uint32_t q = c->start[b_]; q < c->start[b_ + 1]; q++) consider(c, x, p, c->items[q], x0, x1, best);)
-        for (uint32_t q = 0; q < c->nbig; q++) consider(c, x, p, c->big[q], x0, x1, best);
+        FOR_CELLS(c, sg.lo, sg.hi, for (uint32_t q = c->start[b_]; q < c->start[b_ + 1]; q++) consider(c, x, p, c->items[q], &sg, best);)
+        for (uint32_t q = 0; q < c->nbig; q++) consider(c, x, p, c->big[q], &sg, best);
     }
     return best->t < INFINITY;
 }
@@ -272,14 +317,15 @@ uint64_t spn__tri_collider_resolve(spn_tri_collider *c, spn_world *w, const spn_
 {
     if (c->ntri == 0) return 0;
     const spn_vec3 *x = spn_world_positions(w);
-    if ((c->moving || !c->built) && !build(c, x)) return 0;
+    if ((c->follow || !c->built) && !build(c, x)) return 0;
+    if (c->nactive == 0) return 0;
     uint64_t contacts = 0;
     uint32_t np = spn_world_particle_count(w);
     for (uint32_t p = 0; p < np; p++) {
         if (spn_world_is_fixed(w, p)) continue;
         /* A push-out can reach a neighbouring triangle (a concave corner): retest. */
         for (int pass = 0; pass < 3; pass++) {
-            contact k;
+            contact k = {0};
             spn_vec3 x1 = x[p];
             if (!find_contact(c, x, p, x0[p], x1, &k)) break;
             respond(c, w, p, &k, x1);
