@@ -1,8 +1,9 @@
 /* Other mesh formats (3DS, glTF, FBX, COLLADA, ...) through assimp's C API,
  * when the library is built with it. Every mesh of the file is merged into
  * one, in the file's coordinates (node transforms are applied by assimp's
- * PreTransformVertices step); polygons are triangulated by assimp and
- * identical vertices joined, so neighbouring triangles share edges and the
+ * PreTransformVertices step); polygons are triangulated by assimp. Vertices
+ * at the same position are welded here (assimp keeps them apart when their
+ * normals differ, as in STL), so neighbouring triangles share edges and the
  * factory can find bend pairs. Our own readers handle OBJ and PLY, because
  * they must name the line of a malformed entry, which assimp does not. */
 #include "mesh_internal.h"
@@ -14,6 +15,48 @@
 
 #include <stdlib.h>
 #include <string.h>
+
+static const spn_vec3 *sort_base;
+
+static int cmp_position(const void *pa, const void *pb)
+{
+    spn_vec3 a = sort_base[*(const uint32_t *)pa], b = sort_base[*(const uint32_t *)pb];
+    if (a.x != b.x) return a.x < b.x ? -1 : 1;
+    if (a.y != b.y) return a.y < b.y ? -1 : 1;
+    if (a.z != b.z) return a.z < b.z ? -1 : 1;
+    return (*(const uint32_t *)pa > *(const uint32_t *)pb) - (*(const uint32_t *)pa < *(const uint32_t *)pb);
+}
+
+/* Merge vertices with equal positions, keeping first-seen order. */
+static spn_status weld(spn_mesh *m)
+{
+    uint32_t n = m->vertex_count, *order = malloc(n * sizeof *order), *remap = malloc(n * sizeof *remap);
+    if (!order || !remap) {
+        free(order);
+        free(remap);
+        return spn_error(SPN_ERR_NOMEM, "out of memory");
+    }
+    for (uint32_t i = 0; i < n; i++) order[i] = i;
+    sort_base = m->vertices; /* qsort has no context argument; loading is not reentrant here */
+    qsort(order, n, sizeof *order, cmp_position);
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t v = order[i];
+        spn_vec3 a = m->vertices[v], b = i > 0 ? m->vertices[order[i - 1]] : a;
+        bool same = i > 0 && a.x == b.x && a.y == b.y && a.z == b.z;
+        remap[v] = same ? remap[order[i - 1]] : v; /* the run's first has the smallest index */
+    }
+    uint32_t count = 0, *id = order; /* reuse: new id of each kept vertex */
+    for (uint32_t i = 0; i < n; i++)
+        if (remap[i] == i) {
+            id[i] = count;
+            m->vertices[count++] = m->vertices[i];
+        }
+    for (uint32_t t = 0; t < 3 * m->triangle_count; t++) m->triangles[t] = id[remap[m->triangles[t]]];
+    m->vertex_count = count;
+    free(order);
+    free(remap);
+    return SPN_OK;
+}
 
 static spn_status copy_meshes(const struct aiScene *sc, const char *path, spn_mesh *out)
 {
@@ -38,7 +81,8 @@ static spn_status copy_meshes(const struct aiScene *sc, const char *path, spn_me
             out->triangle_count++;
         }
     }
-    return spn__mesh_check(out, path);
+    spn_status st = weld(out);
+    return st == SPN_OK ? spn__mesh_check(out, path) : st;
 }
 
 spn_status spn__mesh_load_assimp(const char *path, spn_mesh *out)
