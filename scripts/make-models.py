@@ -45,10 +45,15 @@ def icosphere(radius, centre, subdivisions):
     return verts, faces
 
 
-def grid(n, size, y, centre=(0.0, 0.0)):
-    """n x n vertices in the x-z plane; diagonals alternate so the cloth has no bias."""
-    verts = [(centre[0] - size / 2 + size * i / (n - 1), y, centre[1] - size / 2 + size * j / (n - 1))
-             for j in range(n) for i in range(n)]
+def grid(n, size, y, centre=(0.0, 0.0), turn=0.0):
+    """n x n vertices in the x-z plane, turned by `turn` degrees about y; diagonals
+    alternate so the cloth has no bias."""
+    c, s = math.cos(math.radians(turn)), math.sin(math.radians(turn))
+    verts = []
+    for j in range(n):
+        for i in range(n):
+            u, v = -size / 2 + size * i / (n - 1), -size / 2 + size * j / (n - 1)
+            verts.append((centre[0] + c * u - s * v, y, centre[1] + s * u + c * v))
     faces = []
     for j in range(n - 1):
         for i in range(n - 1):
@@ -164,7 +169,7 @@ def floor(size):
 
 
 def scenes(d):
-    cloth_v, cloth_f = grid(21, 1.0, 1.05, (0.25, 0.1))
+    cloth_v, cloth_f = grid(21, 1.2, 1.0, (0.15, 0.05), 30)
     tv, tf = table()
     fv, ff = floor(6)
     with open(os.path.join(d, "cloth_table.pov"), "w") as fp:

@@ -38,6 +38,9 @@ static void usage(void)
            "  --frame-interval S [-DT]     time between frames [s] (0.03)\n"
            "  --min-time S [-MINT]         do not test stability before this time [s] (0.1)\n"
            "  --max-time S [-MAXT]         stop after this time [s] (15.3)\n"
+           "  --quiet-time S               stable only after the energy stayed under the\n"
+           "                               threshold this long (0.2; a ball at the top of\n"
+           "                               its bounce is still for an instant only)\n"
            "  --gravity X,Y,Z              [m/s^2] (0,-9.81,0)\n"
            "  --ground Y | --no-ground     ground plane height (0)\n"
            "  --restitution R --friction F contacts, in [0, 1] (0.5, 0.2)\n"
@@ -55,7 +58,7 @@ static void usage(void)
 typedef struct drop_opts {
     spn_mesh_spring_def spring;
     spn_mesh_scene_def scene;
-    double threshold, frame_dt, min_time, max_time;
+    double threshold, frame_dt, min_time, max_time, quiet_time;
     spn_vec3 translate;
     const char *obstacles[MAX_OBSTACLES];
     int nobst;
@@ -65,7 +68,7 @@ typedef struct drop_opts {
 } drop_opts;
 
 enum { O_SS = 256, O_BS, O_SD, O_BD, O_MASS, O_TOTAL, O_VIC, O_FIXG, O_FIX, O_T, O_DT, O_MINT, O_MAXT, O_GRAV, O_GROUND,
-       O_NOGROUND, O_REST, O_FRIC, O_OBST, O_TRANS, O_VEL, O_POV, O_RENDER, O_SIZE, O_MOVIE };
+       O_NOGROUND, O_REST, O_FRIC, O_OBST, O_TRANS, O_VEL, O_POV, O_RENDER, O_SIZE, O_MOVIE, O_QUIET };
 
 static const struct option long_opts[] = {
     {"stretch-stiffness", required_argument, 0, O_SS}, {"bend-stiffness", required_argument, 0, O_BS},
@@ -81,6 +84,7 @@ static const struct option long_opts[] = {
     {"velocity", required_argument, 0, O_VEL},         {"pov", no_argument, 0, O_POV},
     {"render", no_argument, 0, O_RENDER},              {"size", required_argument, 0, O_SIZE},
     {"movie", required_argument, 0, O_MOVIE},          {"output", required_argument, 0, 'o'},
+    {"quiet-time", required_argument, 0, O_QUIET},
     {"help", no_argument, 0, 'h'},                     {0, 0, 0, 0}};
 
 /* The documentation's short forms, rewritten to long options. */
@@ -136,6 +140,7 @@ static int parse_option(int c, const char *arg, drop_opts *o)
     case O_RENDER: o->render = o->pov = true; return 0;
     case O_SIZE: return cli_size(CMD, "--size", arg, 8192, &o->width, &o->height) ? 0 : CLI_EXIT_USAGE;
     case O_MOVIE: o->movie = arg; o->render = o->pov = true; return 0;
+    case O_QUIET: return cli_double(CMD, "--quiet-time", arg, 0, 1e6, &o->quiet_time) ? 0 : CLI_EXIT_USAGE;
     case O_OBST:
         if (o->nobst == MAX_OBSTACLES) return cli_usage(CMD, "--obstacle: at most %d obstacles", MAX_OBSTACLES);
         o->obstacles[o->nobst++] = arg;
@@ -159,6 +164,7 @@ static int parse_args(int argc, char **argv, drop_opts *o)
     o->frame_dt = 0.03;
     o->min_time = 0.1;
     o->max_time = 15.3;
+    o->quiet_time = 0.2;
     o->width = 480;
     o->height = 360;
     optind = 1;
@@ -271,13 +277,19 @@ static spn_status simulate(drop_run *r, bool *stable, double *t, double *ke)
     *stable = false;
     *t = 0;
     *ke = spn_mesh_scene_kinetic(r->scene);
+    double quiet_since = -1; /* when the energy last fell under the threshold */
     while (st == SPN_OK && *t < o->max_time - 1e-12) {
         double dt = fmin(o->frame_dt, o->max_time - *t);
         st = spn_mesh_scene_advance(r->scene, dt);
         *t += dt;
         if (st == SPN_OK) st = frame_dir_write(&r->dir, write_frame, r);
         *ke = spn_mesh_scene_kinetic(r->scene);
-        if (*t >= o->min_time && *ke < o->threshold) {
+        if (*t < o->min_time || *ke >= o->threshold) {
+            quiet_since = -1;
+            continue;
+        }
+        if (quiet_since < 0) quiet_since = *t;
+        if (*t - quiet_since >= o->quiet_time - 1e-12) {
             *stable = true;
             break;
         }
@@ -306,7 +318,7 @@ static int run(drop_run *r)
            ms->particles, ms->fixed, ms->edges, ms->bend, ms->vicinity, spn_mesh_scene_substep(r->scene));
     printf("%s at t = %.4g s: kinetic energy %.4g J %s threshold %.4g J\n", stable ? "stable" : "max time reached", t,
            ke, stable ? "<" : ">=", o->threshold);
-    printf("lowest point y = %.4g m; %llu contacts; %d frames in %s\n", r->lowest,
+    printf("lowest point y = %.4g m; %llu contacts with obstacles; %d frames in %s\n", r->lowest,
            (unsigned long long)spn_mesh_scene_contacts(r->scene), r->dir.count, o->out);
     return 0;
 }
