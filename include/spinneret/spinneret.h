@@ -8,6 +8,8 @@
 #include "web.h"
 #include "io.h"
 #include "scenes.h"
+#include "render.h"
+#include "export.h"
 #include "mesh.h"
 
 #endif
