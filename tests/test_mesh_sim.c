@@ -96,7 +96,7 @@ static void test_sphere_bounces_and_rests_on_floor(void **state)
     assert_int_equal(spn_mesh_scene_add(s, &m, &d, NULL), SPN_OK);
     spn_world *w = spn_mesh_scene_world(s);
     double lowest = INFINITY, first_contact = -1, rise = 0, min_after = INFINITY, cy = 0;
-    for (int f = 0; f < 600; f++) {
+    for (int f = 0; f < 450; f++) {
         assert_int_equal(spn_mesh_scene_advance(s, 0.01), SPN_OK);
         double low = INFINITY;
         cy = 0;
