@@ -52,7 +52,9 @@ static void usage(void)
            "  --pov                        POV-Ray scenes instead of OBJ\n"
            "  --render                     render the POV frames to PNG with povray\n"
            "  --size WxH                   render size (480x360)\n"
-           "  --movie FILE.mp4             render and encode a movie with ffmpeg (implies --pov)\n");
+           "  --movie FILE.mp4             render and encode a movie with ffmpeg (implies --pov)\n"
+           "  --video FILE.mp4|.gif        draw the edges with our renderer (cairo) into a video,\n"
+           "                               no povray needed (frames are still written to -o)\n");
 }
 
 typedef struct drop_opts {
@@ -62,13 +64,13 @@ typedef struct drop_opts {
     spn_vec3 translate;
     const char *obstacles[MAX_OBSTACLES];
     int nobst;
-    const char *fix_list, *model, *out, *movie;
+    const char *fix_list, *model, *out, *movie, *video;
     bool pov, render;
     int width, height;
 } drop_opts;
 
 enum { O_SS = 256, O_BS, O_SD, O_BD, O_MASS, O_TOTAL, O_VIC, O_FIXG, O_FIX, O_T, O_DT, O_MINT, O_MAXT, O_GRAV, O_GROUND,
-       O_NOGROUND, O_REST, O_FRIC, O_OBST, O_TRANS, O_VEL, O_POV, O_RENDER, O_SIZE, O_MOVIE, O_QUIET };
+       O_NOGROUND, O_REST, O_FRIC, O_OBST, O_TRANS, O_VEL, O_POV, O_RENDER, O_SIZE, O_MOVIE, O_QUIET, O_VIDEO };
 
 static const struct option long_opts[] = {
     {"stretch-stiffness", required_argument, 0, O_SS}, {"bend-stiffness", required_argument, 0, O_BS},
@@ -84,7 +86,7 @@ static const struct option long_opts[] = {
     {"velocity", required_argument, 0, O_VEL},         {"pov", no_argument, 0, O_POV},
     {"render", no_argument, 0, O_RENDER},              {"size", required_argument, 0, O_SIZE},
     {"movie", required_argument, 0, O_MOVIE},          {"output", required_argument, 0, 'o'},
-    {"quiet-time", required_argument, 0, O_QUIET},
+    {"quiet-time", required_argument, 0, O_QUIET},      {"video", required_argument, 0, O_VIDEO},
     {"help", no_argument, 0, 'h'},                     {0, 0, 0, 0}};
 
 /* The documentation's short forms, rewritten to long options. */
@@ -140,6 +142,7 @@ static int parse_option(int c, const char *arg, drop_opts *o)
     case O_RENDER: o->render = o->pov = true; return 0;
     case O_SIZE: return cli_size(CMD, "--size", arg, 8192, &o->width, &o->height) ? 0 : CLI_EXIT_USAGE;
     case O_MOVIE: o->movie = arg; o->render = o->pov = true; return 0;
+    case O_VIDEO: o->video = arg; return 0;
     case O_QUIET: return cli_double(CMD, "--quiet-time", arg, 0, 1e6, &o->quiet_time) ? 0 : CLI_EXIT_USAGE;
     case O_OBST:
         if (o->nobst == MAX_OBSTACLES) return cli_usage(CMD, "--obstacle: at most %d obstacles", MAX_OBSTACLES);
@@ -210,7 +213,69 @@ typedef struct drop_run {
     spn_pov_view_def view;
     frame_dir dir;
     double lowest;
+    spn_frames *video;
+    uint8_t *rgba;
 } drop_run;
+
+/* Lines on the ground, 0.25 m apart around the target, so the bounce shows. */
+static spn_status ground_lines(spn_world *w, spn_vec3 centre, double y)
+{
+    spn_status st = SPN_OK;
+    for (int k = -6; st == SPN_OK && k <= 6; k++)
+        for (int axis = 0; st == SPN_OK && axis < 2; axis++) {
+            spn_particle_def p = spn_particle_def_default();
+            uint32_t a, b;
+            p.fixed = true;
+            double u = 0.25 * k;
+            p.position = axis ? spn_v3(centre.x + u, y, centre.z - 1.5) : spn_v3(centre.x - 1.5, y, centre.z + u);
+            st = spn_world_add_particle(w, &p, &a);
+            p.position = axis ? spn_v3(centre.x + u, y, centre.z + 1.5) : spn_v3(centre.x + 1.5, y, centre.z + u);
+            if (st == SPN_OK) st = spn_world_add_particle(w, &p, &b);
+            spn_spring_def d = spn_spring_def_default();
+            d.a = a;
+            d.b = b;
+            d.tag = SPN_THREAD_FRAME;
+            if (st == SPN_OK) st = spn_world_add_spring(w, &d, NULL);
+        }
+    return st;
+}
+
+/* A frame of the video: the scene's stretch springs (the mesh edges) drawn by
+ * the renderer from the POV camera's place. */
+static spn_status video_frame(drop_run *r)
+{
+    spn_world *sw = spn_mesh_scene_world(r->scene), *w = spn_world_create(NULL);
+    if (!w) return spn_error(SPN_ERR_NOMEM, "out of memory");
+    spn_status st = SPN_OK;
+    for (uint32_t i = 0; st == SPN_OK && i < spn_world_particle_count(sw); i++) {
+        spn_particle_def p = spn_particle_def_default();
+        p.position = spn_world_position(sw, i);
+        p.fixed = true;
+        st = spn_world_add_particle(w, &p, NULL);
+    }
+    for (uint32_t s = 0; st == SPN_OK && s < spn_world_spring_count(sw); s++) {
+        spn_spring_info in = spn_world_spring(sw, s);
+        if (in.tag != SPN_THREAD_STRETCH) continue;
+        spn_spring_def d = spn_spring_def_default();
+        d.a = in.a;
+        d.b = in.b;
+        d.tag = SPN_THREAD_CAPTURE; /* the renderer's finest thread */
+        st = spn_world_add_spring(w, &d, NULL);
+    }
+    if (st == SPN_OK && r->o->scene.ground) st = ground_lines(w, r->view.target, r->o->scene.ground_y);
+    spn_render_def def = spn_render_def_default();
+    def.width = r->o->width;
+    def.height = r->o->height;
+    def.camera.kind = SPN_CAMERA_PERSPECTIVE;
+    def.camera.eye = r->view.eye;
+    def.camera.target = r->view.target;
+    def.camera.fov_degrees = 2 * atan(tan(r->view.angle_degrees * SPN_PI / 360) * def.height / def.width) * 180 / SPN_PI;
+    def.background_rgb[0] = 0.08, def.background_rgb[1] = 0.09, def.background_rgb[2] = 0.11;
+    if (st == SPN_OK) st = spn_render_rgba(w, &def, r->rgba);
+    if (st == SPN_OK) st = spn_frames_add(r->video, r->rgba);
+    spn_world_destroy(w);
+    return st;
+}
 
 static spn_status write_frame(void *ctx, spn_sink *sink)
 {
@@ -219,6 +284,11 @@ static spn_status write_frame(void *ctx, spn_sink *sink)
     spn_status st = spn_mesh_scene_object_mesh(r->scene, 0, &now);
     if (st != SPN_OK) return st;
     for (uint32_t i = 0; i < now.vertex_count; i++) r->lowest = fmin(r->lowest, now.vertices[i].y);
+    if (r->video) st = video_frame(r);
+    if (st != SPN_OK) {
+        spn_mesh_free(&now);
+        return st;
+    }
     if (r->o->pov) {
         spn_mesh saved = r->meshes[0];
         r->meshes[0] = now;
@@ -306,7 +376,18 @@ static int run(drop_run *r)
     r->lowest = INFINITY;
     bool stable;
     double t, ke;
-    spn_status st = simulate(r, &stable, &t, &ke);
+    spn_status st = SPN_OK;
+    if (o->video) {
+        r->rgba = malloc((size_t)o->width * (size_t)o->height * 4);
+        st = r->rgba ? spn_frames_open(o->video, o->width, o->height, 1 / o->frame_dt, &r->video)
+                     : spn_error(SPN_ERR_NOMEM, "out of memory");
+    }
+    if (st == SPN_OK) st = simulate(r, &stable, &t, &ke);
+    if (r->video) {
+        spn_status vs = spn_frames_close(r->video, st == SPN_OK);
+        r->video = NULL;
+        if (st == SPN_OK) st = vs;
+    }
     if (st == SPN_OK && o->render)
         st = spn_pov_render_frames(o->out, r->dir.count, o->width, o->height, 1 / o->frame_dt, o->movie);
     if (st != SPN_OK) {
@@ -340,6 +421,7 @@ int cmd_drop(int argc, char **argv)
     spn_mesh_scene_destroy(r.scene);
     for (uint32_t i = 0; i < r.nmesh; i++) spn_mesh_free(&r.meshes[i]);
     free(r.meshes);
+    free(r.rgba);
     for (int i = 0; i < argc; i++) free(args[i]);
     free(args);
     return rc;

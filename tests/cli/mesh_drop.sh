@@ -26,6 +26,15 @@ echo "$out" | grep -q "^max time reached at t = 0.3 s" || fail "torus report: $o
 [ -f "$tmp/torus/frame_00010.pov" ] || fail "torus: POV frames missing"
 grep -q "mesh2" "$tmp/torus/frame_00010.pov" || fail "torus: no mesh2 in the POV frame"
 
+if command -v ffmpeg >/dev/null; then
+  "$SPN" drop "$MODELS/sphere.obj" --max-time 0.2 -DT 0.05 --size 64x48 --video "$tmp/ball.gif" -o "$tmp/v" >/dev/null \
+    || fail "drop --video"
+  [ -s "$tmp/ball.gif" ] || fail "--video wrote no gif"
+  [ "$(ls "$tmp/v" | wc -l)" -eq 5 ] || fail "--video: expected 5 OBJ frames too"
+else
+  echo "skipped --video: ffmpeg not installed"
+fi
+
 for pair in mesh_bad_index.obj:4 mesh_nan.obj:2 mesh_quad.obj:6 mesh_missing_data.ply:11 mesh_quad.ply:14; do
   name=${pair%%:*}; line=${pair##*:}
   msg=$("$SPN" drop "$BAD/$name" -o "$tmp/bad" 2>&1 >/dev/null); rc=$?
