@@ -182,14 +182,14 @@ def scenes(d):
     with open(os.path.join(d, "ball_floor.pov"), "w") as fp:
         fp.write(HEADER % ("ball_floor", "0, 0.7, -2.6", "0, 0.45, 0"))
         fp.write(mesh2("Floor", fv, ff, FIXED, FLOOR_TEX))
-        fp.write(mesh2("Ball", sv, sf, free(2000, 2000, 2, 2, 1, 0.25),
+        fp.write(mesh2("Ball", sv, sf, free(400, 400, 0.2, 0.2, 1, 0.2),
                        "texture { pigment { color rgb <0.2, 0.4, 0.9> } finish { phong 0.6 } }"))
     n = 21
     for pins, name in (([0, n - 1], "cloth_pinned2.pov"), ([0, n - 1, n * (n - 1), n * n - 1], "cloth_pinned4.pov")):
         cv, cf = grid(n, 1.0, 1.4)
         arr = "array[%d] {%s}" % (len(pins), ", ".join(str(p) for p in pins))
         with open(os.path.join(d, name), "w") as fp:
-            fp.write(HEADER % (name[:-4], "0, 1.5, -2.6", "0, 0.9, 0"))
+            fp.write(HEADER % (name[:-4], "0, 2.4, -2.3", "0, 1.0, 0"))
             fp.write(mesh2("Floor", fv, ff, FIXED, FLOOR_TEX))
             fp.write(mesh2("Cloth", cv, cf, free(600, 60, 0.1, 0.02, 0.3, 0, [("fixed_vertices", arr)]), CLOTH_TEX))
 

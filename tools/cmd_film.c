@@ -29,6 +29,7 @@ static void usage(void)
            "  --max-time S          simulated time [s] (2; 0 writes the scene once)\n"
            "  --fps F               frames per second (25)\n"
            "  --gravity X,Y,Z       [m/s^2] (0,-9.81,0)\n"
+           "  --drag D              air drag per unit mass [1/s] (0.5)\n"
            "  --restitution R       contacts, in [0, 1] (0.3)\n"
            "  --friction F          contacts, in [0, 1] (0.5)\n"
            "  --skin D              distance kept from other objects [m] (0.005)\n"
@@ -45,7 +46,7 @@ typedef struct film_opts {
     int width, height;
 } film_opts;
 
-enum { O_MAXT = 256, O_FPS, O_GRAV, O_REST, O_FRIC, O_SKIN, O_RENDER, O_SIZE, O_MOVIE };
+enum { O_MAXT = 256, O_FPS, O_GRAV, O_DRAG, O_REST, O_FRIC, O_SKIN, O_RENDER, O_SIZE, O_MOVIE };
 
 static int parse_option(int c, const char *arg, film_opts *o)
 {
@@ -54,6 +55,7 @@ static int parse_option(int c, const char *arg, film_opts *o)
     case O_MAXT: return cli_double(CMD, "--max-time", arg, 0, 1e5, &o->max_time) ? 0 : CLI_EXIT_USAGE;
     case O_FPS: return cli_double(CMD, "--fps", arg, 0.01, 1000, &o->fps) ? 0 : CLI_EXIT_USAGE;
     case O_GRAV: return cli_vec3(CMD, "--gravity", arg, false, &o->def.world.gravity) ? 0 : CLI_EXIT_USAGE;
+    case O_DRAG: return cli_double(CMD, "--drag", arg, 0, 1e3, &o->def.world.drag) ? 0 : CLI_EXIT_USAGE;
     case O_REST: return cli_double(CMD, "--restitution", arg, 0, 1, &o->def.restitution) ? 0 : CLI_EXIT_USAGE;
     case O_FRIC: return cli_double(CMD, "--friction", arg, 0, 1, &o->def.friction) ? 0 : CLI_EXIT_USAGE;
     case O_SKIN: return cli_double(CMD, "--skin", arg, 1e-7, 1, &o->def.skin) ? 0 : CLI_EXIT_USAGE;
@@ -69,6 +71,7 @@ static int parse_args(int argc, char **argv, film_opts *o)
     static const struct option opts[] = {
         {"output", required_argument, 0, 'o'},    {"max-time", required_argument, 0, O_MAXT},
         {"fps", required_argument, 0, O_FPS},      {"gravity", required_argument, 0, O_GRAV},
+        {"drag", required_argument, 0, O_DRAG},
         {"restitution", required_argument, 0, O_REST}, {"friction", required_argument, 0, O_FRIC},
         {"skin", required_argument, 0, O_SKIN},   {"render", no_argument, 0, O_RENDER},
         {"size", required_argument, 0, O_SIZE},   {"movie", required_argument, 0, O_MOVIE},
@@ -79,6 +82,7 @@ static int parse_args(int argc, char **argv, film_opts *o)
     o->def = spn_mesh_scene_def_default();
     o->def.friction = 0.5;
     o->def.skin = 0.005;
+    o->def.world.drag = 0.5; /* a little air, so pinned cloth comes to hang */
     o->width = 480;
     o->height = 360;
     optind = 1;

@@ -26,12 +26,12 @@ background { color rgb <0.75, 0.82, 0.9> }
 object { Floor }
 
 #declare Ball = mesh2 {
-  #local spring_system_ks = 2000;
-  #local spring_system_kb = 2000;
-  #local spring_system_ds = 2;
-  #local spring_system_db = 2;
+  #local spring_system_ks = 400;
+  #local spring_system_kb = 400;
+  #local spring_system_ds = 0.2;
+  #local spring_system_db = 0.2;
   #local spring_system_mass = 1;
-  #local spring_system_vicinity = 0.25;
+  #local spring_system_vicinity = 0.2;
   #local spring_system_fixed = false;
   vertex_vectors {
     162,

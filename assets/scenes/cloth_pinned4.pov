@@ -2,7 +2,7 @@
 // Simulated objects are mesh2 with #local spring_system_* declarations.
 #version 3.7;
 global_settings { assumed_gamma 1.0 }
-camera { location <0, 1.5, -2.6> look_at <0, 0.9, 0> angle 45 }
+camera { location <0, 2.4, -2.3> look_at <0, 1.0, 0> angle 45 }
 light_source { <2, 4, -3> color rgb 1.0 }
 light_source { <-3, 3, -1> color rgb 0.4 shadowless }
 background { color rgb <0.75, 0.82, 0.9> }
