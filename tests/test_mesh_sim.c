@@ -81,19 +81,21 @@ static void test_cloth_hangs_from_two_corners(void **state)
     spn_mesh_scene_destroy(s);
 }
 
-static void test_sphere_bounces_and_rests_on_floor(void **state)
+/* The floor is the world's plane, or a fixed mesh of two triangles. */
+static void sphere_on_floor(bool mesh_floor)
 {
-    (void)state;
     spn_mesh_scene_def sd = spn_mesh_scene_def_default();
-    sd.ground = true;
-    sd.ground_restitution = 0.5;
+    sd.ground = !mesh_floor;
+    sd.ground_restitution = sd.restitution = 0.5;
     spn_mesh_scene *s;
     assert_int_equal(spn_mesh_scene_create(&sd, &s), SPN_OK);
-    spn_mesh m;
+    spn_mesh m, floor = cloth(2, 6.0, 0, 0, 0);
     assert_int_equal(spn_mesh_load(SPN_SOURCE_DIR "/assets/models/sphere.obj", &m), SPN_OK);
-    spn_mesh_spring_def d = spn_mesh_spring_def_default(); /* the documentation's example values */
-    d.vicinity = 0.3;
+    spn_mesh_spring_def d = spn_mesh_spring_def_default(), fixed = spn_mesh_spring_def_default();
+    d.vicinity = 0.3; /* the documentation's example values */
+    fixed.fixed = true;
     assert_int_equal(spn_mesh_scene_add(s, &m, &d, NULL), SPN_OK);
+    if (mesh_floor) assert_int_equal(spn_mesh_scene_add(s, &floor, &fixed, NULL), SPN_OK);
     spn_world *w = spn_mesh_scene_world(s);
     double lowest = INFINITY, first_contact = -1, rise = 0, min_after = INFINITY, cy = 0;
     for (int f = 0; f < 450; f++) {
@@ -105,7 +107,7 @@ static void test_sphere_bounces_and_rests_on_floor(void **state)
             cy += spn_world_position(w, i).y / m.vertex_count;
         }
         lowest = fmin(lowest, low);
-        if (first_contact < 0 && low < 1e-3) first_contact = f;
+        if (first_contact < 0 && low < sd.skin + 1e-3) first_contact = f;
         if (first_contact >= 0) {
             min_after = fmin(min_after, cy);
             rise = fmax(rise, cy - min_after);
@@ -113,11 +115,66 @@ static void test_sphere_bounces_and_rests_on_floor(void **state)
     }
     assert_true(first_contact > 0);
     assert_true(lowest >= -1e-9); /* never below the floor */
+    if (mesh_floor) assert_true(spn_mesh_scene_contacts(s) > 0);
     assert_true(rise > 0.05);     /* it bounced */
     assert_true(spn_mesh_scene_kinetic(s) < 0.01);
     assert_true(cy > 0.15 && cy < 0.21); /* resting on the floor (radius 0.2), a little squashed */
     spn_mesh_free(&m);
+    spn_mesh_free(&floor);
     spn_mesh_scene_destroy(s);
+}
+
+static void test_sphere_bounces_and_rests_on_floor(void **state)
+{
+    (void)state;
+    sphere_on_floor(false);
+}
+
+static void test_sphere_bounces_and_rests_on_mesh_floor(void **state)
+{
+    (void)state;
+    sphere_on_floor(true);
+}
+
+/* A small triangle on a 30 degree slope: without friction it slides (a = g sin 30
+ * over 0.3 s is 0.22 m), with full friction the contact keeps it in place. */
+static double slide(double friction)
+{
+    spn_mesh_scene_def sd = spn_mesh_scene_def_default();
+    sd.friction = friction;
+    sd.restitution = 0;
+    spn_mesh_scene *s;
+    assert_int_equal(spn_mesh_scene_create(&sd, &s), SPN_OK);
+    const double c = cos(SPN_PI / 6), sn = sin(SPN_PI / 6);
+    spn_mesh slope = cloth(2, 4.0, 0, 0, 0), chip = cloth(2, 0.05, 0, 1.2 * sd.skin, 0);
+    for (uint32_t i = 0; i < 4; i++) { /* tilt both about z: downhill is -x */
+        spn_vec3 *v = &slope.vertices[i], *w = &chip.vertices[i];
+        *v = spn_v3(v->x * c, v->x * sn, v->z);
+        *w = spn_v3(w->x * c - w->y * sn, w->x * sn + w->y * c, w->z);
+    }
+    spn_mesh_spring_def fixed = spn_mesh_spring_def_default(), d = soft_cloth(0.01);
+    fixed.fixed = true;
+    uint32_t obj;
+    assert_int_equal(spn_mesh_scene_add(s, &slope, &fixed, NULL), SPN_OK);
+    assert_int_equal(spn_mesh_scene_add(s, &chip, &d, &obj), SPN_OK);
+    uint32_t first = spn_mesh_scene_object_stats(s, obj)->first_particle;
+    spn_vec3 start = spn_world_position(spn_mesh_scene_world(s), first);
+    assert_int_equal(spn_mesh_scene_advance(s, 0.3), SPN_OK);
+    spn_vec3 dx = spn_v3_sub(spn_world_position(spn_mesh_scene_world(s), first), start), n = spn_v3(-sn, c, 0);
+    double moved = spn_v3_len(spn_v3_sub(dx, spn_v3_scale(n, spn_v3_dot(n, dx)))); /* along the slope */
+    spn_mesh_free(&slope);
+    spn_mesh_free(&chip);
+    spn_mesh_scene_destroy(s);
+    return moved;
+}
+
+static void test_friction_on_a_slope(void **state)
+{
+    (void)state;
+    double free_slide = slide(0), stuck = slide(1);
+    printf("slid %g m without friction, %g m with full friction\n", free_slide, stuck);
+    assert_true(fabs(free_slide - 0.5 * 9.81 * 0.5 * 0.09) < 0.03);
+    assert_true(stuck < 0.005);
 }
 
 static void test_fast_cloth_does_not_tunnel_through_table(void **state)
@@ -187,6 +244,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cloth_hangs_from_two_corners),
         cmocka_unit_test(test_sphere_bounces_and_rests_on_floor),
+        cmocka_unit_test(test_sphere_bounces_and_rests_on_mesh_floor),
+        cmocka_unit_test(test_friction_on_a_slope),
         cmocka_unit_test(test_fast_cloth_does_not_tunnel_through_table),
         cmocka_unit_test(test_free_cloth_lands_on_free_cloth),
     };
