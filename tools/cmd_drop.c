@@ -183,6 +183,10 @@ static int parse_args(int argc, char **argv, drop_opts *o)
     if (optind != argc - 1) return cli_usage(CMD, "expected one model file");
     o->model = argv[optind];
     if (!o->out) return cli_usage(CMD, "-o OUT is required");
+    if (o->render && !spn_program_available("povray"))
+        return cli_fail(CMD, "--render and --movie need the povray program (Debian package povray)");
+    if ((o->movie || o->video) && !spn_program_available("ffmpeg"))
+        return cli_fail(CMD, "--movie and --video need the ffmpeg program (Debian package ffmpeg)");
     return 0;
 }
 

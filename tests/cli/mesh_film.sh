@@ -46,6 +46,12 @@ else
   echo "skipped rendering: povray or ffmpeg not installed"
 fi
 
+# Without povray on the PATH, --render fails at once and writes nothing.
+msg=$(env PATH=/nonexistent "$SPN" film "$SCENES/ball_floor.pov" --render -o "$tmp/nopov" 2>&1); rc=$?
+[ $rc -eq 1 ] || fail "--render without povray: exit $rc"
+echo "$msg" | grep -q "povray" || fail "--render without povray: message '$msg'"
+[ -e "$tmp/nopov" ] && fail "--render without povray left a folder"
+
 # Malformed scenes: exit 1, the file and line named, no folder left.
 for pair in pov_missing_brace:3 pov_include:2 pov_nan:5 pov_bad_face:5 pov_quad:5 pov_sphere_simulated:3; do
   name=${pair%%:*}; line=${pair##*:}
