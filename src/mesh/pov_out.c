@@ -136,15 +136,17 @@ static int run(char *const argv[], const char *dir)
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-static spn_status encode_movie(const char *dir, double fps, const char *movie)
+/* Exactly `count` frames: older frames with higher numbers may lie in the folder. */
+static spn_status encode_movie(const char *dir, int count, double fps, const char *movie)
 {
     spn_atomic_file f;
     spn_status st = spn_atomic_open(&f, movie, false);
     if (st != SPN_OK) return st;
-    char rate[32], pattern[4200];
+    char rate[32], frames[32], pattern[4200];
     snprintf(rate, sizeof rate, "%g", fps);
+    snprintf(frames, sizeof frames, "%d", count);
     snprintf(pattern, sizeof pattern, "%s/frame_%%05d.png", dir);
-    char *argv[] = {"ffmpeg", "-y", "-loglevel", "error", "-framerate", rate, "-i", pattern, "-vf",
+    char *argv[] = {"ffmpeg", "-y", "-loglevel", "error", "-framerate", rate, "-i", pattern, "-frames:v", frames, "-vf",
                     "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p", f.tmp_path, NULL};
     if (run(argv, NULL) != 0) {
         spn_atomic_abort(&f);
@@ -171,5 +173,5 @@ spn_status spn_pov_render_frames(const char *dir, int count, int width, int heig
         if (run(argv, dir) != 0)
             return spn_error(SPN_ERR_IO, "%s/frame_%05d.pov: povray failed to render it", dir, i);
     }
-    return movie ? encode_movie(dir, fps, movie) : SPN_OK;
+    return movie ? encode_movie(dir, count, fps, movie) : SPN_OK;
 }
