@@ -73,7 +73,9 @@ static view frame_all(const recording *r)
     view v;
     v.lo = v.hi = r->character[0];
     for (uint32_t f = 0; f < r->frames; f++) {
-        grow_box(&v, r->character[f]);
+        /* The character after release may fly out of the picture: framing
+         * its whole flight would shrink the shot itself. */
+        if (r->phase[f] < SPN_SHOT_ZIPP) grow_box(&v, r->character[f]);
         for (uint32_t i = 0; i < r->count[f]; i++) grow_box(&v, r->strand[(size_t)f * r->n + i]);
     }
     v.centre = spn_v3_scale(spn_v3_add(v.lo, v.hi), 0.5);
@@ -101,8 +103,8 @@ static spn_status build_scenery(spn_world *w, const view *v, uint32_t *marker_fi
 {
     spn_vec3 ext = spn_v3_sub(v->hi, v->lo);
     double e = fmax(fmax(ext.x, ext.z), 1e-3), hx = 0.5 * ext.x + 0.15 * e, hz = fmax(0.5 * ext.z, 0.3 * e) + 0.15 * e;
-    double step = pow(10, floor(log10(e / 2)));
-    while (2 * fmax(hx, hz) / step > 16) step *= 2;
+    double step = pow(10, floor(log10(e / 10)));
+    while (2 * fmax(hx, hz) / step > 14) step *= 2;
     double y = v->lo.y - 0.05 * e, x0 = floor((v->centre.x - hx) / step) * step,
            z0 = floor((v->centre.z - hz) / step) * step, x1 = v->centre.x + hx, z1 = v->centre.z + hz;
     spn_status st = SPN_OK;
@@ -166,7 +168,7 @@ static spn_render_def render_def(int width, int height, const view *v)
     double fov = d.camera.fov_degrees * SPN_PI / 180;
     if (width < height) fov = 2 * atan(tan(fov / 2) * width / height); /* the narrower side frames */
     double dist = 0.95 * v->radius / sin(fov / 2);
-    spn_vec3 dir = spn_v3_norm(spn_v3(0.3, 0.28, 1));
+    spn_vec3 dir = spn_v3_norm(spn_v3(0.25, 0.16, 1));
     d.camera.target = v->centre;
     d.camera.eye = spn_v3_add(v->centre, spn_v3_scale(dir, dist));
     return d;

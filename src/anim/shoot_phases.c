@@ -120,6 +120,13 @@ void spn__thwap_begin(spn_shot *s)
     enter(s, SPN_SHOT_THWAP);
     for (uint32_t i = 0; i < n; i++) {
         spn_vec3 v = spn_v3_scale(spn_v3_sub(s->tick_b[i], s->tick_a[i]), 1.0 / s->tick);
+        if (i > 0 && i + 1 < n) {
+            /* The head has stopped: the strand keeps its sideways motion (the
+             * noise wave whips on) but not its motion along itself, which
+             * would only crumple it into the anchor. */
+            spn_vec3 tan = spn_v3_norm(spn_v3_sub(s->pos[i + 1], s->pos[i - 1]));
+            v = spn_v3_sub(v, spn_v3_scale(tan, spn_v3_dot(v, tan)));
+        }
         spn_world_set_position(w, i, s->pos[i]);
         spn_world_set_velocity(w, i, spn_world_is_fixed(w, i) ? spn_v3(0, 0, 0) : v);
     }
