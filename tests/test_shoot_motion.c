@@ -229,6 +229,32 @@ static void test_thwip_independent_of_frame_rate(void **state)
     }
 }
 
+/* Whatever the frame time, every shot ends: time always advances, also when a
+ * phase ends a rounding error after a frame (this once hung a shot). */
+static void test_every_frame_rate_reaches_the_end(void **state)
+{
+    (void)state;
+    const double dts[] = {1.0 / 60, 1.0 / 30, 1.0 / 144, 0.1, 0.0123};
+    for (size_t k = 0; k < sizeof dts / sizeof dts[0]; k++)
+        for (int i = 0; i < 16; i++) {
+            spn_shot_def def = spn_shot_def_default();
+            def.speed = 22;
+            def.points = 12;
+            def.seed = (uint64_t)i + 1;
+            def.target.z = 0.25 * i;
+            spn_shot *s = make(&def);
+            long steps = 0, cap = (long)(30 / dts[k]);
+            while (spn_shot_phase_now(s) != SPN_SHOT_DONE && steps < cap) {
+                double t0 = spn_shot_time(s);
+                assert_int_equal(spn_shot_step(s, dts[k]), SPN_OK);
+                assert_true(fabs(spn_shot_time(s) - (t0 + dts[k])) < 1e-12);
+                steps++;
+            }
+            assert_int_equal(spn_shot_phase_now(s), SPN_SHOT_DONE);
+            spn_shot_destroy(s);
+        }
+}
+
 static void test_camera_shake_decays(void **state)
 {
     (void)state;
@@ -300,6 +326,7 @@ int main(void)
         cmocka_unit_test(test_handovers_are_continuous),
         cmocka_unit_test(test_fading_out_before_gone),
         cmocka_unit_test(test_thwip_independent_of_frame_rate),
+        cmocka_unit_test(test_every_frame_rate_reaches_the_end),
         cmocka_unit_test(test_camera_shake_decays),
         cmocka_unit_test(test_deterministic_and_seeded),
         cmocka_unit_test(test_bad_definitions_named),

@@ -291,7 +291,11 @@ spn_status spn_shot_step(spn_shot *s, double dt)
 {
     if (!(dt > 0 && dt <= 1)) return spn_error(SPN_ERR_INVALID, "shot: dt must be in (0, 1] s, got %g", dt);
     const double end = s->t + dt;
-    while (s->phase != SPN_SHOT_DONE && s->t < end) {
+    /* Each pass reaches `end` or changes phase, so a handful of passes do;
+     * the bound turns a logic error into a message instead of a hang. */
+    for (int pass = 0; s->phase != SPN_SHOT_DONE && s->t < end; pass++) {
+        if (pass > 2 * SPN_SHOT_DONE + 2)
+            return spn_error(SPN_ERR_UNSTABLE, "shot: time stuck at %.17g s in %s", s->t, spn_shot_phase_name(s->phase));
         if (s->phase == SPN_SHOT_THWIP) {
             thwip_advance(s, end);
         } else {

@@ -215,7 +215,7 @@ spn_status spn__springs_advance(spn_shot *s, double until)
 {
     double end = phase_end(s), stop = fmin(until, end);
     double span = stop - s->t;
-    int nsub = span > 0 ? (int)ceil(span / s->dt_sub - 1e-9) : 0;
+    int nsub = span > 0 ? (int)fmax(ceil(span / s->dt_sub - 1e-9), 1) : 0; /* >= 1: time always moves */
     double h = nsub > 0 ? span / nsub : 0;
     bool released = false;
     for (int k = 0; k < nsub && !released; k++) {
