@@ -77,20 +77,23 @@ static void usage(FILE *out)
     fprintf(out, "usage: spinneret shoot --from X,Y,Z --to X,Y,Z -o OUT [options]\n"
                  "Shoot a web strand: THWIP (flight), THWAP (snap taut), WHOOSH (swing), ZIPP (release).\n"
                  "OUT: .json (every frame's polyline), .mp4, .gif, or a folder of PNG frames.\n\n"
-                 "  -o, --output OUT        required\n"
-                 "      --from X,Y,Z        the hand [m] (required)\n"
-                 "      --to X,Y,Z          the target [m] (required)\n"
-                 "      --phases thwip|all  stop at contact, or play all four; default all\n"
-                 "      --auto-speed        out of reach: use the least speed that reaches\n"
-                 "      --seed N            noise seed; default 1\n"
-                 "      --gravity X,Y,Z     [m/s^2]; default 0,-9.81,0\n"
-                 "      --velocity X,Y,Z    WHOOSH: character velocity at the swing [m/s]; default 0,0,0\n"
-                 "      --drift X,Y,Z       ZIPP: air velocity [m/s]; default 0,0,1\n"
-                 "      --size WxH          video frame size, sides in [1, 4096]; default 960x540\n"
-                 "      --quiet             no progress bar\n");
-    for (const num_opt *n = t; n->name; n++)
-        fprintf(out, "      --%-16s %s, in [%g, %g]; default %g\n", n->name, n->help, n->lo, n->hi, *n->field);
-    fprintf(out, "  -h, --help              this text\n");
+                 "  -o, --output OUT           required\n"
+                 "      --from X,Y,Z           the hand [m] (required)\n"
+                 "      --to X,Y,Z             the target [m] (required)\n"
+                 "      --phases thwip|all     stop at contact, or play all four; default all\n"
+                 "      --auto-speed           out of reach: use the least speed that reaches\n"
+                 "      --seed N               noise seed; default 1\n"
+                 "      --gravity X,Y,Z        [m/s^2]; default 0,-9.81,0\n"
+                 "      --velocity X,Y,Z       WHOOSH: character velocity at the swing [m/s]; default 0,0,0\n"
+                 "      --drift X,Y,Z          ZIPP: air velocity [m/s]; default 0,0,1\n"
+                 "      --size WxH             video frame size, sides in [1, 4096]; default 960x540\n"
+                 "      --quiet                no progress bar\n");
+    for (const num_opt *n = t; n->name; n++) {
+        char name[32];
+        snprintf(name, sizeof name, "%s V", n->name);
+        fprintf(out, "      --%-20s %s, in [%g, %g]; default %g\n", name, n->help, n->lo, n->hi, *n->field);
+    }
+    fprintf(out, "  -h, --help                 this text\n");
 }
 
 enum { OPT_FROM = 256, OPT_TO, OPT_PHASES, OPT_AUTO, OPT_SEED, OPT_GRAVITY, OPT_VELOCITY, OPT_DRIFT, OPT_SIZE,
