@@ -218,6 +218,8 @@ static int record(const shoot_options *o, spn_shot *s, recording *r)
     r->n = (uint32_t)o->def.points;
     const uint32_t limit = (uint32_t)ceil(o->max_time * o->fps) + 1;
     for (uint32_t k = 0; k < limit; k++) {
+        if ((size_t)(r->frames + 1) * r->n > 20000000u)
+            return cli_fail(CMD, "more than 2e7 recorded points by frame %u: lower --fps, --points or --max-time", k);
         if (r->frames == r->cap && !grow(r)) return cli_fail(CMD, "out of memory recording frame %u", k);
         if (k > 0) {
             spn_status st = spn_shot_step(s, 1.0 / o->fps);
