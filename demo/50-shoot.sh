@@ -3,7 +3,7 @@
 # (flight), THWAP (snap taut), WHOOSH (swing), ZIPP (release) — as a video and
 # as JSON; then THWIP three ways side by side, so the value of each step shows:
 # noise off (the bare ballistic arc) / noise on with the pure soft pull / noise
-# with the velocity blend. Each is also kept as an onion skin (every 4th frame
+# with the velocity blend, all three seen by the same camera. Each is also kept as an onion skin (every 4th frame
 # laid over one picture) for judging the motion at a glance.
 set -eu
 out="$OUT/shoot"
@@ -24,7 +24,8 @@ opts=("--noise 0" "--noise 0.08 --blend 0" "--noise 0.08 --blend 0.6")
 font=/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
 for i in 0 1 2; do
   # shellcheck disable=SC2086
-  "$SPN" shoot "${shot[@]}" ${opts[$i]} --phases thwip --size 480x400 --quiet -o "$tmp/v$i"
+  "$SPN" shoot "${shot[@]}" ${opts[$i]} --phases thwip --size 480x400 --eye 7.5,7.5,15 --look-at 5,5.5,0 \
+    --quiet -o "$tmp/v$i"
   frames=$(ls "$tmp/v$i"/frame_*.png | awk 'NR % 4 == 1')
   # shellcheck disable=SC2086
   convert $frames -background black -compose lighten -flatten "$tmp/onion$i.png"

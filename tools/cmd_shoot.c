@@ -26,9 +26,9 @@ typedef struct num_opt {
 typedef struct shoot_options {
     spn_shot_def def;
     const char *output;
-    bool have_from, have_to, quiet;
-    double fps, max_time, points, hills;
-    int width, height;
+    bool have_from, have_to;
+    double max_time, points, hills;
+    video_options video;
 } shoot_options;
 
 enum { NUM_OPTS = 27 };
@@ -59,7 +59,7 @@ static void bind_numbers(shoot_options *o, num_opt *t)
         {"zipp-time", &d->zipp_time, 0, 60, "ZIPP: the strand is gone after [s]"},
         {"slack", &d->slack, 0, 2, "ZIPP: rest length grows by this fraction"},
         {"air-drag", &d->air_drag, 0, 100, "ZIPP: air drag [1/s]"},
-        {"fps", &o->fps, 1, 240, "frames per second"},
+        {"fps", &o->video.fps, 1, 240, "frames per second"},
         {"max-time", &o->max_time, 0.1, 600, "stop recording after [s]"},
         {NULL, NULL, 0, 0, NULL},
     };
@@ -71,7 +71,7 @@ static void usage(FILE *out)
     shoot_options o;
     memset(&o, 0, sizeof o);
     o.def = spn_shot_def_default();
-    o.fps = 60, o.max_time = 30, o.points = o.def.points, o.hills = o.def.noise_points;
+    o.video.fps = 60, o.max_time = 30, o.points = o.def.points, o.hills = o.def.noise_points;
     num_opt t[NUM_OPTS];
     bind_numbers(&o, t);
     fprintf(out, "usage: spinneret shoot --from X,Y,Z --to X,Y,Z -o OUT [options]\n"
@@ -87,6 +87,8 @@ static void usage(FILE *out)
                  "      --velocity X,Y,Z       WHOOSH: character velocity at the swing [m/s]; default 0,0,0\n"
                  "      --drift X,Y,Z          ZIPP: air velocity [m/s]; default 0,0,1\n"
                  "      --size WxH             video frame size, sides in [1, 4096]; default 960x540\n"
+                 "      --eye X,Y,Z            video: camera position [m]; default: framing the shot\n"
+                 "      --look-at X,Y,Z        video: the point looked at [m]; default: the shot's centre\n"
                  "      --quiet                no progress bar\n");
     for (const num_opt *n = t; n->name; n++) {
         char name[32];
@@ -97,7 +99,7 @@ static void usage(FILE *out)
 }
 
 enum { OPT_FROM = 256, OPT_TO, OPT_PHASES, OPT_AUTO, OPT_SEED, OPT_GRAVITY, OPT_VELOCITY, OPT_DRIFT, OPT_SIZE,
-       OPT_QUIET, OPT_NUM };
+       OPT_QUIET, OPT_EYE, OPT_LOOK, OPT_NUM };
 
 static int parse_other(int c, const char *arg, shoot_options *o)
 {
@@ -107,12 +109,14 @@ static int parse_other(int c, const char *arg, shoot_options *o)
     case OPT_FROM: ok = o->have_from = cli_vec3(CMD, "--from", arg, false, &o->def.origin); break;
     case OPT_TO: ok = o->have_to = cli_vec3(CMD, "--to", arg, false, &o->def.target); break;
     case OPT_AUTO: o->def.auto_speed = true; break;
-    case OPT_QUIET: o->quiet = true; break;
+    case OPT_QUIET: o->video.quiet = true; break;
+    case OPT_EYE: ok = o->video.have_eye = cli_vec3(CMD, "--eye", arg, false, &o->video.eye); break;
+    case OPT_LOOK: ok = o->video.have_look = cli_vec3(CMD, "--look-at", arg, false, &o->video.look); break;
     case OPT_SEED: ok = cli_u64(CMD, "--seed", arg, &o->def.seed); break;
     case OPT_GRAVITY: ok = cli_vec3(CMD, "--gravity", arg, false, &o->def.gravity); break;
     case OPT_VELOCITY: ok = cli_vec3(CMD, "--velocity", arg, false, &o->def.character_velocity); break;
     case OPT_DRIFT: ok = cli_vec3(CMD, "--drift", arg, false, &o->def.drift); break;
-    case OPT_SIZE: ok = cli_size(CMD, "--size", arg, 4096, &o->width, &o->height); break;
+    case OPT_SIZE: ok = cli_size(CMD, "--size", arg, 4096, &o->video.width, &o->video.height); break;
     case OPT_PHASES:
         if (strcmp(arg, "thwip") == 0) o->def.all_phases = false;
         else if (strcmp(arg, "all") == 0) o->def.all_phases = true;
@@ -135,8 +139,9 @@ static int parse_options(int argc, char **argv, shoot_options *o)
         {"gravity", required_argument, NULL, OPT_GRAVITY}, {"velocity", required_argument, NULL, OPT_VELOCITY},
         {"drift", required_argument, NULL, OPT_DRIFT},   {"size", required_argument, NULL, OPT_SIZE},
         {"quiet", no_argument, NULL, OPT_QUIET},         {"help", no_argument, NULL, 'h'},
+        {"eye", required_argument, NULL, OPT_EYE},       {"look-at", required_argument, NULL, OPT_LOOK},
     };
-    int k = 12;
+    int k = 14;
     for (int i = 0; t[i].name; i++) options[k++] = (struct option){t[i].name, required_argument, NULL, OPT_NUM + i};
     options[k] = (struct option){NULL, 0, NULL, 0};
     opterr = 0;
@@ -161,6 +166,9 @@ static int parse_options(int argc, char **argv, shoot_options *o)
     if (!o->have_from) return cli_usage(CMD, "--from: the hand position is required");
     if (!o->have_to) return cli_usage(CMD, "--to: the target position is required");
     if (!o->output || !*o->output) return cli_usage(CMD, "-o/--output: the output is required");
+    if (o->video.have_eye && o->video.have_look &&
+        spn_v3_len(spn_v3_sub(o->video.eye, o->video.look)) < 1e-9)
+        return cli_usage(CMD, "--eye and --look-at must differ");
     if (o->points != floor(o->points)) return cli_usage(CMD, "--points: expected a whole number, got %g", o->points);
     if (o->hills != floor(o->hills)) return cli_usage(CMD, "--hills: expected a whole number, got %g", o->hills);
     o->def.points = (int)o->points;
@@ -216,13 +224,13 @@ static void recording_free(recording *r)
 static int record(const shoot_options *o, spn_shot *s, recording *r)
 {
     r->n = (uint32_t)o->def.points;
-    const uint32_t limit = (uint32_t)ceil(o->max_time * o->fps) + 1;
+    const uint32_t limit = (uint32_t)ceil(o->max_time * o->video.fps) + 1;
     for (uint32_t k = 0; k < limit; k++) {
         if ((size_t)(r->frames + 1) * r->n > 20000000u)
             return cli_fail(CMD, "more than 2e7 recorded points by frame %u: lower --fps, --points or --max-time", k);
         if (r->frames == r->cap && !grow(r)) return cli_fail(CMD, "out of memory recording frame %u", k);
         if (k > 0) {
-            spn_status st = spn_shot_step(s, 1.0 / o->fps);
+            spn_status st = spn_shot_step(s, 1.0 / o->video.fps);
             if (st != SPN_OK) return cli_fail_status(CMD, st);
         }
         record_frame(r, s);
@@ -236,8 +244,8 @@ int cmd_shoot(int argc, char **argv)
     shoot_options o;
     memset(&o, 0, sizeof o);
     o.def = spn_shot_def_default();
-    o.fps = 60, o.max_time = 30, o.points = o.def.points, o.hills = o.def.noise_points;
-    o.width = 960, o.height = 540;
+    o.video.fps = 60, o.max_time = 30, o.points = o.def.points, o.hills = o.def.noise_points;
+    o.video.width = 960, o.video.height = 540;
     int rc = parse_options(argc, argv, &o);
     if (rc >= 0) return rc;
     const char *ext = cli_extension(o.output);
@@ -254,10 +262,9 @@ int cmd_shoot(int argc, char **argv)
     memset(&r, 0, sizeof r);
     rc = record(&o, s, &r);
     if (rc == 0) {
-        fprintf(stderr, "shoot: %u frames at %g fps (%.3g s), ended in %s\n", r.frames, o.fps, r.t[r.frames - 1],
+        fprintf(stderr, "shoot: %u frames at %g fps (%.3g s), ended in %s\n", r.frames, o.video.fps, r.t[r.frames - 1],
                 spn_shot_phase_name(r.phase[r.frames - 1]));
-        rc = json ? shoot_write_json(CMD, o.output, s, &r, o.fps)
-                  : shoot_write_video(CMD, o.output, &r, o.width, o.height, o.fps, o.quiet);
+        rc = json ? shoot_write_json(CMD, o.output, s, &r, o.video.fps) : shoot_write_video(CMD, o.output, &r, &o.video);
     }
     recording_free(&r);
     spn_shot_destroy(s);

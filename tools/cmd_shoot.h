@@ -15,8 +15,17 @@ typedef struct recording {
     spn_shot_phase *phase;
 } recording;
 
+/* How frames are rendered. The camera frames the whole shot unless eye or
+ * look-at are given (then those win, so several shots can share a view). */
+typedef struct video_options {
+    int width, height;
+    double fps;
+    bool quiet;
+    bool have_eye, have_look;
+    spn_vec3 eye, look;
+} video_options;
+
 int shoot_write_json(const char *cmd, const char *path, const spn_shot *s, const recording *r, double fps);
-int shoot_write_video(const char *cmd, const char *path, const recording *r, int width, int height, double fps,
-                      bool quiet);
+int shoot_write_video(const char *cmd, const char *path, const recording *r, const video_options *v);
 
 #endif

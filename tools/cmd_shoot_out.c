@@ -154,8 +154,9 @@ static spn_status build_strand(spn_world *w, uint32_t n)
     return st;
 }
 
-static spn_render_def render_def(int width, int height, const view *v)
+static spn_render_def render_def(const video_options *o, const view *v)
 {
+    const int width = o->width, height = o->height;
     spn_render_def d = spn_render_def_default();
     d.width = width, d.height = height;
     d.background_rgb[0] = 0.035, d.background_rgb[1] = 0.045, d.background_rgb[2] = 0.075;
@@ -169,8 +170,8 @@ static spn_render_def render_def(int width, int height, const view *v)
     if (width < height) fov = 2 * atan(tan(fov / 2) * width / height); /* the narrower side frames */
     double dist = 0.95 * v->radius / sin(fov / 2);
     spn_vec3 dir = spn_v3_norm(spn_v3(0.25, 0.16, 1));
-    d.camera.target = v->centre;
-    d.camera.eye = spn_v3_add(v->centre, spn_v3_scale(dir, dist));
+    d.camera.target = o->have_look ? o->look : v->centre;
+    d.camera.eye = o->have_eye ? o->eye : spn_v3_add(d.camera.target, spn_v3_scale(dir, dist));
     return d;
 }
 
@@ -214,11 +215,11 @@ static spn_status render_frame(renderer *q, const recording *r, uint32_t f, spn_
     return st == SPN_OK ? spn_frames_add(q->frames, q->b) : st;
 }
 
-int shoot_write_video(const char *cmd, const char *path, const recording *r, int width, int height, double fps,
-                      bool quiet)
+int shoot_write_video(const char *cmd, const char *path, const recording *r, const video_options *o)
 {
+    const int width = o->width, height = o->height;
     view v = frame_all(r);
-    spn_render_def d = render_def(width, height, &v);
+    spn_render_def d = render_def(o, &v);
     renderer q;
     memset(&q, 0, sizeof q);
     q.strand = spn_world_create(NULL);
@@ -231,8 +232,8 @@ int shoot_write_video(const char *cmd, const char *path, const recording *r, int
     }
     spn_status st = build_strand(q.strand, r->n);
     if (st == SPN_OK) st = build_scenery(q.scenery, &v, &q.marker_first);
-    if (st == SPN_OK) st = spn_frames_open(path, width, height, fps, &q.frames);
-    spn_progress *bar = spn_progress_begin("shoot", r->frames, quiet);
+    if (st == SPN_OK) st = spn_frames_open(path, width, height, o->fps, &q.frames);
+    spn_progress *bar = spn_progress_begin("shoot", r->frames, o->quiet);
     for (uint32_t f = 0; f < r->frames && st == SPN_OK; f++) {
         st = render_frame(&q, r, f, d, &v);
         spn_progress_update(bar, f + 1);

@@ -44,7 +44,7 @@ python3 -c "
 import json,sys; d=json.load(open('$tmp/b.json')); ph=[f['phase'] for f in d['frames']]
 assert set(ph) <= {'thwip','done'} and ph[-1]=='done', ph" || fail "--phases thwip ends at contact"
 
-"$SPN" shoot --from 0,0,0 --to 8,3,0 --phases thwip --size 64x48 --quiet -o "$tmp/frames" 2>/dev/null || fail "frames run"
+"$SPN" shoot --from 0,0,0 --to 8,3,0 --phases thwip --size 64x48 --eye 4,2,12 --look-at 4,1.5,0 --quiet -o "$tmp/frames" 2>/dev/null || fail "frames run"
 n=$(ls "$tmp/frames" | grep -c '^frame_.*\.png$')
 [ "$n" -gt 5 ] || fail "expected PNG frames, got $n"
 
@@ -75,6 +75,8 @@ bad "--phases" --from 0,0,0 --to 5,1,0 --phases most -o "$tmp/bad.json"
 bad "--from" --from 0,nan,0 --to 5,1,0 -o "$tmp/bad.json"
 bad "target" --from 1,1,1 --to 1,1,1 -o "$tmp/bad.json"
 bad ".json, .mp4, .gif" --from 0,0,0 --to 5,1,0 -o "$tmp/bad.txt"
+bad "--look-at" --from 0,0,0 --to 5,1,0 --eye 1,2,3 --look-at 1,2,3 -o "$tmp/bad.json"
+bad "--eye" --from 0,0,0 --to 5,1,0 --eye 1,2 -o "$tmp/bad.json"
 bad "unknown option" --from 0,0,0 --to 5,1,0 --frobnicate -o "$tmp/bad.json"
 [ ! -e "$tmp/bad.txt" ] || fail "bad extension left an output"
 "$SPN" shoot --from 0,0,0 --to 5,1,0 -o "$tmp/no/such/dir/x.json" 2>/dev/null
