@@ -11,5 +11,6 @@
 #include "render.h"
 #include "export.h"
 #include "mesh.h"
+#include "shoot.h"
 
 #endif
