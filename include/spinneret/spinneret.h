@@ -12,5 +12,7 @@
 #include "export.h"
 #include "limits.h"
 #include "interrupt.h"
+#include "mesh.h"
+#include "shoot.h"
 
 #endif
