@@ -228,7 +228,7 @@ static spn_status ground_lines(spn_world *w, spn_vec3 centre, double y)
     for (int k = -6; st == SPN_OK && k <= 6; k++)
         for (int axis = 0; st == SPN_OK && axis < 2; axis++) {
             spn_particle_def p = spn_particle_def_default();
-            uint32_t a, b;
+            uint32_t a = 0, b = 0;
             p.fixed = true;
             double u = 0.25 * k;
             p.position = axis ? spn_v3(centre.x + u, y, centre.z - 1.5) : spn_v3(centre.x - 1.5, y, centre.z + u);

@@ -87,7 +87,7 @@ static spn_status add_line(spn_world *w, spn_vec3 a, spn_vec3 b, uint32_t tag)
 {
     spn_particle_def p = spn_particle_def_default();
     p.fixed = true;
-    uint32_t ia, ib;
+    uint32_t ia = 0, ib = 0;
     p.position = a;
     spn_status st = spn_world_add_particle(w, &p, &ia);
     p.position = b;

@@ -4,6 +4,8 @@
  * ASCII complaints name the line; binary ones the element and its index. */
 #include "mesh_internal.h"
 
+#include "spinneret/limits.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -212,8 +214,10 @@ static spn_status read_elem(ply_reader *r, const ply_elem *e, spn_mesh *m)
             }
             if (is_vertex && pr->name[1] == '\0' && pr->name[0] >= 'x' && pr->name[0] <= 'z') xyz[pr->name[0] - 'x'] = v;
         }
-        if (r->format == 0 && s.lp < s.lend && strspn(s.lp, " \t\r") < (size_t)(s.lend - s.lp))
-            return bad_item(r, e, i, "extra values on the line");
+        /* Bounded by the line's end: the data need not end in a NUL. */
+        const char *rest = s.lp;
+        while (r->format == 0 && rest && rest < s.lend && (*rest == ' ' || *rest == '\t' || *rest == '\r')) rest++;
+        if (r->format == 0 && rest && rest < s.lend) return bad_item(r, e, i, "extra values on the line");
         if (is_vertex) {
             m->vertices[i] = spn_v3(xyz[0], xyz[1], xyz[2]);
             if (!spn_v3_finite(m->vertices[i])) return bad_item(r, e, i, "coordinate missing or not finite");
@@ -236,6 +240,14 @@ static spn_status check_elements(ply_reader *r, spn_mesh *m)
         }
     }
     if (!vertex || !face) return spn_error(SPN_ERR_FORMAT, "%s: needs a vertex and a face element", r->name);
+    /* Every vertex and face takes at least one byte of the body, so a count
+     * beyond the file's size is a lie; refuse it before allocating for it. */
+    size_t body = (size_t)(r->end - r->p);
+    if (m->vertex_count > body || m->triangle_count > body)
+        return spn_error(SPN_ERR_FORMAT, "%s: declares %u vertices and %u faces, more than its %zu bytes can hold",
+                         r->name, m->vertex_count, m->triangle_count, body);
+    spn_status st = spn_check_counts(r->name, m->vertex_count, 3 * (uint64_t)m->triangle_count);
+    if (st != SPN_OK) return st;
     m->vertices = calloc(m->vertex_count ? m->vertex_count : 1, sizeof *m->vertices);
     m->triangles = calloc(3 * (size_t)(m->triangle_count ? m->triangle_count : 1), sizeof *m->triangles);
     if (!m->vertices || !m->triangles) return spn_error(SPN_ERR_NOMEM, "%s: out of memory", r->name);

@@ -90,6 +90,11 @@ static spn_status count_header(parser *p, const char *block, uint32_t *count)
     if (st != SPN_OK) return st;
     if (!(n >= 0 && n == floor(n) && n < 1e8))
         return spn_error(SPN_ERR_FORMAT, "%s:%d: %s count must be a whole number", p->name, tok(p)->line, block);
+    /* Each item is ", < a , b , c >": 7 tokens. A count the rest of the file
+     * cannot hold is refused before anything is allocated for it. */
+    if (n > (double)(p->lx.count - p->t) / 7)
+        return spn_error(SPN_ERR_FORMAT, "%s:%d: %s declares %.0f items, more than the rest of the file holds", p->name,
+                         tok(p)->line, block, n);
     *count = (uint32_t)n;
     return st;
 }
@@ -97,6 +102,7 @@ static spn_status count_header(parser *p, const char *block, uint32_t *count)
 static spn_status vertex_vectors(parser *p, pov_object *o)
 {
     int line = tok(p)->line;
+    if (o->mesh.vertices) return fail_at(p, "vertex_vectors given twice in one mesh2");
     p->t++;
     uint32_t n;
     spn_status st = count_header(p, "vertex_vectors", &n);
@@ -154,6 +160,7 @@ static spn_status face_indices(parser *p, pov_object *o)
     int line = tok(p)->line;
     if (!o->mesh.vertices)
         return spn_error(SPN_ERR_FORMAT, "%s:%d: face_indices before vertex_vectors", p->name, line);
+    if (o->mesh.triangles) return fail_at(p, "face_indices given twice in one mesh2");
     p->t++;
     uint32_t n;
     spn_status st = count_header(p, "face_indices", &n);
@@ -185,6 +192,8 @@ static spn_status pins(parser *p, pov_object *o)
     if (st == SPN_OK) st = expect(p, "{", "expected '{'");
     if (st != SPN_OK) return st;
     if (!(n >= 1 && n < 1e7 && n == floor(n))) return fail_at(p, "array size must be a positive whole number");
+    if (n > (double)(p->lx.count - p->t) / 2) return fail_at(p, "array size larger than the values that follow");
+    if (o->pins) return fail_at(p, "spring_system_fixed_vertices given twice for one object");
     o->pins = malloc((size_t)n * sizeof *o->pins);
     if (!o->pins) return spn_error(SPN_ERR_NOMEM, "out of memory");
     for (uint32_t i = 0; i < (uint32_t)n && st == SPN_OK; i++) {

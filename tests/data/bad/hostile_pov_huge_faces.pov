@@ -1,0 +1,5 @@
+#declare M = mesh2 {
+  #local spring_system_mass = 1;
+  vertex_vectors { 3, <0, 0, 0>, <1, 0, 0>, <0, 1, 0> }
+  face_indices { 99999999, <0, 1, 2> }
+}
