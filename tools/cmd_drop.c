@@ -352,11 +352,12 @@ static spn_status simulate(drop_run *r, bool *stable, double *t, double *ke)
     *t = 0;
     *ke = spn_mesh_scene_kinetic(r->scene);
     double quiet_since = -1; /* when the energy last fell under the threshold */
-    while (st == SPN_OK && *t < o->max_time - 1e-12) {
+    while (st == SPN_OK && *t < o->max_time - 1e-12 && !spn_interrupted()) {
         double dt = fmin(o->frame_dt, o->max_time - *t);
         st = spn_mesh_scene_advance(r->scene, dt);
         *t += dt;
         if (st == SPN_OK) st = frame_dir_write(&r->dir, write_frame, r);
+        spn_interrupt_progress((uint64_t)r->dir.count, (uint64_t)ceil(o->max_time / o->frame_dt) + 1);
         *ke = spn_mesh_scene_kinetic(r->scene);
         if (*t < o->min_time || *ke >= o->threshold) {
             quiet_since = -1;
@@ -386,12 +387,18 @@ static int run(drop_run *r)
         st = r->rgba ? spn_frames_open(o->video, o->width, o->height, 1 / o->frame_dt, &r->video)
                      : spn_error(SPN_ERR_NOMEM, "out of memory");
     }
+    cli_interruptible((uint64_t)ceil(o->max_time / o->frame_dt) + 1);
     if (st == SPN_OK) st = simulate(r, &stable, &t, &ke);
+    bool stopped = st == SPN_OK && spn_interrupted();
     if (r->video) {
         spn_status vs = spn_frames_close(r->video, st == SPN_OK);
         r->video = NULL;
         if (st == SPN_OK) st = vs;
     }
+    if (stopped) /* the complete frames (and the video of them) are kept; no rendering */
+        return cli_report_interrupt(CMD, (uint64_t)r->dir.count, (uint64_t)ceil(o->max_time / o->frame_dt) + 1,
+                                    "the complete frames are kept", 0);
+    spn_interrupt_graceful(false);
     if (st == SPN_OK && o->render)
         st = spn_pov_render_frames(o->out, r->dir.count, o->width, o->height, 1 / o->frame_dt, o->movie);
     if (st != SPN_OK) {

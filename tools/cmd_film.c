@@ -147,10 +147,15 @@ static int run(const film_opts *o, film_run *r)
     if (!frame_dir_open(&dir, CMD, o->out, "pov")) return CLI_EXIT_FAIL;
     int frames = (int)floor(o->max_time * o->fps + 1e-9) + 1;
     spn_status st = frame_dir_write(&dir, write_frame, r);
-    for (int f = 1; st == SPN_OK && f < frames; f++) {
+    cli_interruptible((uint64_t)frames);
+    for (int f = 1; st == SPN_OK && f < frames && !spn_interrupted(); f++) {
         st = spn_mesh_scene_advance(r->scene, 1 / o->fps);
         if (st == SPN_OK) st = frame_dir_write(&dir, write_frame, r);
+        spn_interrupt_progress((uint64_t)dir.count, (uint64_t)frames);
     }
+    if (st == SPN_OK && spn_interrupted()) /* keep the complete frames; no rendering */
+        return cli_report_interrupt(CMD, (uint64_t)dir.count, (uint64_t)frames, "the complete frames are kept", 0);
+    spn_interrupt_graceful(false);
     char movie[4200];
     snprintf(movie, sizeof movie, "%s/movie.mp4", o->out);
     if (st == SPN_OK && o->render)

@@ -234,17 +234,22 @@ int shoot_write_video(const char *cmd, const char *path, const recording *r, con
     if (st == SPN_OK) st = build_scenery(q.scenery, &v, &q.marker_first);
     if (st == SPN_OK) st = spn_frames_open(path, width, height, o->fps, &q.frames);
     spn_progress *bar = spn_progress_begin("shoot", r->frames, o->quiet);
-    for (uint32_t f = 0; f < r->frames && st == SPN_OK; f++) {
+    uint32_t f = 0;
+    cli_interruptible(r->frames);
+    for (; f < r->frames && st == SPN_OK && !spn_interrupted(); f++) {
         st = render_frame(&q, r, f, d, &v);
         spn_progress_update(bar, f + 1);
+        spn_interrupt_progress(f + 1, r->frames);
     }
     spn_progress_end(bar);
-    if (st == SPN_OK) {
+    if (st == SPN_OK) { /* interrupted or not: the complete frames */
         st = spn_frames_close(q.frames, true);
         q.frames = NULL;
     }
     renderer_free(&q);
-    if (st != SPN_OK) return cli_fail_status(cmd, st);
+    if (st != SPN_OK) return spn_interrupt_graceful(false), cli_fail_status(cmd, st);
+    if (spn_interrupted()) return cli_report_interrupt(cmd, f, r->frames, "the complete frames are kept", 0);
+    spn_interrupt_graceful(false);
     fprintf(stderr, "shoot: wrote %s\n", path);
     return 0;
 }
