@@ -230,6 +230,9 @@ static spn_status check_elements(ply_reader *r, spn_mesh *m)
 {
     bool vertex = false, face = false;
     for (int k = 0; k < r->nelems; k++) {
+        bool again = (vertex && strcmp(r->elems[k].name, "vertex") == 0) || (face && strcmp(r->elems[k].name, "face") == 0);
+        if (again) /* the arrays are sized by one element of each */
+            return spn_error(SPN_ERR_FORMAT, "%s: more than one '%s' element", r->name, r->elems[k].name);
         if (strcmp(r->elems[k].name, "vertex") == 0) {
             vertex = true;
             m->vertex_count = r->elems[k].count;
