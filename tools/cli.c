@@ -190,3 +190,14 @@ int cli_report_interrupt(const char *cmd, uint64_t done, uint64_t total, const c
             (unsigned long long)done, (unsigned long long)total, kept);
     return 128 + sig;
 }
+
+bool cli_output_writable(const char *cmd, const char *path)
+{
+    spn_atomic_file f;
+    if (spn_atomic_open(&f, path, false) != SPN_OK) {
+        cli_fail(cmd, "%s", spn_last_error());
+        return false;
+    }
+    spn_atomic_abort(&f);
+    return true;
+}

@@ -40,6 +40,10 @@ void cli_interruptible(uint64_t total);
  * what was kept, and return 128 + the signal; otherwise return `code`. */
 int cli_report_interrupt(const char *cmd, uint64_t done, uint64_t total, const char *kept, int code);
 
+/* Before a long computation: can `path` be written? (Makes and removes a
+ * temporary beside it.) False after printing "cannot write: REASON". */
+bool cli_output_writable(const char *cmd, const char *path);
+
 /* Lower-case file extension of a path ("png"), or "" when none. */
 const char *cli_extension(const char *path);
 /* True when argv has --help or -h (print usage then). */

@@ -93,6 +93,10 @@ int cmd_settle(int argc, char **argv)
 
     spn_world *w = NULL;
     if (spn_web_load(o.input, &w) != SPN_OK) return cli_fail(CMD, "%s", spn_last_error());
+    if (!cli_output_writable(CMD, o.output)) { /* before the work, not after it */
+        spn_world_destroy(w);
+        return CLI_EXIT_FAIL;
+    }
     if (o.solver) {
         spn_integrator integ = SPN_INTEGRATOR_SYMPLECTIC;
         spn_integrator_parse(o.solver, &integ);

@@ -35,16 +35,21 @@ spn_status spn_atomic_open(spn_atomic_file *f, const char *path, bool open_strea
     const char *base = slash ? slash + 1 : path;
     snprintf(f->tmp_path, n, "%.*s.tmp%ld-%s", (int)(base - path), path, (long)getpid(), base);
     spn__temp_track(f->tmp_path);
-    if (open_stream) {
-        f->fp = fopen(f->tmp_path, "wb");
-        if (!f->fp) {
-            spn_status st = spn_error(SPN_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
-            spn__temp_untrack(f->tmp_path);
-            free(f->path);
-            free(f->tmp_path);
-            memset(f, 0, sizeof *f);
-            return st;
-        }
+    /* Without a stream the temporary is still made (and closed): a missing or
+     * read-only folder is named here, with the system's reason, rather than
+     * by the writer that later fails with a vaguer message. */
+    f->fp = fopen(f->tmp_path, "wb");
+    if (!f->fp) {
+        spn_status st = spn_error(SPN_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
+        spn__temp_untrack(f->tmp_path);
+        free(f->path);
+        free(f->tmp_path);
+        memset(f, 0, sizeof *f);
+        return st;
+    }
+    if (!open_stream) {
+        fclose(f->fp);
+        f->fp = NULL;
     }
     return SPN_OK;
 }

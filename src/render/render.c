@@ -187,14 +187,22 @@ static spn_status write_png(const spn_world *w, const spn_render_def *def, const
     return st;
 }
 
+/* cairo's own file output loses write errors (a full disk gave a truncated
+ * PDF and success), so vector output goes through our stream, whose errors
+ * spn_atomic_commit sees. */
+static cairo_status_t write_stream(void *closure, const unsigned char *data, unsigned int length)
+{
+    return fwrite(data, 1, length, (FILE *)closure) == length ? CAIRO_STATUS_SUCCESS : CAIRO_STATUS_WRITE_ERROR;
+}
+
 static spn_status write_vector(const spn_world *w, const spn_render_def *def, const char *path, out_type type)
 {
     spn_status st = spn_render_def_check(def);
     spn_atomic_file f;
-    if (st == SPN_OK) st = spn_atomic_open(&f, path, false);
+    if (st == SPN_OK) st = spn_atomic_open(&f, path, true);
     if (st != SPN_OK) return st;
-    cairo_surface_t *s = type == OUT_SVG ? cairo_svg_surface_create(f.tmp_path, def->width, def->height)
-                                         : cairo_pdf_surface_create(f.tmp_path, def->width, def->height);
+    cairo_surface_t *s = type == OUT_SVG ? cairo_svg_surface_create_for_stream(write_stream, f.fp, def->width, def->height)
+                                         : cairo_pdf_surface_create_for_stream(write_stream, f.fp, def->width, def->height);
     cairo_t *cr = cairo_create(s);
     st = spn__cairo_draw(w, def, cr);
     cairo_destroy(cr);
