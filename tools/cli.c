@@ -107,6 +107,18 @@ bool cli_vec3(const char *cmd, const char *opt, const char *text, bool allow_2d,
     return true;
 }
 
+bool cli_vec3_bounded(const char *cmd, const char *opt, const char *text, double bound, spn_vec3 *out)
+{
+    spn_vec3 v;
+    if (!cli_vec3(cmd, opt, text, false, &v)) return false;
+    if (!(fabs(v.x) <= bound && fabs(v.y) <= bound && fabs(v.z) <= bound)) {
+        cli_usage(cmd, "%s: expected X,Y,Z with each in [%g, %g], got '%s'", opt, -bound, bound, text);
+        return false;
+    }
+    *out = v;
+    return true;
+}
+
 bool cli_size(const char *cmd, const char *opt, const char *text, int max_side, int *w, int *h)
 {
     char *end = NULL;

@@ -23,6 +23,12 @@ bool cli_int(const char *cmd, const char *opt, const char *text, long lo, long h
 bool cli_u64(const char *cmd, const char *opt, const char *text, uint64_t *out);
 /* "X,Y,Z" (or "X,Y" with z = 0 when allow_2d), all finite. */
 bool cli_vec3(const char *cmd, const char *opt, const char *text, bool allow_2d, spn_vec3 *out);
+/* cli_vec3 with every component in [-bound, bound]: keeps differences, cross
+ * products and a step's worth of motion finite. Bounds the commands share: */
+#define CLI_MAX_COORD 1e6 /* positions [m] */
+#define CLI_MAX_ACCEL 1e4 /* accelerations, gravity [m/s^2]: a thousand g */
+#define CLI_MAX_SPEED 1e3 /* velocities of bodies and air [m/s] */
+bool cli_vec3_bounded(const char *cmd, const char *opt, const char *text, double bound, spn_vec3 *out);
 /* "WxH" with 1 <= W, H <= max_side. */
 bool cli_size(const char *cmd, const char *opt, const char *text, int max_side, int *w, int *h);
 /* Options every subcommand takes, removed from argv before the command sees

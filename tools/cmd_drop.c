@@ -134,10 +134,10 @@ static int parse_option(int c, const char *arg, drop_opts *o)
     case 'o': o->out = arg; return 0;
     case O_FIXG: o->spring.fixed_group = arg; return 0;
     case O_FIX: o->fix_list = arg; return 0;
-    case O_GRAV: return cli_vec3(CMD, "--gravity", arg, false, &o->scene.world.gravity) ? 0 : CLI_EXIT_USAGE;
+    case O_GRAV: return cli_vec3_bounded(CMD, "--gravity", arg, CLI_MAX_ACCEL, &o->scene.world.gravity) ? 0 : CLI_EXIT_USAGE;
     case O_NOGROUND: o->scene.ground = false; return 0;
-    case O_TRANS: return cli_vec3(CMD, "--translate", arg, false, &o->translate) ? 0 : CLI_EXIT_USAGE;
-    case O_VEL: return cli_vec3(CMD, "--velocity", arg, false, &o->spring.velocity) ? 0 : CLI_EXIT_USAGE;
+    case O_TRANS: return cli_vec3_bounded(CMD, "--translate", arg, CLI_MAX_COORD, &o->translate) ? 0 : CLI_EXIT_USAGE;
+    case O_VEL: return cli_vec3_bounded(CMD, "--velocity", arg, CLI_MAX_SPEED, &o->spring.velocity) ? 0 : CLI_EXIT_USAGE;
     case O_POV: o->pov = true; return 0;
     case O_RENDER: o->render = o->pov = true; return 0;
     case O_SIZE: return cli_size(CMD, "--size", arg, 8192, &o->width, &o->height) ? 0 : CLI_EXIT_USAGE;

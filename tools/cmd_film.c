@@ -54,7 +54,7 @@ static int parse_option(int c, const char *arg, film_opts *o)
     case 'o': o->out = arg; return 0;
     case O_MAXT: return cli_double(CMD, "--max-time", arg, 0, 1e5, &o->max_time) ? 0 : CLI_EXIT_USAGE;
     case O_FPS: return cli_double(CMD, "--fps", arg, 0.01, 1000, &o->fps) ? 0 : CLI_EXIT_USAGE;
-    case O_GRAV: return cli_vec3(CMD, "--gravity", arg, false, &o->def.world.gravity) ? 0 : CLI_EXIT_USAGE;
+    case O_GRAV: return cli_vec3_bounded(CMD, "--gravity", arg, CLI_MAX_ACCEL, &o->def.world.gravity) ? 0 : CLI_EXIT_USAGE;
     case O_DRAG: return cli_double(CMD, "--drag", arg, 0, 1e3, &o->def.world.drag) ? 0 : CLI_EXIT_USAGE;
     case O_REST: return cli_double(CMD, "--restitution", arg, 0, 1, &o->def.restitution) ? 0 : CLI_EXIT_USAGE;
     case O_FRIC: return cli_double(CMD, "--friction", arg, 0, 1, &o->def.friction) ? 0 : CLI_EXIT_USAGE;

@@ -106,16 +106,16 @@ static int parse_other(int c, const char *arg, shoot_options *o)
     bool ok = true;
     switch (c) {
     case 'o': o->output = arg; break;
-    case OPT_FROM: ok = o->have_from = cli_vec3(CMD, "--from", arg, false, &o->def.origin); break;
-    case OPT_TO: ok = o->have_to = cli_vec3(CMD, "--to", arg, false, &o->def.target); break;
+    case OPT_FROM: ok = o->have_from = cli_vec3_bounded(CMD, "--from", arg, CLI_MAX_COORD, &o->def.origin); break;
+    case OPT_TO: ok = o->have_to = cli_vec3_bounded(CMD, "--to", arg, CLI_MAX_COORD, &o->def.target); break;
     case OPT_AUTO: o->def.auto_speed = true; break;
     case OPT_QUIET: o->video.quiet = true; break;
-    case OPT_EYE: ok = o->video.have_eye = cli_vec3(CMD, "--eye", arg, false, &o->video.eye); break;
-    case OPT_LOOK: ok = o->video.have_look = cli_vec3(CMD, "--look-at", arg, false, &o->video.look); break;
+    case OPT_EYE: ok = o->video.have_eye = cli_vec3_bounded(CMD, "--eye", arg, CLI_MAX_COORD, &o->video.eye); break;
+    case OPT_LOOK: ok = o->video.have_look = cli_vec3_bounded(CMD, "--look-at", arg, CLI_MAX_COORD, &o->video.look); break;
     case OPT_SEED: ok = cli_u64(CMD, "--seed", arg, &o->def.seed); break;
-    case OPT_GRAVITY: ok = cli_vec3(CMD, "--gravity", arg, false, &o->def.gravity); break;
-    case OPT_VELOCITY: ok = cli_vec3(CMD, "--velocity", arg, false, &o->def.character_velocity); break;
-    case OPT_DRIFT: ok = cli_vec3(CMD, "--drift", arg, false, &o->def.drift); break;
+    case OPT_GRAVITY: ok = cli_vec3_bounded(CMD, "--gravity", arg, CLI_MAX_ACCEL, &o->def.gravity); break;
+    case OPT_VELOCITY: ok = cli_vec3_bounded(CMD, "--velocity", arg, CLI_MAX_SPEED, &o->def.character_velocity); break;
+    case OPT_DRIFT: ok = cli_vec3_bounded(CMD, "--drift", arg, CLI_MAX_SPEED, &o->def.drift); break;
     case OPT_SIZE: ok = cli_size(CMD, "--size", arg, 4096, &o->video.width, &o->video.height); break;
     case OPT_PHASES:
         if (strcmp(arg, "thwip") == 0) o->def.all_phases = false;

@@ -66,22 +66,6 @@ static bool light(const char *cmd, const char *arg, spn_vec3 *dir)
     return false;
 }
 
-/* Camera points and directions: coordinates within a thousand kilometres,
- * so differences and cross products stay finite. */
-#define RO_MAX_COORD 1e6
-
-static bool point(const char *cmd, const char *opt, const char *arg, spn_vec3 *out)
-{
-    spn_vec3 p;
-    if (!cli_vec3(cmd, opt, arg, false, &p)) return false;
-    if (fabs(p.x) > RO_MAX_COORD || fabs(p.y) > RO_MAX_COORD || fabs(p.z) > RO_MAX_COORD) {
-        cli_usage(cmd, "%s: expected X,Y,Z with each in [%g, %g] m, got '%s'", opt, -RO_MAX_COORD, RO_MAX_COORD, arg);
-        return false;
-    }
-    *out = p;
-    return true;
-}
-
 static bool size(const char *cmd, const char *arg, spn_render_def *d)
 {
     if (!cli_size(cmd, "--size", arg, 16384, &d->width, &d->height)) return false;
@@ -110,9 +94,9 @@ int render_options_parse(const char *cmd, int c, const char *arg, render_options
     switch (c) {
     case RO_SIZE: ok = size(cmd, arg, d); break;
     case RO_CAMERA: ok = camera_kind(cmd, arg, &d->camera.kind); break;
-    case RO_EYE: ok = o->eye_set = point(cmd, "--eye", arg, &d->camera.eye); break;
-    case RO_TARGET: ok = o->target_set = point(cmd, "--target", arg, &d->camera.target); break;
-    case RO_UP: ok = point(cmd, "--up", arg, &d->camera.up); break;
+    case RO_EYE: ok = o->eye_set = cli_vec3_bounded(cmd, "--eye", arg, CLI_MAX_COORD, &d->camera.eye); break;
+    case RO_TARGET: ok = o->target_set = cli_vec3_bounded(cmd, "--target", arg, CLI_MAX_COORD, &d->camera.target); break;
+    case RO_UP: ok = cli_vec3_bounded(cmd, "--up", arg, CLI_MAX_COORD, &d->camera.up); break;
     case RO_FOV: ok = cli_double(cmd, "--fov", arg, 1, 170, &d->camera.fov_degrees); break;
     case RO_YAW: ok = cli_double(cmd, "--yaw", arg, -360, 360, &o->yaw); break;
     case RO_PITCH: ok = cli_double(cmd, "--pitch", arg, -89, 89, &o->pitch); break;

@@ -10,7 +10,9 @@
  * A loop that can stop cleanly between frames turns on graceful mode: a
  * signal then only sets a flag, the loop polls spn_interrupted(), finishes the
  * frame it is on, commits what is complete and says so. A second signal exits
- * at once as above. */
+ * at once as above, and so does a frame that has not finished
+ * SPN_INTERRUPT_GRACE_SECONDS after the first (a single SIGTERM, as sent by
+ * `timeout` or a service manager, always ends the program). */
 #ifndef SPINNERET_INTERRUPT_H
 #define SPINNERET_INTERRUPT_H
 
@@ -20,7 +22,10 @@
 extern "C" {
 #endif
 
-/// Catch SIGINT and SIGTERM. `label` starts the message ("spinneret render"),
+/// How long a graceful stop waits for the frame in progress [s].
+#define SPN_INTERRUPT_GRACE_SECONDS 10
+
+/// Catch SIGINT and SIGTERM (and SIGALRM, for the grace period). `label` starts the message ("spinneret render"),
 /// `unit` names what progress counts ("frames", "steps"); both are copied.
 SPN_API void spn_interrupt_catch(const char *label, const char *unit);
 /// Restore the default handlers and clear the flag.

@@ -88,8 +88,12 @@ static void die(int sig)
 
 static void handler(int sig)
 {
+    if (sig == SIGALRM) die(caught ? caught : SIGTERM); /* the frame in progress took too long */
     if (graceful && !caught) {
         caught = sig;
+        /* A loop stuck inside one frame would never poll: `timeout` and
+         * service managers send one SIGTERM, which must still end us. */
+        alarm(SPN_INTERRUPT_GRACE_SECONDS);
         return;
     }
     die(sig);
@@ -108,6 +112,7 @@ void spn_interrupt_catch(const char *what, const char *units)
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
+    sigaction(SIGALRM, &sa, NULL);
 }
 
 void spn_interrupt_release(void)
@@ -116,8 +121,10 @@ void spn_interrupt_release(void)
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = SIG_DFL;
     sigemptyset(&sa.sa_mask);
+    alarm(0);
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
+    sigaction(SIGALRM, &sa, NULL);
     caught = 0;
     graceful = 0;
 }

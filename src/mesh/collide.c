@@ -116,10 +116,13 @@ static uint32_t bucket(const spn_tri_collider *c, int64_t x, int64_t y, int64_t 
     return (uint32_t)(h * 0x9e3779b97f4a7c15ULL >> 32) & c->mask;
 }
 
+/* In doubles: a box far out (1e300) or not finite must not pass through
+ * int64 (undefined, and the wrapped count let a hostile gravity walk 2^63
+ * cells); NaN comes back as NaN, which callers treat as too many. */
 static double box_cells(const spn_tri_collider *c, spn_vec3 lo, spn_vec3 hi)
 {
-    return (double)(cell_of(c, hi.x) - cell_of(c, lo.x) + 1) * (double)(cell_of(c, hi.y) - cell_of(c, lo.y) + 1) *
-           (double)(cell_of(c, hi.z) - cell_of(c, lo.z) + 1);
+    return (floor(hi.x / c->cell) - floor(lo.x / c->cell) + 1) * (floor(hi.y / c->cell) - floor(lo.y / c->cell) + 1) *
+           (floor(hi.z / c->cell) - floor(lo.z / c->cell) + 1);
 }
 
 /* Call fn for each bucket of the cells covering [lo, hi]. */
@@ -205,7 +208,7 @@ static bool build(spn_tri_collider *c, const spn_vec3 *x)
     c->nbig = 0;
     for (uint32_t q = 0; q < c->nactive; q++) {
         uint32_t t = c->active[q];
-        if (box_cells(c, c->lo[t], c->hi[t]) > MAX_CELLS) c->big[c->nbig++] = t;
+        if (!(box_cells(c, c->lo[t], c->hi[t]) <= MAX_CELLS)) c->big[c->nbig++] = t;
         else FOR_CELLS(c, c->lo[t], c->hi[t], c->start[b_ + 1]++;)
     }
     for (uint32_t b = 0; b < size; b++) c->start[b + 1] += c->start[b];
@@ -290,7 +293,7 @@ static bool find_contact(spn_tri_collider *c, const spn_vec3 *x, uint32_t p, spn
     double s = c->skin;
     segment sg = {x0, x1, spn_v3(fmin(x0.x, x1.x) - s, fmin(x0.y, x1.y) - s, fmin(x0.z, x1.z) - s),
                   spn_v3(fmax(x0.x, x1.x) + s, fmax(x0.y, x1.y) + s, fmax(x0.z, x1.z) + s)};
-    if (box_cells(c, sg.lo, sg.hi) > MAX_CELLS) {
+    if (!(box_cells(c, sg.lo, sg.hi) <= MAX_CELLS)) { /* NaN too */
         for (uint32_t q = 0; q < c->nactive; q++) consider(c, x, p, c->active[q], &sg, best);
     } else {
         FOR_CELLS(c, sg.lo, sg.hi, for (uint32_t q = c->start[b_]; q < c->start[b_ + 1]; q++) consider(c, x, p, c->items[q], &sg, best);)

@@ -138,8 +138,10 @@ double spn_mesh_scene_substep(spn_mesh_scene *s)
         if (spn_world_is_fixed(s->w, i)) continue;
         double m = spn_world_mass(s->w, i);
         double a = 2 * ksum[i] / m, b = 4 * dsum[i] / m; /* a h^2 + b h < 4 */
-        if (a > 0) h = fmin(h, 0.4 * (-b + sqrt(b * b + 16 * a)) / (2 * a));
-        else if (b > 0) h = fmin(h, 0.4 * 4 / b);
+        /* The positive root of a h^2 + b h = 4, written 8 / (b + sqrt(b^2 + 16 a))
+         * rather than (-b + sqrt(...)) / 2a: the latter cancels to 0 when a is
+         * tiny beside b (stiffness 1e-300 gave a zero sub-step). */
+        if (a > 0 || b > 0) h = fmin(h, 0.4 * 8 / (b + sqrt(b * b + 16 * a)));
     }
     free(ksum);
     free(dsum);
