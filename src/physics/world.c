@@ -81,21 +81,25 @@ static void free_compiled(spn_world *w)
     free(w->adj_start);
     free(w->adj);
     free(w->fs);
-    free(w->fair);
     free(w->sdiam);
     free(w->f);
+    free(w->fext);
     free(w->x0);
     free(w->v0);
-    free(w->xt);
-    free(w->vt);
-    for (int i = 0; i < 4; i++) {
-        free(w->kx[i]);
-        free(w->kv[i]);
-        w->kx[i] = w->kv[i] = NULL;
+    for (int i = 0; i < SPN_TMP_COUNT; i++) {
+        free(w->tmp[i]);
+        w->tmp[i] = NULL;
     }
+    free(w->fair);
+    free(w->wind);
+    free(w->cair);
+    free(w->jac);
+    free(w->partial);
     w->adj_start = w->adj = NULL;
-    w->fs = w->fair = w->f = w->x0 = w->v0 = w->xt = w->vt = NULL;
-    w->sdiam = NULL;
+    w->fs = w->f = w->fext = w->x0 = w->v0 = w->fair = w->wind = NULL;
+    w->sdiam = w->cair = w->partial = NULL;
+    w->jac = NULL;
+    w->npartial = 0;
     w->compiled = false;
 }
 
@@ -241,42 +245,57 @@ static double tag_diameter(const spn_world *w, uint32_t tag)
     return 0;
 }
 
+/* Allocate the compiled arrays; false when out of memory. */
+static bool alloc_compiled(spn_world *w)
+{
+    size_t np = w->np ? w->np : 1, ns = w->ns ? w->ns : 1;
+    uint32_t nb = spn__blocks(w->np > w->ns ? w->np : w->ns);
+    w->npartial = nb ? nb : 1;
+    w->adj_start = calloc(np + 1, sizeof *w->adj_start);
+    w->adj = malloc(2 * ns * sizeof *w->adj);
+    w->fs = malloc(ns * sizeof *w->fs);
+    w->sdiam = malloc(ns * sizeof *w->sdiam);
+    w->f = malloc(np * sizeof *w->f);
+    w->fext = calloc(np, sizeof *w->fext);
+    w->x0 = malloc(np * sizeof *w->x0);
+    w->v0 = malloc(np * sizeof *w->v0);
+    w->partial = calloc((size_t)w->npartial * SPN_NSUMS, sizeof *w->partial);
+    return w->adj_start && w->adj && w->fs && w->sdiam && w->f && w->fext && w->x0 && w->v0 && w->partial;
+}
+
+/* Air buffers, only for worlds with threads that have a diameter. */
+static bool alloc_air(spn_world *w)
+{
+    w->any_diam = false;
+    for (uint32_t s = 0; s < w->ns; s++) {
+        w->sdiam[s] = tag_diameter(w, w->stag[s]);
+        if (w->sdiam[s] > 0) w->any_diam = true;
+    }
+    if (!w->any_diam) return true;
+    w->fair = calloc(w->ns, sizeof *w->fair);
+    w->wind = calloc(w->ns, sizeof *w->wind);
+    w->cair = calloc(w->ns, sizeof *w->cair);
+    return w->fair && w->wind && w->cair;
+}
+
 spn_status spn_world_compile(spn_world *w)
 {
     if (w->compiled) return SPN_OK;
     free_compiled(w);
-    size_t np = w->np ? w->np : 1, ns = w->ns ? w->ns : 1;
-    w->adj_start = calloc(np + 1, sizeof *w->adj_start);
-    w->adj = malloc(2 * ns * sizeof *w->adj);
-    w->fs = malloc(ns * sizeof *w->fs);
-    w->fair = calloc(ns, sizeof *w->fair);
-    w->sdiam = malloc(ns * sizeof *w->sdiam);
-    w->f = malloc(np * sizeof *w->f);
-    w->x0 = malloc(np * sizeof *w->x0);
-    w->v0 = malloc(np * sizeof *w->v0);
-    w->xt = malloc(np * sizeof *w->xt);
-    w->vt = malloc(np * sizeof *w->vt);
-    bool ok = w->adj_start && w->adj && w->fs && w->fair && w->sdiam && w->f && w->x0 && w->v0 && w->xt && w->vt;
-    for (int i = 0; i < 4 && ok; i++) {
-        w->kx[i] = malloc(np * sizeof **w->kx);
-        w->kv[i] = malloc(np * sizeof **w->kv);
-        ok = w->kx[i] && w->kv[i];
-    }
-    if (!ok) {
+    uint32_t *fill = calloc(w->np ? w->np : 1, sizeof *fill);
+    if (!fill || !alloc_compiled(w) || !alloc_air(w)) {
+        free(fill);
         free_compiled(w);
         return spn_error(SPN_ERR_NOMEM, "out of memory compiling a world of %u particles and %u springs", w->np, w->ns);
     }
+    /* CSR adjacency by counting sort: each particle's springs in id order. */
+    w->any_limits = false;
     for (uint32_t s = 0; s < w->ns; s++) {
+        if (w->bmin[s] > 0 || w->bmax[s] < INFINITY) w->any_limits = true;
         w->adj_start[w->sa[s] + 1]++;
         w->adj_start[w->sb[s] + 1]++;
-        w->sdiam[s] = tag_diameter(w, w->stag[s]);
     }
     for (uint32_t i = 0; i < w->np; i++) w->adj_start[i + 1] += w->adj_start[i];
-    uint32_t *fill = calloc(np, sizeof *fill);
-    if (!fill) {
-        free_compiled(w);
-        return spn_error(SPN_ERR_NOMEM, "out of memory");
-    }
     for (uint32_t s = 0; s < w->ns; s++) {
         w->adj[w->adj_start[w->sa[s]] + fill[w->sa[s]]++] = s << 1;
         w->adj[w->adj_start[w->sb[s]] + fill[w->sb[s]]++] = (s << 1) | 1u;
@@ -342,7 +361,7 @@ void spn_world_set_spring_stiffness(spn_world *w, uint32_t s, double k, double k
 void spn_world_set_spring_tag(spn_world *w, uint32_t s, uint32_t tag)
 {
     w->stag[s] = tag;
-    if (w->compiled) w->sdiam[s] = tag_diameter(w, tag);
+    w->compiled = false; /* the air buffers depend on the tags' diameters */
 }
 void spn_world_break_spring(spn_world *w, uint32_t s) { w->sflags[s] |= SPN_SPRING_BROKEN; }
 
@@ -458,9 +477,11 @@ spn_world *spn_world_clone(const spn_world *w)
     *c = *w;
     c->compiled = false;
     c->adj_start = c->adj = NULL;
-    c->fs = c->fair = c->f = c->x0 = c->v0 = c->xt = c->vt = NULL;
-    c->sdiam = NULL;
-    for (int i = 0; i < 4; i++) c->kx[i] = c->kv[i] = NULL;
+    c->fs = c->f = c->fext = c->x0 = c->v0 = c->fair = c->wind = NULL;
+    c->sdiam = c->cair = c->partial = NULL;
+    c->jac = NULL;
+    c->npartial = 0;
+    for (int i = 0; i < SPN_TMP_COUNT; i++) c->tmp[i] = NULL;
     /* Nothing may alias w's arrays if a copy below fails and c is destroyed. */
     c->x = c->v = NULL;
     c->mass = c->inv_mass = c->k = c->kd = c->rest = c->bmin = c->bmax = NULL;
