@@ -22,10 +22,19 @@
 
 #include <math.h>
 
-/* Energy of particle i that collisions can change: kinetic + gravitational. */
+/* Energy that moving particle i can change: its kinetic and gravitational
+ * energy and the elastic energy of its springs. */
 static double particle_energy(const spn_world *w, uint32_t i)
 {
-    return 0.5 * w->mass[i] * spn_v3_dot(w->v[i], w->v[i]) - w->mass[i] * spn_v3_dot(w->def.gravity, w->x[i]);
+    double e = 0.5 * w->mass[i] * spn_v3_dot(w->v[i], w->v[i]) - w->mass[i] * spn_v3_dot(w->def.gravity, w->x[i]);
+    for (uint32_t j = w->adj_start[i]; j < w->adj_start[i + 1]; j++) {
+        uint32_t s = w->adj[j] >> 1;
+        if (w->sflags[s] & SPN_SPRING_BROKEN) continue;
+        double d = spn_v3_len(spn_v3_sub(w->x[w->sa[s]], w->x[w->sb[s]])) - w->rest[s];
+        if (d < 0 && (w->sflags[s] & SPN_SPRING_TENSION_ONLY)) continue;
+        e += 0.5 * w->k[s] * d * d;
+    }
+    return e;
 }
 
 /* Depth of x inside collider c (> 0: inside) and the outward normal there. */

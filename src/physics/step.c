@@ -8,7 +8,8 @@
  *   gain = dKE + dPE - E_elastic,before - W_external
  * is positive (the new elastic energy is at least zero, so this is a lower
  * bound of the energy created); it has blown up when the gain exceeds
- * def.energy_jump times the energy in play (KE + elastic before, plus |W|).
+ * def.energy_jump times the energy in play (KE + elastic before, plus |W|
+ * and what gravity gives in one step, M g^2 dt^2).
  * The world then gets back the state from before the step, and the message
  * names the step and the particle (first non-finite one, or the fastest).
  *
@@ -81,7 +82,10 @@ spn_status spn_world_step(spn_world *w, double dt)
     st = integrate(w, dt, &r);
     if (st != SPN_OK) return st;
     double gain = r.gain_kp - r.elastic - r.work;
-    double scale = r.e_before + fabs(r.work);
+    /* Energy in play; gravity alone gives m g^2 dt^2 per step (forward
+     * Euler gains half of that from rest). */
+    double g2 = spn_v3_dot(w->def.gravity, w->def.gravity);
+    double scale = r.e_before + fabs(r.work) + w->free_mass * g2 * dt * dt;
     if (!isfinite(r.kinetic) || !isfinite(r.gain_kp) || gain > w->def.energy_jump * scale + 1e-300)
         return blew_up(w, dt, gain);
     double lost = 0;

@@ -290,6 +290,9 @@ spn_status spn_world_compile(spn_world *w)
     }
     /* CSR adjacency by counting sort: each particle's springs in id order. */
     w->any_limits = false;
+    w->free_mass = 0;
+    for (uint32_t i = 0; i < w->np; i++)
+        if (w->inv_mass[i] > 0) w->free_mass += w->mass[i];
     for (uint32_t s = 0; s < w->ns; s++) {
         if (w->bmin[s] > 0 || w->bmax[s] < INFINITY) w->any_limits = true;
         w->adj_start[w->sa[s] + 1]++;
@@ -318,17 +321,23 @@ void spn_world_set_position(spn_world *w, uint32_t i, spn_vec3 p) { w->x[i] = p;
 void spn_world_set_velocity(spn_world *w, uint32_t i, spn_vec3 v) { w->v[i] = v; }
 void spn_world_set_particle_tag(spn_world *w, uint32_t i, uint32_t tag) { w->ptag[i] = tag; }
 
+static double free_mass_of(const spn_world *w, uint32_t i) { return w->inv_mass[i] > 0 ? w->mass[i] : 0; }
+
 void spn_world_set_fixed(spn_world *w, uint32_t i, bool fixed)
 {
+    w->free_mass -= free_mass_of(w, i);
     w->inv_mass[i] = (fixed || w->mass[i] == 0) ? 0 : 1.0 / w->mass[i];
     if (fixed) w->v[i] = spn_v3(0, 0, 0);
+    w->free_mass += free_mass_of(w, i);
 }
 
 void spn_world_set_mass(spn_world *w, uint32_t i, double mass)
 {
     bool fixed = w->inv_mass[i] == 0 && w->mass[i] != 0;
+    w->free_mass -= free_mass_of(w, i);
     w->mass[i] = mass;
     w->inv_mass[i] = (fixed || mass == 0) ? 0 : 1.0 / mass;
+    w->free_mass += free_mass_of(w, i);
 }
 
 spn_spring_info spn_world_spring(const spn_world *w, uint32_t s)

@@ -85,6 +85,7 @@ struct spn_world {
     double *sdiam;        /* per-spring diameter for air drag */
     bool any_diam;        /* some spring has a diameter */
     bool any_limits;      /* some spring has a break length */
+    double free_mass;     /* total mass of the free particles */
     spn_vec3 *f, *fext;   /* per-particle total and external force */
     spn_vec3 *x0, *v0;    /* state before the step (restored on blow-up) */
     spn_vec3 *tmp[SPN_TMP_COUNT]; /* per-particle scratch, allocated on demand */
