@@ -2,7 +2,8 @@
  * Simulation" (SIGGRAPH 1998), section 3: one Newton step per time step,
  *   (M - h df/dv - h^2 df/dx) dv = h (f0 + h df/dx v0),
  *   v1 = v0 + dv,  x1 = x0 + h v1,
- * solved by conjugate gradients with a Jacobi (diagonal) preconditioner.
+ * solved by conjugate gradients with a block-Jacobi preconditioner (the
+ * inverse of each particle's 3x3 diagonal block).
  * Fixed particles are filtered out (their rows and columns are the identity
  * with a zero right-hand side: their dv stays exactly 0).
  *
@@ -31,7 +32,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { T_DV = SPN_TMP_A, T_R, T_Z, T_P, T_AP, T_B, T_MINV };
+enum { T_DV = SPN_TMP_A, T_R, T_Z, T_P, T_AP, T_B };
 
 /* Per-spring Jacobian and the stiffness term of the right-hand side,
  * h^2 K (v_a - v_b), into w->fs. */
@@ -66,32 +67,49 @@ static void build_jacobian(spn_world *w, double h)
     }
 }
 
-/* Right-hand side b = h f + h^2 K v and the inverse diagonal of A. */
+/* Inverse of the symmetric 3x3 block (xx, yy, zz, xy, xz, yz), by cofactors. */
+static void invert_sym3(const double a[6], double out[6])
+{
+    const double xx = a[0], yy = a[1], zz = a[2], xy = a[3], xz = a[4], yz = a[5];
+    const double c0 = yy * zz - yz * yz, c1 = xx * zz - xz * xz, c2 = xx * yy - xy * xy;
+    const double c3 = xz * yz - xy * zz, c4 = xy * yz - xz * yy, c5 = xy * xz - xx * yz;
+    const double det = xx * c0 + xy * c3 + xz * c4;
+    const double inv = 1 / det;
+    out[0] = c0 * inv, out[1] = c1 * inv, out[2] = c2 * inv;
+    out[3] = c3 * inv, out[4] = c4 * inv, out[5] = c5 * inv;
+}
+
+/* Right-hand side b = h f + h^2 K v, and the inverse of each particle's 3x3
+ * diagonal block of A (block Jacobi: a strand's node is stiff along the
+ * thread and soft across it, which a scalar diagonal cannot see). */
 static void build_rhs(spn_world *w, double h)
 {
     const uint32_t np = w->np;
-    spn_vec3 *b = w->tmp[T_B], *minv = w->tmp[T_MINV];
+    spn_vec3 *b = w->tmp[T_B];
+    double *minv = w->pinv;
     const double drag = w->def.drag;
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
     for (uint32_t i = 0; i < np; i++) {
-        const spn_vec3 zero = {0, 0, 0};
+        double *mi = minv + 6 * (size_t)i;
         if (w->inv_mass[i] == 0) {
-            b[i] = minv[i] = zero;
+            b[i] = spn_v3(0, 0, 0);
+            for (int c = 0; c < 6; c++) mi[c] = 0;
             continue;
         }
         spn_vec3 bi = spn_v3_scale(w->f[i], h);
         const double m = w->mass[i] * (1 + h * drag);
-        spn_vec3 d = {m, m, m};
+        double d[6] = {m, m, m, 0, 0, 0};
         for (uint32_t k = w->adj_start[i]; k < w->adj_start[i + 1]; k++) {
             const uint32_t e = w->adj[k], s = e >> 1;
             const spn__jac *j = &w->jac[s];
             bi = (e & 1u) ? spn_v3_sub(bi, w->fs[s]) : spn_v3_add(bi, w->fs[s]);
-            d.x += j->iso + j->axial * j->u.x * j->u.x + j->air * (1 - j->u.x * j->u.x);
-            d.y += j->iso + j->axial * j->u.y * j->u.y + j->air * (1 - j->u.y * j->u.y);
-            d.z += j->iso + j->axial * j->u.z * j->u.z + j->air * (1 - j->u.z * j->u.z);
+            const double iso = j->iso + j->air, ax = j->axial - j->air;
+            const spn_vec3 u = j->u;
+            d[0] += iso + ax * u.x * u.x, d[1] += iso + ax * u.y * u.y, d[2] += iso + ax * u.z * u.z;
+            d[3] += ax * u.x * u.y, d[4] += ax * u.x * u.z, d[5] += ax * u.y * u.z;
         }
         b[i] = bi;
-        minv[i] = spn_v3(1 / d.x, 1 / d.y, 1 / d.z);
+        invert_sym3(d, mi);
     }
 }
 
@@ -142,7 +160,8 @@ static double apply(spn_world *w, double h, const spn_vec3 *p, spn_vec3 *ap)
 static void cg_update(spn_world *w, double alpha, double *rz, double *rr)
 {
     spn_vec3 *dv = w->tmp[T_DV], *r = w->tmp[T_R], *z = w->tmp[T_Z];
-    const spn_vec3 *p = w->tmp[T_P], *ap = w->tmp[T_AP], *minv = w->tmp[T_MINV];
+    const spn_vec3 *p = w->tmp[T_P], *ap = w->tmp[T_AP];
+    const double *minv = w->pinv;
     const uint32_t np = w->np, nb = spn__blocks(np);
     double *partial = w->partial;
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
@@ -152,7 +171,9 @@ static void cg_update(spn_world *w, double alpha, double *rz, double *rr)
         for (uint32_t i = lo; i < hi; i++) {
             dv[i] = spn_v3_add(dv[i], spn_v3_scale(p[i], alpha));
             const spn_vec3 ri = spn_v3_sub(r[i], spn_v3_scale(ap[i], alpha));
-            const spn_vec3 zi = spn_v3(ri.x * minv[i].x, ri.y * minv[i].y, ri.z * minv[i].z);
+            const double *m = minv + 6 * (size_t)i;
+            const spn_vec3 zi = spn_v3(m[0] * ri.x + m[3] * ri.y + m[4] * ri.z, m[3] * ri.x + m[1] * ri.y + m[5] * ri.z,
+                                       m[4] * ri.x + m[5] * ri.y + m[2] * ri.z);
             r[i] = ri;
             z[i] = zi;
             a += spn_v3_dot(ri, zi);
@@ -243,8 +264,10 @@ static void finish(spn_world *w, double h, bool ext, spn__step_result *r)
 
 spn_status spn__step_implicit(spn_world *w, double h, spn__step_result *r)
 {
-    spn_status st = spn__scratch(w, 7);
+    spn_status st = spn__scratch(w, 6);
     if (st != SPN_OK) return st;
+    if (!w->pinv && !(w->pinv = malloc((w->np ? w->np : 1) * 6 * sizeof *w->pinv)))
+        return spn_error(SPN_ERR_NOMEM, "out of memory for the implicit solver (%u particles)", w->np);
     if (!w->jac && !(w->jac = malloc((w->ns ? w->ns : 1) * sizeof *w->jac)))
         return spn_error(SPN_ERR_NOMEM, "out of memory for the implicit solver (%u springs)", w->ns);
     memcpy(w->x0, w->x, w->np * sizeof *w->x);

@@ -94,10 +94,11 @@ static void free_compiled(spn_world *w)
     free(w->wind);
     free(w->cair);
     free(w->jac);
+    free(w->pinv);
     free(w->partial);
     w->adj_start = w->adj = NULL;
     w->fs = w->f = w->fext = w->x0 = w->v0 = w->fair = w->wind = NULL;
-    w->sdiam = w->cair = w->partial = NULL;
+    w->sdiam = w->cair = w->partial = w->pinv = NULL;
     w->jac = NULL;
     w->npartial = 0;
     w->compiled = false;
@@ -487,7 +488,7 @@ spn_world *spn_world_clone(const spn_world *w)
     c->compiled = false;
     c->adj_start = c->adj = NULL;
     c->fs = c->f = c->fext = c->x0 = c->v0 = c->fair = c->wind = NULL;
-    c->sdiam = c->cair = c->partial = NULL;
+    c->sdiam = c->cair = c->partial = c->pinv = NULL;
     c->jac = NULL;
     c->npartial = 0;
     for (int i = 0; i < SPN_TMP_COUNT; i++) c->tmp[i] = NULL;

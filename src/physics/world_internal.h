@@ -21,11 +21,11 @@
 #define SPN_SPRING_BROKEN 2u
 
 /* Items per reduction block; fixed so sums do not depend on the thread count. */
-#define SPN_BLOCK 4096u
+#define SPN_BLOCK 1024u
 /* Partial sums kept per block. */
 #define SPN_NSUMS 6
 /* Below these sizes a loop runs on one thread (the fork costs more). */
-#define SPN_PAR_MIN 8192u
+#define SPN_PAR_MIN 2048u
 
 /* Per-particle scratch buffers, allocated on first use (see spn__scratch). */
 enum {
@@ -93,6 +93,7 @@ struct spn_world {
     spn_vec3 *wind;       /* per-spring air velocity at the midpoint (on demand) */
     double *cair;         /* per-spring linear air-drag coefficient (on demand) */
     spn__jac *jac;        /* implicit: per-spring Jacobian (on demand) */
+    double *pinv;         /* implicit: per-particle inverse 3x3 block, 6 each (on demand) */
     double *partial;      /* SPN_NSUMS per block */
     uint32_t npartial;    /* blocks the partial array holds */
 
