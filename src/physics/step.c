@@ -18,6 +18,7 @@
 #include "world_internal.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 /* The particle to name in a blow-up: the first non-finite one, or the one
@@ -51,10 +52,13 @@ static spn_status blew_up(spn_world *w, double dt, double gain)
         return spn_error(SPN_ERR_UNSTABLE,
                          "simulation blew up at step %llu (t = %g s, %s, dt = %g s): particle %u is not finite",
                          (unsigned long long)w->steps + 1, w->t + dt, spn_integrator_name(w->def.integrator), dt, i);
+    char jump[64];
+    if (isfinite(gain)) snprintf(jump, sizeof jump, "energy jumped by %g J", gain);
+    else snprintf(jump, sizeof jump, "energy overflowed");
     return spn_error(SPN_ERR_UNSTABLE,
-                     "simulation blew up at step %llu (t = %g s, %s, dt = %g s): energy jumped by %g J, "
-                     "fastest particle %u; try a smaller step or the implicit solver",
-                     (unsigned long long)w->steps + 1, w->t + dt, spn_integrator_name(w->def.integrator), dt, gain, i);
+                     "simulation blew up at step %llu (t = %g s, %s, dt = %g s): %s, fastest particle %u; "
+                     "try a smaller step or the implicit solver",
+                     (unsigned long long)w->steps + 1, w->t + dt, spn_integrator_name(w->def.integrator), dt, jump, i);
 }
 
 static spn_status integrate(spn_world *w, double dt, spn__step_result *r)
