@@ -33,6 +33,7 @@ static spn_vec3 *run(spn_integrator integ, int threads)
     spn_world_def def = spn_world_def_default();
     def.integrator = integ;
     def.threads = threads;
+    def.parallel_min = 256; /* split even this small web across threads */
     spn_orb_scene_def od = spn_orb_scene_def_default();
     od.rings = 50;
     od.radials = 50;

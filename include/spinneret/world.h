@@ -48,6 +48,8 @@ typedef struct spn_world_def {
     double provot_max_strain;  ///< Provot deformation limit (0 = off), e.g. 0.1 = 10%
     int provot_iterations;     ///< Provot passes per step, default 4
     uint64_t seed;             ///< for anything random in the world, default 1
+    uint32_t parallel_min;     ///< loops over fewer items than this run on one thread
+                               ///< (waking threads costs more), default 32768
 } spn_world_def;
 
 SPN_API spn_world_def spn_world_def_default(void);

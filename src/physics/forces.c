@@ -23,7 +23,7 @@
 int spn__threads(const spn_world *w, uint32_t n)
 {
 #ifdef _OPENMP
-    if (n < SPN_PAR_MIN) return 1;
+    if (n < w->def.parallel_min) return 1;
     return w->def.threads > 0 ? w->def.threads : omp_get_max_threads();
 #else
     (void)w;
@@ -64,11 +64,12 @@ static inline spn_vec3 spring_force(const spn_world *w, uint32_t s, const spn_ve
     if (!(len > 0)) return zero;
     const double stretch = len - w->rest[s];
     if (stretch < 0 && (w->sflags[s] & SPN_SPRING_TENSION_ONLY)) return zero;
-    const double rate = spn_v3_dot(spn_v3_sub(v[a], v[b]), l) / len; /* d|l|/dt */
+    const double inv = 1 / len;
+    const double rate = spn_v3_dot(spn_v3_sub(v[a], v[b]), l) * inv; /* d|l|/dt */
     const double k = w->k[s], kd = w->kd[s];
     *energy += 0.5 * k * stretch * stretch;
     *power += kd * rate * rate;
-    return spn_v3_scale(l, -(k * stretch + kd * rate) / len);
+    return spn_v3_scale(l, -(k * stretch + kd * rate) * inv);
 }
 
 double spn_cylinder_drag_coefficient(double re)

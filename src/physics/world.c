@@ -25,6 +25,7 @@ spn_world_def spn_world_def_default(void)
     d.provot_max_strain = 0;
     d.provot_iterations = 4;
     d.seed = 1;
+    d.parallel_min = 32768;
     return d;
 }
 

@@ -24,8 +24,6 @@
 #define SPN_BLOCK 1024u
 /* Partial sums kept per block. */
 #define SPN_NSUMS 6
-/* Below these sizes a loop runs on one thread (the fork costs more). */
-#define SPN_PAR_MIN 2048u
 
 /* Per-particle scratch buffers, allocated on first use (see spn__scratch). */
 enum {
@@ -125,7 +123,7 @@ struct spn_world {
 
 /* ---- forces.c ---- */
 
-/* Threads for a loop over n items (1 below SPN_PAR_MIN). */
+/* Threads for a loop over n items (1 below def.parallel_min). */
 int spn__threads(const spn_world *w, uint32_t n);
 /* Ensure the first `count` per-particle scratch buffers exist. */
 spn_status spn__scratch(spn_world *w, int count);
@@ -163,11 +161,9 @@ static inline spn_vec3 spn__force_on(const spn_world *w, uint32_t i, spn_vec3 vi
     for (uint32_t j = w->adj_start[i]; j < end; j++) {
         const uint32_t e = w->adj[j];
         const spn_vec3 fe = w->fs[e >> 1];
-        if (e & 1u) {
-            fi.x -= fe.x, fi.y -= fe.y, fi.z -= fe.z;
-        } else {
-            fi.x += fe.x, fi.y += fe.y, fi.z += fe.z;
-        }
+        /* Branch-free sign: which end a particle is follows no pattern. */
+        const double sg = 1.0 - 2.0 * (double)(e & 1u);
+        fi.x += sg * fe.x, fi.y += sg * fe.y, fi.z += sg * fe.z;
     }
     if (has_ext) fi = spn_v3_add(fi, w->fext[i]);
     return fi;
