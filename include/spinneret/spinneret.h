@@ -8,5 +8,7 @@
 #include "web.h"
 #include "io.h"
 #include "scenes.h"
+#include "render.h"
+#include "export.h"
 
 #endif
