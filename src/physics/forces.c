@@ -54,7 +54,7 @@ bool spn__air_active(const spn_world *w) { return w->air_fn && w->any_diam && w-
 
 /* Spring s's force on end a at (x, v); its elastic energy and damping power. */
 static inline spn_vec3 spring_force(const spn_world *w, uint32_t s, const spn_vec3 *x, const spn_vec3 *v,
-                                    double *energy, double *power)
+                                    double *energy, double *power, double *gross)
 {
     const spn_vec3 zero = {0, 0, 0};
     if (w->sflags[s] & SPN_SPRING_BROKEN) return zero;
@@ -69,7 +69,9 @@ static inline spn_vec3 spring_force(const spn_world *w, uint32_t s, const spn_ve
     const double k = w->k[s], kd = w->kd[s];
     *energy += 0.5 * k * stretch * stretch;
     *power += kd * rate * rate;
-    return spn_v3_scale(l, -(k * stretch + kd * rate) * inv);
+    const double mag = k * stretch + kd * rate;
+    *gross += fabs(mag);
+    return spn_v3_scale(l, -mag * inv);
 }
 
 double spn_cylinder_drag_coefficient(double re)
@@ -134,20 +136,23 @@ void spn__spring_pass(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, ns))
     for (uint32_t blk = 0; blk < nb; blk++) {
         const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < ns ? lo + SPN_BLOCK : ns;
-        double energy = 0, power = 0;
-        for (uint32_t s = lo; s < hi; s++) fs[s] = spring_force(w, s, x, v, &energy, &power);
+        double energy = 0, power = 0, gross = 0;
+        for (uint32_t s = lo; s < hi; s++) fs[s] = spring_force(w, s, x, v, &energy, &power, &gross);
         if (air)
             for (uint32_t s = lo; s < hi; s++) w->fair[s] = air_force(w, s, x, v, &w->cair[s]);
         partial[(size_t)blk * SPN_NSUMS + 0] = energy;
         partial[(size_t)blk * SPN_NSUMS + 1] = power;
+        partial[(size_t)blk * SPN_NSUMS + 2] = gross;
     }
-    double elastic = 0, damp = 0;
+    double elastic = 0, damp = 0, gross = 0;
     for (uint32_t blk = 0; blk < nb; blk++) {
         elastic += partial[(size_t)blk * SPN_NSUMS + 0];
         damp += partial[(size_t)blk * SPN_NSUMS + 1];
+        gross += partial[(size_t)blk * SPN_NSUMS + 2];
     }
     e->elastic = elastic;
     e->damp_power = damp;
+    e->gross = gross + w->free_mass * spn_v3_len(w->def.gravity);
     e->kinetic = 0;
     e->ext_power = 0;
 }

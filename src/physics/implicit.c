@@ -198,8 +198,12 @@ static void cg_direction(spn_world *w, double beta)
     for (uint32_t i = 0; i < np; i++) p[i] = spn_v3_add(z[i], spn_v3_scale(p[i], beta));
 }
 
-/* Preconditioned CG for A dv = b from dv = 0; returns the iterations. */
-static int solve(spn_world *w, double h)
+/* Preconditioned CG for A dv = b from dv = 0; returns the iterations. It
+ * stops at relative residual def.cg_tolerance, or when the residual is down
+ * to the round-off of the forces themselves (h times 1e-13 of their gross
+ * scale): at rest b is itself round-off and no tolerance relative to it
+ * could be met. */
+static int solve(spn_world *w, double h, double gross)
 {
     const uint32_t np = w->np;
     spn_vec3 *dv = w->tmp[T_DV], *r = w->tmp[T_R], *z = w->tmp[T_Z], *p = w->tmp[T_P];
@@ -210,7 +214,9 @@ static int solve(spn_world *w, double h)
     memset(w->tmp[T_AP], 0, np * sizeof *p);
     cg_update(w, 0, &rz, &rr); /* z = M^-1 r and the norms */
     memcpy(p, z, np * sizeof *p);
-    const double stop = w->def.cg_tolerance * w->def.cg_tolerance * rr;
+    const double floor = 1e-13 * h * gross;
+    double stop = w->def.cg_tolerance * w->def.cg_tolerance * rr;
+    if (stop < floor * floor) stop = floor * floor;
     int it = 0;
     while (it < w->def.cg_max_iterations && rr > stop && rz > 0) {
         double pap = apply(w, h, p, w->tmp[T_AP]);
@@ -279,7 +285,7 @@ spn_status spn__step_implicit(spn_world *w, double h, spn__step_result *r)
     r->elastic = e.elastic;
     build_jacobian(w, h);
     build_rhs(w, h);
-    w->last.cg_iterations = solve(w, h);
+    w->last.cg_iterations = solve(w, h, e.gross);
     finish(w, h, ext, r);
     return SPN_OK;
 }
