@@ -28,11 +28,12 @@ static double particle_energy(const spn_world *w, uint32_t i)
 {
     double e = 0.5 * w->mass[i] * spn_v3_dot(w->v[i], w->v[i]) - w->mass[i] * spn_v3_dot(w->def.gravity, w->x[i]);
     for (uint32_t j = w->adj_start[i]; j < w->adj_start[i + 1]; j++) {
-        uint32_t s = w->adj[j] >> 1;
-        if (w->sflags[s] & SPN_SPRING_BROKEN) continue;
-        double d = spn_v3_len(spn_v3_sub(w->x[w->sa[s]], w->x[w->sb[s]])) - w->rest[s];
-        if (d < 0 && (w->sflags[s] & SPN_SPRING_TENSION_ONLY)) continue;
-        e += 0.5 * w->k[s] * d * d;
+        uint32_t s = w->adj[j] >> 1; /* internal order */
+        if (w->hflags[s] & SPN_SPRING_BROKEN) continue;
+        const spn__spring *sp = &w->hs[s];
+        double d = spn_v3_len(spn_v3_sub(w->x[sp->a], w->x[sp->b])) - sp->rest;
+        if (d < 0 && (w->hflags[s] & SPN_SPRING_TENSION_ONLY)) continue;
+        e += 0.5 * sp->k * d * d;
     }
     return e;
 }
@@ -136,6 +137,7 @@ int spn__check_breakage(spn_world *w)
         double len = spn_v3_len(spn_v3_sub(w->x[w->sa[s]], w->x[w->sb[s]]));
         if (len >= w->bmin[s] && len <= w->bmax[s]) continue;
         w->sflags[s] |= SPN_SPRING_BROKEN;
+        w->hflags[w->iperm[s]] |= SPN_SPRING_BROKEN;
         breaks++;
         if (w->break_fn) w->break_fn(w->break_user, s, w->t, len);
     }

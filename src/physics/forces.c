@@ -12,8 +12,8 @@
  * only the air velocity normal to the segment counts,
  *   u = w(midpoint) - (v_a + v_b) / 2,  u_n = u - t (t . u),
  *   F = 1/2 rho C_d(Re) d L |u_n| u_n,   Re = rho |u_n| d / mu,
- * half of F on each end. The air callback is called serially in spring order,
- * so it may keep state (a seeded gust generator, say). */
+ * half of F on each end. The air callback is called serially in a fixed
+ * order, so it may keep state (a seeded gust generator, say). */
 #include "world_internal.h"
 
 #include <math.h>
@@ -57,16 +57,18 @@ static inline spn_vec3 spring_force(const spn_world *w, uint32_t s, const spn_ve
                                     double *energy, double *power, double *gross)
 {
     const spn_vec3 zero = {0, 0, 0};
-    if (w->sflags[s] & SPN_SPRING_BROKEN) return zero;
-    const uint32_t a = w->sa[s], b = w->sb[s];
+    const uint8_t flags = w->hflags[s];
+    if (flags & SPN_SPRING_BROKEN) return zero;
+    const spn__spring sp = w->hs[s];
+    const uint32_t a = sp.a, b = sp.b;
     const spn_vec3 l = spn_v3_sub(x[a], x[b]);
     const double len = sqrt(spn_v3_dot(l, l));
     if (!(len > 0)) return zero;
-    const double stretch = len - w->rest[s];
-    if (stretch < 0 && (w->sflags[s] & SPN_SPRING_TENSION_ONLY)) return zero;
+    const double stretch = len - sp.rest;
+    if (stretch < 0 && (flags & SPN_SPRING_TENSION_ONLY)) return zero;
     const double inv = 1 / len;
     const double rate = spn_v3_dot(spn_v3_sub(v[a], v[b]), l) * inv; /* d|l|/dt */
-    const double k = w->k[s], kd = w->kd[s];
+    const double k = sp.k, kd = sp.kd;
     *energy += 0.5 * k * stretch * stretch;
     *power += kd * rate * rate;
     const double mag = k * stretch + kd * rate;
@@ -100,8 +102,8 @@ static spn_vec3 air_force(const spn_world *w, uint32_t s, const spn_vec3 *x, con
     const spn_vec3 zero = {0, 0, 0};
     *c = 0;
     const double d = w->sdiam[s];
-    if (!(d > 0) || (w->sflags[s] & SPN_SPRING_BROKEN)) return zero;
-    const uint32_t a = w->sa[s], b = w->sb[s];
+    if (!(d > 0) || (w->hflags[s] & SPN_SPRING_BROKEN)) return zero;
+    const uint32_t a = w->hs[s].a, b = w->hs[s].b;
     const spn_vec3 l = spn_v3_sub(x[a], x[b]);
     const double len = spn_v3_len(l);
     if (!(len > 0)) return zero;
@@ -116,12 +118,13 @@ static spn_vec3 air_force(const spn_world *w, uint32_t s, const spn_vec3 *x, con
     return spn_v3_scale(un, *c);
 }
 
-/* Air velocity at each tagged segment's midpoint, serially in spring order. */
+/* Air velocity at each tagged segment's midpoint, serially in the internal
+ * spring order. */
 static void sample_air(spn_world *w, double t, const spn_vec3 *x)
 {
     for (uint32_t s = 0; s < w->ns; s++) {
         if (!(w->sdiam[s] > 0)) continue;
-        spn_vec3 mid = spn_v3_scale(spn_v3_add(x[w->sa[s]], x[w->sb[s]]), 0.5);
+        spn_vec3 mid = spn_v3_scale(spn_v3_add(x[w->hs[s].a], x[w->hs[s].b]), 0.5);
         w->wind[s] = w->air_fn(w->air_user, t, mid);
     }
 }

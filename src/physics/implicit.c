@@ -45,17 +45,18 @@ static void build_jacobian(spn_world *w, double h)
     for (uint32_t s = 0; s < ns; s++) {
         spn__jac j = {{0, 0, 0}, 0, 0, 0};
         spn_vec3 g = {0, 0, 0};
-        const uint32_t a = w->sa[s], b = w->sb[s];
+        const spn__spring sp = w->hs[s];
+        const uint32_t a = sp.a, b = sp.b;
         const spn_vec3 l = spn_v3_sub(x[a], x[b]);
         const double len = spn_v3_len(l);
-        if (len > 0 && !(w->sflags[s] & SPN_SPRING_BROKEN)) {
+        if (len > 0 && !(w->hflags[s] & SPN_SPRING_BROKEN)) {
             j.u = spn_v3_scale(l, 1 / len);
-            const double rest = w->rest[s], k = w->k[s];
-            const bool slack = len < rest && (w->sflags[s] & SPN_SPRING_TENSION_ONLY);
+            const double rest = sp.rest, k = sp.k;
+            const bool slack = len < rest && (w->hflags[s] & SPN_SPRING_TENSION_ONLY);
             if (!slack) {
                 const double tau = len > rest ? 1 - rest / len : 0;
                 const double h2k = h * h * k;
-                j.axial = h * w->kd[s] + h2k * (1 - tau);
+                j.axial = h * sp.kd + h2k * (1 - tau);
                 j.iso = h2k * tau;
                 const spn_vec3 dv = spn_v3_sub(v[a], v[b]);
                 g = spn_v3_add(spn_v3_scale(j.u, -h2k * (1 - tau) * spn_v3_dot(j.u, dv)), spn_v3_scale(dv, -j.iso));
@@ -121,7 +122,7 @@ static double apply(spn_world *w, double h, const spn_vec3 *p, spn_vec3 *ap)
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, ns))
     for (uint32_t s = 0; s < ns; s++) {
         const spn__jac *j = &w->jac[s];
-        const spn_vec3 pa = p[w->sa[s]], pb = p[w->sb[s]];
+        const spn_vec3 pa = p[w->hs[s].a], pb = p[w->hs[s].b];
         const spn_vec3 d = spn_v3_sub(pa, pb);
         w->fs[s] = spn_v3_add(spn_v3_scale(d, j->iso), spn_v3_scale(j->u, j->axial * spn_v3_dot(j->u, d)));
         if (air) {
@@ -259,8 +260,9 @@ static void finish(spn_world *w, double h, bool ext, spn__step_result *r)
     spn__sum_partials(w, nb, sum);
     double spring_damp = 0; /* axial damping power at the new velocities */
     for (uint32_t s = 0; s < w->ns; s++) {
-        const double rate = spn_v3_dot(w->jac[s].u, spn_v3_sub(w->v[w->sa[s]], w->v[w->sb[s]]));
-        spring_damp += w->kd[s] * rate * rate;
+        const spn__spring *sp = &w->hs[s];
+        const double rate = spn_v3_dot(w->jac[s].u, spn_v3_sub(w->v[sp->a], w->v[sp->b]));
+        spring_damp += sp->kd * rate * rate;
     }
     r->gain_kp = sum[0];
     r->kinetic = sum[1];

@@ -81,6 +81,10 @@ static void free_compiled(spn_world *w)
 {
     free(w->adj_start);
     free(w->adj);
+    free(w->hs);
+    free(w->hflags);
+    free(w->perm);
+    free(w->iperm);
     free(w->fs);
     free(w->sdiam);
     free(w->f);
@@ -97,7 +101,9 @@ static void free_compiled(spn_world *w)
     free(w->jac);
     free(w->pinv);
     free(w->partial);
-    w->adj_start = w->adj = NULL;
+    w->adj_start = w->adj = w->perm = w->iperm = NULL;
+    w->hs = NULL;
+    w->hflags = NULL;
     w->fs = w->f = w->fext = w->x0 = w->v0 = w->fair = w->wind = NULL;
     w->sdiam = w->cair = w->partial = w->pinv = NULL;
     w->jac = NULL;
@@ -255,6 +261,10 @@ static bool alloc_compiled(spn_world *w)
     w->npartial = nb ? nb : 1;
     w->adj_start = calloc(np + 1, sizeof *w->adj_start);
     w->adj = malloc(2 * ns * sizeof *w->adj);
+    w->hs = malloc(ns * sizeof *w->hs);
+    w->hflags = malloc(ns * sizeof *w->hflags);
+    w->perm = malloc(ns * sizeof *w->perm);
+    w->iperm = malloc(ns * sizeof *w->iperm);
     w->fs = malloc(ns * sizeof *w->fs);
     w->sdiam = malloc(ns * sizeof *w->sdiam);
     w->f = malloc(np * sizeof *w->f);
@@ -262,7 +272,7 @@ static bool alloc_compiled(spn_world *w)
     w->x0 = malloc(np * sizeof *w->x0);
     w->v0 = malloc(np * sizeof *w->v0);
     w->partial = calloc((size_t)w->npartial * SPN_NSUMS, sizeof *w->partial);
-    return w->adj_start && w->adj && w->fs && w->sdiam && w->f && w->fext && w->x0 && w->v0 && w->partial;
+    return w->adj_start && w->adj && w->hs && w->hflags && w->perm && w->iperm && w->fs && w->sdiam && w->f && w->fext && w->x0 && w->v0 && w->partial;
 }
 
 /* Air buffers, only for worlds with threads that have a diameter. */
@@ -270,7 +280,7 @@ static bool alloc_air(spn_world *w)
 {
     w->any_diam = false;
     for (uint32_t s = 0; s < w->ns; s++) {
-        w->sdiam[s] = tag_diameter(w, w->stag[s]);
+        w->sdiam[s] = tag_diameter(w, w->stag[w->perm[s]]);
         if (w->sdiam[s] > 0) w->any_diam = true;
     }
     if (!w->any_diam) return true;
@@ -280,32 +290,60 @@ static bool alloc_air(spn_world *w)
     return w->fair && w->wind && w->cair;
 }
 
+/* The internal spring order: by lower particle id, ties in public order
+ * (counting sort, so it is stable and O(n)); `count` has np + 1 zeros. */
+static void order_springs(spn_world *w, uint32_t *count)
+{
+    for (uint32_t s = 0; s < w->ns; s++) count[(w->sa[s] < w->sb[s] ? w->sa[s] : w->sb[s]) + 1]++;
+    for (uint32_t i = 0; i < w->np; i++) count[i + 1] += count[i];
+    for (uint32_t s = 0; s < w->ns; s++) w->perm[count[w->sa[s] < w->sb[s] ? w->sa[s] : w->sb[s]]++] = s;
+    for (uint32_t k = 0; k < w->ns; k++) {
+        uint32_t s = w->perm[k];
+        w->iperm[s] = k;
+        w->hs[k] = (spn__spring){w->sa[s], w->sb[s], w->k[s], w->kd[s], w->rest[s]};
+        w->hflags[k] = w->sflags[s];
+    }
+}
+
+/* CSR adjacency by counting sort: each particle's springs in internal order. */
+static void build_adjacency(spn_world *w, uint32_t *fill)
+{
+    for (uint32_t k = 0; k < w->ns; k++) {
+        w->adj_start[w->hs[k].a + 1]++;
+        w->adj_start[w->hs[k].b + 1]++;
+    }
+    for (uint32_t i = 0; i < w->np; i++) w->adj_start[i + 1] += w->adj_start[i];
+    for (uint32_t k = 0; k < w->ns; k++) {
+        uint32_t a = w->hs[k].a, b = w->hs[k].b;
+        w->adj[w->adj_start[a] + fill[a]++] = k << 1;
+        w->adj[w->adj_start[b] + fill[b]++] = (k << 1) | 1u;
+    }
+}
+
 spn_status spn_world_compile(spn_world *w)
 {
     if (w->compiled) return SPN_OK;
     free_compiled(w);
-    uint32_t *fill = calloc(w->np ? w->np : 1, sizeof *fill);
-    if (!fill || !alloc_compiled(w) || !alloc_air(w)) {
-        free(fill);
+    uint32_t *count = calloc((size_t)w->np + 1, sizeof *count);
+    if (!count || !alloc_compiled(w)) {
+        free(count);
         free_compiled(w);
         return spn_error(SPN_ERR_NOMEM, "out of memory compiling a world of %u particles and %u springs", w->np, w->ns);
     }
-    /* CSR adjacency by counting sort: each particle's springs in id order. */
+    order_springs(w, count);
+    memset(count, 0, ((size_t)w->np + 1) * sizeof *count);
+    build_adjacency(w, count);
+    free(count);
+    if (!alloc_air(w)) {
+        free_compiled(w);
+        return spn_error(SPN_ERR_NOMEM, "out of memory for air drag on %u springs", w->ns);
+    }
     w->any_limits = false;
+    for (uint32_t s = 0; s < w->ns; s++)
+        if (w->bmin[s] > 0 || w->bmax[s] < INFINITY) w->any_limits = true;
     w->free_mass = 0;
     for (uint32_t i = 0; i < w->np; i++)
         if (w->inv_mass[i] > 0) w->free_mass += w->mass[i];
-    for (uint32_t s = 0; s < w->ns; s++) {
-        if (w->bmin[s] > 0 || w->bmax[s] < INFINITY) w->any_limits = true;
-        w->adj_start[w->sa[s] + 1]++;
-        w->adj_start[w->sb[s] + 1]++;
-    }
-    for (uint32_t i = 0; i < w->np; i++) w->adj_start[i + 1] += w->adj_start[i];
-    for (uint32_t s = 0; s < w->ns; s++) {
-        w->adj[w->adj_start[w->sa[s]] + fill[w->sa[s]]++] = s << 1;
-        w->adj[w->adj_start[w->sb[s]] + fill[w->sb[s]]++] = (s << 1) | 1u;
-    }
-    free(fill);
     w->compiled = true;
     return SPN_OK;
 }
@@ -363,18 +401,31 @@ spn_spring_info spn_world_spring(const spn_world *w, uint32_t s)
     return info;
 }
 
-void spn_world_set_spring_rest(spn_world *w, uint32_t s, double rest) { w->rest[s] = rest; }
+void spn_world_set_spring_rest(spn_world *w, uint32_t s, double rest)
+{
+    w->rest[s] = rest;
+    if (w->compiled) w->hs[w->iperm[s]].rest = rest;
+}
+
 void spn_world_set_spring_stiffness(spn_world *w, uint32_t s, double k, double kd)
 {
     w->k[s] = k;
     w->kd[s] = kd;
+    if (w->compiled) {
+        w->hs[w->iperm[s]].k = k;
+        w->hs[w->iperm[s]].kd = kd;
+    }
 }
 void spn_world_set_spring_tag(spn_world *w, uint32_t s, uint32_t tag)
 {
     w->stag[s] = tag;
     w->compiled = false; /* the air buffers depend on the tags' diameters */
 }
-void spn_world_break_spring(spn_world *w, uint32_t s) { w->sflags[s] |= SPN_SPRING_BROKEN; }
+void spn_world_break_spring(spn_world *w, uint32_t s)
+{
+    w->sflags[s] |= SPN_SPRING_BROKEN;
+    if (w->compiled) w->hflags[w->iperm[s]] |= SPN_SPRING_BROKEN;
+}
 
 void spn_world_set_integrator(spn_world *w, spn_integrator integrator) { w->def.integrator = integrator; }
 void spn_world_set_gravity(spn_world *w, spn_vec3 g) { w->def.gravity = g; }
@@ -487,7 +538,9 @@ spn_world *spn_world_clone(const spn_world *w)
     if (!c) return NULL;
     *c = *w;
     c->compiled = false;
-    c->adj_start = c->adj = NULL;
+    c->adj_start = c->adj = c->perm = c->iperm = NULL;
+    c->hs = NULL;
+    c->hflags = NULL;
     c->fs = c->f = c->fext = c->x0 = c->v0 = c->fair = c->wind = NULL;
     c->sdiam = c->cair = c->partial = c->pinv = NULL;
     c->jac = NULL;

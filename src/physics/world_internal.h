@@ -43,6 +43,12 @@ typedef struct spn_tag_diameter {
     double diameter;
 } spn_tag_diameter;
 
+/* The hot fields of one spring, in the compiled (internal) order. */
+typedef struct spn__spring {
+    uint32_t a, b;
+    double k, kd, rest;
+} spn__spring;
+
 /* What one force evaluation measured at its state (x, v). */
 typedef struct spn__eval {
     double elastic;     /* sum 1/2 k stretch^2 (intact, non-slack springs) */
@@ -76,8 +82,17 @@ struct spn_world {
     uint8_t *sflags;
     uint32_t *stag, *sstage, *sorder;
 
-    /* compiled data: valid while `compiled` */
+    /* compiled data: valid while `compiled`. Springs are stepped in an
+     * internal order, sorted by their lower particle id (so consecutive
+     * springs touch nearby particles); perm / iperm map between internal and
+     * public ids, and everything indexed per spring below (fs, jac, ...) is
+     * in internal order. The public arrays above stay the reference; the
+     * setters write both. */
     bool compiled;
+    spn__spring *hs;      /* hot spring records, internal order */
+    uint8_t *hflags;      /* spring flags, internal order */
+    uint32_t *perm;       /* internal -> public spring id */
+    uint32_t *iperm;      /* public -> internal spring id */
     uint32_t *adj_start;  /* np + 1 */
     uint32_t *adj;        /* spring id << 1 | (1 if the particle is end b) */
     spn_vec3 *fs;         /* per-spring force on end a (scratch) */
