@@ -53,13 +53,14 @@ void spn__sum_partials(const spn_world *w, uint32_t blocks, double *out)
 bool spn__air_active(const spn_world *w) { return w->air_fn && w->any_diam && w->fair; }
 
 /* Spring s's force on end a at (x, v); its elastic energy and damping power. */
-static inline spn_vec3 spring_force(const spn_world *w, uint32_t s, const spn_vec3 *x, const spn_vec3 *v,
-                                    double *energy, double *power, double *gross)
+static inline spn_vec3 spring_force(const spn__spring *restrict hs, const uint8_t *restrict hflags, uint32_t s,
+                                    const spn_vec3 *restrict x, const spn_vec3 *restrict v, double *energy,
+                                    double *power, double *gross)
 {
     const spn_vec3 zero = {0, 0, 0};
-    const uint8_t flags = w->hflags[s];
+    const uint8_t flags = hflags[s];
     if (flags & SPN_SPRING_BROKEN) return zero;
-    const spn__spring sp = w->hs[s];
+    const spn__spring sp = hs[s];
     const uint32_t a = sp.a, b = sp.b;
     const spn_vec3 l = spn_v3_sub(x[a], x[b]);
     const double len = sqrt(spn_v3_dot(l, l));
@@ -134,13 +135,15 @@ void spn__spring_pass(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 
     const uint32_t ns = w->ns, nb = spn__blocks(ns);
     const bool air = spn__air_active(w);
     if (air) sample_air(w, t, x);
-    spn_vec3 *fs = w->fs;
+    spn_vec3 *restrict fs = w->fs;
+    const spn__spring *restrict hs = w->hs;
+    const uint8_t *restrict hflags = w->hflags;
     double *partial = w->partial;
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, ns))
     for (uint32_t blk = 0; blk < nb; blk++) {
         const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < ns ? lo + SPN_BLOCK : ns;
         double energy = 0, power = 0, gross = 0;
-        for (uint32_t s = lo; s < hi; s++) fs[s] = spring_force(w, s, x, v, &energy, &power, &gross);
+        for (uint32_t s = lo; s < hi; s++) fs[s] = spring_force(hs, hflags, s, x, v, &energy, &power, &gross);
         if (air)
             for (uint32_t s = lo; s < hi; s++) w->fair[s] = air_force(w, s, x, v, &w->cair[s]);
         partial[(size_t)blk * SPN_NSUMS + 0] = energy;
@@ -184,13 +187,15 @@ void spn__gather(spn_world *w, const spn_vec3 *x, const spn_vec3 *v, bool has_ex
     const uint32_t np = w->np, nb = spn__blocks(np);
     const double drag = w->def.drag;
     double *partial = w->partial;
+    const spn__gather_ctx ctx = spn__gather_ctx_of(w);
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
     for (uint32_t blk = 0; blk < nb; blk++) {
         const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < np ? lo + SPN_BLOCK : np;
+        const spn__gather_ctx c = ctx;
         double ke = 0, dp = 0, ep = 0;
         for (uint32_t i = lo; i < hi; i++) {
             const spn_vec3 vi = v[i];
-            f[i] = spn__force_on(w, i, vi, has_ext);
+            f[i] = spn__force_on(&c, i, vi, has_ext);
             if (w->inv_mass[i] == 0) continue;
             const double v2 = spn_v3_dot(vi, vi), m = w->mass[i];
             ke += 0.5 * m * v2;

@@ -166,22 +166,38 @@ double spn__elastic_energy(const spn_world *w, const spn_vec3 *x);
 double spn__kinetic_energy(const spn_world *w, const spn_vec3 *v);
 double spn__gravity_energy(const spn_world *w, const spn_vec3 *x);
 
-/* Net force on particle i: gravity, viscous drag, its springs (from w->fs, in
- * adjacency order) and, when `has_ext`, w->fext[i]. */
-static inline spn_vec3 spn__force_on(const spn_world *w, uint32_t i, spn_vec3 vi, bool has_ext)
+/* What the gather reads, copied out of the world into locals so the
+ * compiler knows stores to positions and velocities cannot change them
+ * (otherwise it reloads every pointer from the world on every particle). */
+typedef struct spn__gather_ctx {
+    const uint32_t *restrict adj_start, *restrict adj;
+    const spn_vec3 *restrict fs, *restrict fext;
+    const double *restrict mass, *restrict inv_mass;
+    spn_vec3 g;
+    double drag;
+} spn__gather_ctx;
+
+static inline spn__gather_ctx spn__gather_ctx_of(const spn_world *w)
 {
-    const double m = w->mass[i], c = w->def.drag * m;
-    const spn_vec3 g = w->def.gravity;
-    spn_vec3 fi = {m * g.x - c * vi.x, m * g.y - c * vi.y, m * g.z - c * vi.z};
-    const uint32_t end = w->adj_start[i + 1];
-    for (uint32_t j = w->adj_start[i]; j < end; j++) {
-        const uint32_t e = w->adj[j];
-        const spn_vec3 fe = w->fs[e >> 1];
+    spn__gather_ctx c = {w->adj_start, w->adj, w->fs, w->fext, w->mass, w->inv_mass, w->def.gravity, w->def.drag};
+    return c;
+}
+
+/* Net force on particle i: gravity, viscous drag, its springs (from fs, in
+ * adjacency order) and, when `has_ext`, fext[i]. */
+static inline spn_vec3 spn__force_on(const spn__gather_ctx *c, uint32_t i, spn_vec3 vi, bool has_ext)
+{
+    const double m = c->mass[i], dm = c->drag * m;
+    spn_vec3 fi = {m * c->g.x - dm * vi.x, m * c->g.y - dm * vi.y, m * c->g.z - dm * vi.z};
+    const uint32_t end = c->adj_start[i + 1];
+    for (uint32_t j = c->adj_start[i]; j < end; j++) {
+        const uint32_t e = c->adj[j];
+        const spn_vec3 fe = c->fs[e >> 1];
         /* Branch-free sign: which end a particle is follows no pattern. */
         const double sg = 1.0 - 2.0 * (double)(e & 1u);
         fi.x += sg * fe.x, fi.y += sg * fe.y, fi.z += sg * fe.z;
     }
-    if (has_ext) fi = spn_v3_add(fi, w->fext[i]);
+    if (has_ext) fi = spn_v3_add(fi, c->fext[i]);
     return fi;
 }
 
