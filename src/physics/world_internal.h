@@ -137,6 +137,11 @@ struct spn_world {
     char *metadata;
 };
 
+/* ---- compile.c ---- */
+
+/* Free every compiled array (the world goes back to construction mode). */
+void spn__free_compiled(spn_world *w);
+
 /* ---- forces.c ---- */
 
 /* Threads for a loop over n items (1 below def.parallel_min). */
