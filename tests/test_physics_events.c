@@ -189,6 +189,53 @@ static void test_collide_callback(void **state)
     spn_world_destroy(w);
 }
 
+/* Springs are stepped in an internal order; setters by public id after the
+ * world compiled must reach the stepping copies. Springs added in an order
+ * the internal sort changes: s0 = (1, 2), s1 = (0, 1). */
+static void test_setters_after_compile(void **state)
+{
+    (void)state;
+    spn_world_def def = spn_world_def_default();
+    def.gravity = spn_v3(0, -10, 0);
+    spn_world *w = spn_world_create(&def);
+    spn_particle_def p = spn_particle_def_default();
+    p.fixed = true;
+    spn_world_add_particle(w, &p, NULL);
+    p.fixed = false;
+    p.position = spn_v3(0, -1, 0);
+    spn_world_add_particle(w, &p, NULL);
+    p.position = spn_v3(0, -2, 0);
+    spn_world_add_particle(w, &p, NULL);
+    spn_spring_def s = spn_spring_def_default();
+    s.a = 1, s.b = 2, s.k = 100, s.rest = 1;
+    spn_world_add_spring(w, &s, NULL);
+    s.a = 0, s.b = 1;
+    spn_world_add_spring(w, &s, NULL);
+    const double dt = 1e-6;
+    assert_int_equal(spn_world_step(w, dt), SPN_OK);
+    /* Shorten s0 by 0.1: it pulls particle 2 up with k * 0.1 = 10 N, against its weight. */
+    spn_world_set_spring_rest(w, 0, 0.9);
+    spn_vec3 v0 = spn_world_velocity(w, 2);
+    assert_int_equal(spn_world_step(w, dt), SPN_OK);
+    double a = (spn_world_velocity(w, 2).y - v0.y) / dt;
+    assert_true(fabs(a - (-10 + 100 * 0.1)) < 1e-3);
+    /* Soften s0 to nothing: particle 2 falls freely. */
+    spn_world_set_spring_stiffness(w, 0, 0, 0);
+    v0 = spn_world_velocity(w, 2);
+    assert_int_equal(spn_world_step(w, dt), SPN_OK);
+    assert_true(fabs((spn_world_velocity(w, 2).y - v0.y) / dt + 10) < 1e-6);
+    /* Break s1 by hand: particle 1 falls freely too, and no callback fires. */
+    breaks b = {0, 0, 0};
+    spn_world_set_break_callback(w, on_break, &b);
+    spn_world_break_spring(w, 1);
+    v0 = spn_world_velocity(w, 1);
+    assert_int_equal(spn_world_step(w, dt), SPN_OK);
+    assert_true(fabs((spn_world_velocity(w, 1).y - v0.y) / dt + 10) < 1e-6);
+    assert_int_equal(b.count, 0);
+    assert_true(spn_world_spring(w, 1).broken);
+    spn_world_destroy(w);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -197,6 +244,7 @@ int main(void)
         cmocka_unit_test(test_plane_bounce),
         cmocka_unit_test(test_sphere_and_friction),
         cmocka_unit_test(test_collide_callback),
+        cmocka_unit_test(test_setters_after_compile),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
