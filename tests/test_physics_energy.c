@@ -103,9 +103,10 @@ static void test_adaptive_never_gains(void **state)
 static void test_accounting(void **state)
 {
     (void)state;
-    spn_integrator which[] = {SPN_INTEGRATOR_RK4, SPN_INTEGRATOR_SYMPLECTIC, SPN_INTEGRATOR_IMPLICIT};
-    double dts[] = {1e-4, 1e-5, 1e-5};
-    for (int j = 0; j < 3; j++) {
+    spn_integrator which[] = {SPN_INTEGRATOR_RK4, SPN_INTEGRATOR_SYMPLECTIC, SPN_INTEGRATOR_IMPLICIT,
+                              SPN_INTEGRATOR_ADAPTIVE};
+    double dts[] = {1e-4, 1e-5, 1e-5, 1e-3};
+    for (int j = 0; j < 4; j++) {
         spn_world *w = stiff_chain(which[j]);
         spn_world_set_drag(w, 0.5);
         assert_int_equal(spn_world_add_plane(w, spn_v3(0, 1, 0), -0.25, 0.5, 0.2), SPN_OK);
@@ -120,6 +121,10 @@ static void test_accounting(void **state)
         if (which[j] == SPN_INTEGRATOR_IMPLICIT) {
             /* Backward Euler also damps numerically: it may only lose more. */
             assert_true(balance < 0 && -balance < 0.05 * en.dissipated);
+        } else if (which[j] == SPN_INTEGRATOR_ADAPTIVE) {
+            /* It keeps only sub-steps that do not gain: symplectic Euler's
+             * energy wobble is clipped to its losing half, a numerical loss. */
+            assert_true(balance < 0 && -balance < 0.2 * en.dissipated);
         } else {
             assert_true(fabs(balance) < 0.001 * en.dissipated);
         }
