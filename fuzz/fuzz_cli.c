@@ -7,7 +7,8 @@
  * leak, hang, or allocate absurdly (libFuzzer's -malloc_limit_mb, -timeout).
  *
  * Runs in a private temporary folder holding small fixtures (a web file
- * "web.json", a picture "bg.png"); after each input everything in it is
+ * "web.json", a picture "bg.png", a tetrahedron "m.obj" and a scene with it
+ * "s.pov"); after each input everything in it is
  * removed and the fixtures are written again, so one input cannot feed the
  * next. PATH is emptied: no ffmpeg or povray is started (their absence is an
  * error path worth fuzzing; the programs themselves are not ours).
@@ -61,8 +62,23 @@ static const limits table[] = {
     {"settle", 200, {NULL}},
     {"render", 200, {"--quiet", NULL}},
     {"export", 200, {"--quiet", NULL}},
+    {"shoot", 200, {"--max-time", "0.3", "--quiet", NULL}},
+    {"drop", 100, {"--max-time", "0.3", NULL}},
+    {"film", 100, {"--max-time", "0.3", NULL}},
     {NULL, 100, {NULL}}, /* default */
 };
+
+static const char tetra_obj[] = "v 0 0.5 0\nv 0.1 0.5 0\nv 0 0.6 0\nv 0 0.5 0.1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+static const char tetra_pov[] =
+    "camera { location <0, 0.7, -2> look_at <0, 0.4, 0> }\n"
+    "#declare Floor = mesh2 {\n  #local spring_system_fixed = true;\n"
+    "  vertex_vectors { 4, <-1, 0, -1>, <1, 0, -1>, <1, 0, 1>, <-1, 0, 1> }\n"
+    "  face_indices { 2, <0, 2, 1>, <0, 3, 2> }\n}\n"
+    "#declare Tetra = mesh2 {\n  #local spring_system_ks = 400;\n  #local spring_system_kb = 400;\n"
+    "  #local spring_system_ds = 0.2;\n  #local spring_system_db = 0.2;\n  #local spring_system_mass = 0.1;\n"
+    "  #local spring_system_vicinity = 0;\n"
+    "  vertex_vectors { 4, <0, 0.5, 0>, <0.1, 0.5, 0>, <0, 0.6, 0>, <0, 0.5, 0.1> }\n"
+    "  face_indices { 4, <0, 2, 1>, <0, 1, 3>, <0, 3, 2>, <1, 2, 3> }\n}\n";
 
 enum { MAX_ARGS = 24, MAX_ARG_LEN = 512 };
 
@@ -133,6 +149,9 @@ static void reset_folder(void)
     if (d) closedir(d);
     write_file("web.json", &web_fixture);
     write_file("bg.png", &png_fixture);
+    spn_buffer obj = {(char *)tetra_obj, sizeof tetra_obj - 1, 0}, pov = {(char *)tetra_pov, sizeof tetra_pov - 1, 0};
+    write_file("m.obj", &obj);
+    write_file("s.pov", &pov);
 }
 
 static void slurp(const char *path, spn_buffer *b)
