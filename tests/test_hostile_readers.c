@@ -23,6 +23,7 @@ static const hostile_case cases[] = {
     {"hostile_ply_no_newline.ply", "repeats a vertex"}, /* read past its end (strspn) before */
     {"hostile_ply_huge_count.ply", "more than its"},
     {"hostile_ply_two_vertex_elements.ply", "more than one 'vertex' element"},
+    {"hostile_ply_empty_element_loop.ply", "declares 1000000000 items"}, /* a minute of looping before */
     {"hostile_ply_huge_faces.ply", "more than its"},
     {"hostile_pov_huge_count.pov", "more than the rest of the file"},
     {"hostile_pov_huge_faces.pov", "more than the rest of the file"},

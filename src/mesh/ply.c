@@ -249,6 +249,12 @@ static spn_status check_elements(ply_reader *r, spn_mesh *m)
     if (m->vertex_count > body || m->triangle_count > body)
         return spn_error(SPN_ERR_FORMAT, "%s: declares %u vertices and %u faces, more than its %zu bytes can hold",
                          r->name, m->vertex_count, m->triangle_count, body);
+    /* Any other element too: a billion items of no properties took a minute
+     * of looping over nothing. */
+    for (int k = 0; k < r->nelems; k++)
+        if (r->elems[k].count > body)
+            return spn_error(SPN_ERR_FORMAT, "%s: element '%s' declares %u items, more than its %zu bytes can hold",
+                             r->name, r->elems[k].name, r->elems[k].count, body);
     spn_status st = spn_check_counts(r->name, m->vertex_count, 3 * (uint64_t)m->triangle_count);
     if (st != SPN_OK) return st;
     m->vertices = calloc(m->vertex_count ? m->vertex_count : 1, sizeof *m->vertices);
