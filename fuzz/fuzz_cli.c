@@ -54,16 +54,16 @@ static const command commands[] = {
 typedef struct limits {
     const char *name;
     double cap;
-    const char *extra[4];
+    const char *extra[6];
 } limits;
 
 static const limits table[] = {
     {"info", 1e6, {NULL}},
     {"settle", 200, {NULL}},
-    {"render", 200, {"--quiet", NULL}},
+    {"render", 200, {"--quiet", "--size", "64x64", NULL}}, /* 6 frames of 1200x1200 took 10 s */
     {"export", 200, {"--quiet", NULL}},
-    {"shoot", 200, {"--max-time", "0.3", "--quiet", NULL}},
-    {"drop", 100, {"--max-time", "0.3", NULL}},
+    {"shoot", 200, {"--max-time", "0.3", "--quiet", "--size", "64x64"}},
+    {"drop", 100, {"--max-time", "0.3", "--size", "64x64", NULL}},
     {"film", 100, {"--max-time", "0.3", NULL}},
     {NULL, 100, {NULL}}, /* default */
 };

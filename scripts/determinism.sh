@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Same command, same bytes: runs a set of commands with every build given
+# (e.g. build build-asan) and with 1 and 2 OpenMP threads, and compares the
+# web files (and other text outputs) they write. One JSON line per command;
+# fails if any output differs. Used by `make determinism`; results and what
+# may differ across compilers are in docs/determinism.md.
+#   scripts/determinism.sh BUILD_DIR... (each holding a built `spinneret`)
+set -u
+[ $# -ge 1 ] || { echo "usage: $0 BUILD_DIR..." >&2; exit 2; }
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+first=$1/spinneret
+# A web above the parallel threshold (32768 particles), so 2 threads really split the loops.
+"$first" export scene:orb:200x200 -o "$T/big.json" || exit 1
+"$first" export scene:orb:12x16 -o "$T/small.json" || exit 1
+DATA=$(cd "$(dirname "$0")/.." && pwd)/tests/data
+
+commands=(
+  "settle $T/big.json -o OUT.json --solver symplectic --dt 1e-6 --max-time 1e-5"
+  "settle $T/big.json -o OUT.json --solver rk4 --dt 1e-6 --max-time 1e-5"
+  "settle $T/big.json -o OUT.json --solver implicit --dt 1e-4 --max-time 2e-4"
+  "settle $T/small.json -o OUT.json --solver adaptive --dt 1e-4 --max-time 0.01"
+  "settle $T/small.json -o OUT.json --solver implicit --dt 1e-3 --max-time 0.2"
+  "shoot --from 0,1.5,0 --to 3,3,0 -o OUT.json --max-time 1"
+  "drop $DATA/hostile/tetra.obj -o OUT --max-time 0.3"
+  "export $T/small.json -o OUT.obj --tubes 0.001 --dew"
+)
+
+differ=0
+for line in "${commands[@]}"; do
+  sums=()
+  for b in "$@"; do
+    for threads in 1 2; do
+      out=$T/out-$(basename "$b")-$threads
+      rm -rf "$out" "$out".*
+      args=()
+      for w in $line; do case $w in OUT*) args+=("$out${w#OUT}") ;; *) args+=("$w") ;; esac; done
+      OMP_NUM_THREADS=$threads "$b/spinneret" "${args[@]}" >/dev/null 2>"$T/err" ||
+        { echo "determinism: '$line' failed with $b, $threads threads: $(tail -c 300 "$T/err")" >&2; differ=1; continue; }
+      target=$(ls -d "$out"* | head -1)
+      if [ -d "$target" ]; then sum=$(cd "$target" && cat $(ls) | sha256sum | cut -c1-16)
+      else sum=$(sha256sum <"$target" | cut -c1-16); fi
+      sums+=("$(basename "$b"):$threads=$sum")
+    done
+  done
+  distinct=$(printf '%s\n' "${sums[@]}" | sed 's/.*=//' | sort -u | wc -l)
+  [ "$distinct" -eq 1 ] || differ=1
+  printf '{"command":"%s","runs":"%s","identical":%s}\n' "${line//$T\//}" "${sums[*]}" \
+    "$([ "$distinct" -eq 1 ] && echo true || echo false)"
+done
+exit $differ
