@@ -6,6 +6,9 @@
 #   make demo     build and write the showcase into out/
 #   make bench    run the benchmarks, write bench/results/<machine>.json
 #   make fuzz     run every libFuzzer harness FUZZ_SECONDS each (default 60; build-fuzz/)
+#   make test-valgrind  the suite under valgrind memcheck (build/; not in CI: see docs/hostile-input.md)
+#   make soak     a long run of a 20,000-particle web, SOAK_SECONDS (default 600); not in CI
+#   make determinism  same bytes from build/ and build-asan/ with 1 and 2 threads
 #   make install  install into PREFIX (default /usr/local)
 
 PREFIX ?= /usr/local
@@ -18,7 +21,8 @@ DEPS := cmake pkg-config gcc make libcmocka-dev libcairo2-dev libcjson-dev fonts
         libassimp-dev libglfw3-dev libgl-dev libgl1-mesa-dri xvfb xauth ffmpeg povray clang libclang-rt-14-dev
 BENCH_DEPS := libbullet-dev g++ libsuitesparse-dev
 
-.PHONY: all deps deps-bench build test test-fast test-asan fuzz fuzz-build demo bench install clean
+.PHONY: all deps deps-bench build test test-fast test-asan fuzz fuzz-build demo bench install clean \
+        test-valgrind soak determinism
 
 FUZZ_SECONDS ?= 60
 
@@ -58,6 +62,17 @@ fuzz: fuzz-build
 # The suite, the sanitizer run, and a short fuzzing pass so regressions surface.
 test: test-fast test-asan
 	$(MAKE) fuzz FUZZ_SECONDS=$(if $(CI),5,3)
+
+test-valgrind: build
+	@command -v valgrind >/dev/null || scripts/install-deps.sh valgrind
+	scripts/valgrind.sh build
+
+soak: build
+	SOAK_SECONDS=$(or $(SOAK_SECONDS),600) scripts/soak.sh build
+
+determinism: build build-asan/CMakeCache.txt
+	cmake --build build-asan -j $(JOBS)
+	scripts/determinism.sh build build-asan
 
 demo: build
 	@scripts/demo.sh build/spinneret out
