@@ -107,7 +107,15 @@ spn_status spn__tri_collider_set_owner(spn_tri_collider *c, uint32_t first, uint
 
 /* ---- the grid ------------------------------------------------------------ */
 
-static int64_t cell_of(const spn_tri_collider *c, double x) { return (int64_t)floor(x / c->cell); }
+/* Clamped into int64's range (a particle thrown to 1e300 made the plain cast
+ * undefined); boxes that far out are few cells wide only in this clamped sense,
+ * and the hash merely bins. */
+static int64_t cell_of(const spn_tri_collider *c, double x)
+{
+    double f = floor(x / c->cell);
+    if (!(f >= -4e18)) return (int64_t)-4e18;
+    return f > 4e18 ? (int64_t)4e18 : (int64_t)f;
+}
 
 static uint32_t bucket(const spn_tri_collider *c, int64_t x, int64_t y, int64_t z)
 {

@@ -175,10 +175,20 @@ static uint32_t cell_hash(int64_t x, int64_t y, int64_t z, uint32_t mask)
     return (uint32_t)(h * 0x9e3779b97f4a7c15ULL >> 32) & mask;
 }
 
+/* A cell coordinate, clamped into int64's range: with a tiny cell (vicinity
+ * 1e-300) the quotient is far beyond it and the plain cast is undefined. The
+ * clamped cells only bin for hashing, so lumping far points costs nothing. */
+static int64_t cell_coord(double q)
+{
+    double f = floor(q);
+    if (!(f >= -4e18)) return (int64_t)-4e18; /* NaN too */
+    return f > 4e18 ? (int64_t)4e18 : (int64_t)f;
+}
+
 static uint32_t point_cell(const point_grid *g, spn_vec3 p, int dx, int dy, int dz)
 {
-    return cell_hash((int64_t)floor(p.x / g->cell) + dx, (int64_t)floor(p.y / g->cell) + dy,
-                     (int64_t)floor(p.z / g->cell) + dz, g->mask);
+    return cell_hash(cell_coord(p.x / g->cell) + dx, cell_coord(p.y / g->cell) + dy, cell_coord(p.z / g->cell) + dz,
+                     g->mask);
 }
 
 static bool point_grid_build(point_grid *g, const spn_mesh *m, double cell)
