@@ -105,7 +105,8 @@ spn_status view_screenshot(view_state *v, const char *path);
 spn_status view_load_background(view_state *v, const char *path);
 
 /* view_world.c */
-spn_status view_open_file(view_state *v, const char *path);
+/* Open a web file, mesh or scene:NAME; 0, or an exit code after printing why. */
+int view_open_file(view_state *v, const char *spec);
 
 /* view_input.c */
 void view_install_callbacks(view_state *v);

@@ -185,12 +185,10 @@ int spn_view_main(int argc, char **argv)
     glfwGetFramebufferSize(v->win, &v->fb_w, &v->fb_h);
 
     int code = 0;
-    spn_status st = SPN_OK;
-    if (v->opt.background) st = view_load_background(v, v->opt.background);
-    if (st == SPN_OK && v->opt.file) st = view_open_file(v, v->opt.file);
-    if (st != SPN_OK) {
+    if (v->opt.background && view_load_background(v, v->opt.background) != SPN_OK)
         code = cli_fail("view", "%s", spn_last_error());
-    } else {
+    if (code == 0 && v->opt.file) code = view_open_file(v, v->opt.file);
+    if (code == 0) {
         if (!v->world) view_frame_camera(v);
         run_loop(v);
         if (v->opt.screenshot) {
