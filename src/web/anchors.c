@@ -22,6 +22,14 @@ spn_status spn_web_check_anchors(const spn_vec3 *anchors, int count)
         for (int j = i + 1; j < count; j++)
             if (spn_v3_len(spn_v3_sub(anchors[i], anchors[j])) < 1e-6 * extent)
                 return spn_error(SPN_ERR_INVALID, "anchors %d and %d are the same point", i + 1, j + 1);
+    for (int i = 0; i < count; i++)
+        for (int j = i + 2; j < count; j++) {
+            if (i == 0 && j == count - 1) continue; /* neighbours around the loop */
+            if (spn__segments_cross(anchors[i], anchors[(i + 1) % count], anchors[j], anchors[(j + 1) % count]))
+                return spn_error(SPN_ERR_INVALID,
+                                 "anchors: frame side %d-%d crosses side %d-%d; give the anchors in order around the web",
+                                 i + 1, i + 2, j + 1, (j + 1) % count + 1);
+        }
     double area = 0;
     for (int i = 0; i < count; i++) {
         spn_vec3 a = anchors[i], b = anchors[(i + 1) % count];
@@ -32,13 +40,5 @@ spn_status spn_web_check_anchors(const spn_vec3 *anchors, int count)
         if (fabs(spn__cross2(anchors[0], anchors[1], anchors[i])) > 1e-6 * extent * extent) collinear = false;
     if (collinear || fabs(area) / 2 < 1e-4 * extent * extent)
         return spn_error(SPN_ERR_INVALID, "anchors: all on one line (the web needs an area in the x-y plane)");
-    for (int i = 0; i < count; i++)
-        for (int j = i + 2; j < count; j++) {
-            if (i == 0 && j == count - 1) continue; /* neighbours around the loop */
-            if (spn__segments_cross(anchors[i], anchors[(i + 1) % count], anchors[j], anchors[(j + 1) % count]))
-                return spn_error(SPN_ERR_INVALID,
-                                 "anchors: frame side %d-%d crosses side %d-%d; give the anchors in order around the web",
-                                 i + 1, i + 2, j + 1, (j + 1) % count + 1);
-        }
     return SPN_OK;
 }

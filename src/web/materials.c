@@ -6,7 +6,7 @@
  * 1e-8 N s/m per particle. As materials (k = EA / r, particle mass = density
  * * r for a chain's inner particle) that is EA = k r and density = 1e-8 kg / r,
  * so the thesis' own lengths give back exactly its k and masses. The thesis
- * gives no values for the spiral; it gets a tenth of the spokes' stiffness so
+ * gives no values for the spiral; it gets 3% of the spokes' stiffness so
  * that its pull does not bend the spokes (capture silk is the compliant one).
  *
  * Silk (docs/species.md has the sources): major ampullate (dragline) silk,
@@ -59,7 +59,9 @@ spn_web_materials spn_web_materials_preset(spn_material_preset preset)
     m.kind[SPN_THREAD_FRAME] = mat(stiffer * 0.001 * 0.015, heavier * particle / 0.015, 3e-6, zeta);
     /* The hub ring gathers every secondary spoke: it is many strands thick. */
     m.kind[SPN_THREAD_HUB] = mat(50 * 0.01 * 0.003, 5 * particle / 0.003, 4e-6, zeta);
-    m.kind[SPN_THREAD_CAPTURE] = m.kind[SPN_THREAD_AUX_SPIRAL] = mat(0.001 * 0.003, particle / 0.003, 1.5e-6, zeta);
+    /* The thesis gives every particle 10 ug, and the spiral adds no particles
+     * (it joins spoke masses), so its threads carry almost no mass of their own. */
+    m.kind[SPN_THREAD_CAPTURE] = m.kind[SPN_THREAD_AUX_SPIRAL] = mat(0.0003 * 0.003, 0.05 * particle / 0.003, 1.5e-6, zeta);
     return m;
 }
 

@@ -219,7 +219,9 @@ spn_status spn__layout_weave(const spn__layout *l, spn__weaver *wv, double segme
             uint32_t a = pid[ln->idx[j - 1]], b = pid[p];
             double d = spn_v3_len(spn_v3_sub(l->pt[ln->idx[j - 1]], l->pt[p]));
             if (!(d > 1e-9)) continue;
-            int n = (int)ceil(d / segment);
+            /* The auxiliary spiral is temporary: one spring per piece, so that
+             * removing it leaves no particles hanging in the air. */
+            int n = ln->kind == SPN_THREAD_AUX_SPIRAL ? 1 : (int)ceil(d / segment);
             spn__chain(wv, a, b, n, d / n / (1 + pre), ln->kind, ln->stage, SPN_PARTICLE_GENERIC, NULL);
         }
     }
