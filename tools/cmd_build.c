@@ -27,6 +27,7 @@ static void usage(FILE *out)
             "  --settle-time S                 at most S simulated seconds (default 30)\n"
             "  --frames DIR                    write PNG frames of the construction into DIR\n"
             "  --frame-count N                 frames of the construction (default 60)\n"
+            "  --png FILE                      also render the finished web (PNG, SVG or PDF)\n"
             "  -o, --output FILE               the web file to write\n\n"
             "physical (thesis values; 1 thesis unit = 1 mm):\n"
             "  --move-outer M (0.06)  --outer-placement M (0.005)  --outer-rest M (0.002)\n"
@@ -46,7 +47,7 @@ static void usage(FILE *out)
 typedef struct opts {
     spn_vec3 anchors[SPN_WEB_MAX_ANCHORS];
     int anchor_count;
-    const char *method, *species, *preset, *output, *frames;
+    const char *method, *species, *preset, *output, *frames, *png;
     uint64_t seed;
     bool settle, keep_aux;
     double settle_time;
@@ -78,7 +79,7 @@ static bool parse_anchors(const char *text, opts *o)
 }
 
 enum { O_ANCHORS = 256, O_METHOD, O_SPECIES, O_PRESET, O_SEED, O_SETTLE, O_SETTLE_TIME, O_FRAMES, O_FRAME_COUNT,
-       O_PROVOT, O_KEEP_AUX, O_NUM };
+       O_PROVOT, O_KEEP_AUX, O_PNG, O_NUM };
 
 /* Numeric options: name, where it goes, range. */
 typedef struct num_opt {
@@ -139,7 +140,7 @@ static int parse(int argc, char **argv, opts *o)
         {"seed", required_argument, NULL, O_SEED},       {"settle", no_argument, NULL, O_SETTLE},
         {"settle-time", required_argument, NULL, O_SETTLE_TIME}, {"frames", required_argument, NULL, O_FRAMES},
         {"frame-count", required_argument, NULL, O_FRAME_COUNT}, {"provot", required_argument, NULL, O_PROVOT},
-        {"keep-aux", no_argument, NULL, O_KEEP_AUX},     {"output", required_argument, NULL, 'o'},
+        {"keep-aux", no_argument, NULL, O_KEEP_AUX},     {"png", required_argument, NULL, O_PNG},     {"output", required_argument, NULL, 'o'},
         {"help", no_argument, NULL, 'h'}};
     for (size_t i = 0; i < sizeof fixed / sizeof fixed[0]; i++) lo[k++] = fixed[i];
     for (size_t i = 0; i < NNUM; i++) lo[k++] = (struct option){nums[i].name, required_argument, NULL, O_NUM + (int)i};
@@ -163,6 +164,7 @@ static int parse(int argc, char **argv, opts *o)
             o->phys.provot = true;
             break;
         case O_KEEP_AUX: o->keep_aux = true; break;
+        case O_PNG: o->png = optarg; break;
         case ':': return cli_usage(CMD, "option '%s' needs a value", argv[optind - 1]);
         case '?': return cli_usage(CMD, "unknown option '%s'", argv[optind - 1]);
         default:
@@ -298,6 +300,11 @@ int cmd_build(int argc, char **argv)
                 rep.reason == SPN_SETTLE_CONVERGED ? "to rest" : "(time out)", rep.time, rep.residual);
     }
     if (o.frames) st = write_frames(w, o.frames, (int)o.frame_count);
+    if (st == SPN_OK && o.png) {
+        spn_render_def rd = spn_render_def_default();
+        rd.width = rd.height = 1000;
+        st = spn_render_file(w, &rd, o.png);
+    }
     if (st == SPN_OK) st = spn_web_save(w, o.output);
     spn_world_destroy(w);
     return st == SPN_OK ? 0 : cli_fail(CMD, "%s", spn_last_error());
