@@ -95,6 +95,27 @@ static void test_ranges(void **state)
     }
 }
 
+/* The crossing check itself finds a crossing (so a pass above means something). */
+static void test_checker_sees_crossings(void **state)
+{
+    (void)state;
+    spn_world *w = spn_world_create(NULL);
+    const spn_vec3 pts[4] = {{0, 0, 0}, {1, 1, 0}, {1, 0, 0}, {0, 1, 0}};
+    for (int i = 0; i < 4; i++) {
+        spn_particle_def p = spn_particle_def_default();
+        p.position = pts[i];
+        p.fixed = true;
+        assert_int_equal(spn_world_add_particle(w, &p, NULL), SPN_OK);
+    }
+    for (uint32_t i = 0; i < 4; i += 2) {
+        spn_spring_def s = spn_spring_def_default();
+        s.a = i, s.b = i + 1, s.k = 1, s.tag = SPN_THREAD_CAPTURE;
+        assert_int_equal(spn_world_add_spring(w, &s, NULL), SPN_OK);
+    }
+    assert_int_equal(web_crossings(w, SPN_THREAD_CAPTURE, SPN_THREAD_CAPTURE), 1);
+    spn_world_destroy(w);
+}
+
 static void test_bad_anchors(void **state)
 {
     (void)state;
@@ -153,7 +174,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_structure), cmocka_unit_test(test_contraction_pulls_frame_to_g),
         cmocka_unit_test(test_ranges),    cmocka_unit_test(test_bad_anchors),
-        cmocka_unit_test(test_species_ranges),
+        cmocka_unit_test(test_species_ranges),  cmocka_unit_test(test_checker_sees_crossings),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -41,29 +41,68 @@ static inline bool seg_cross(spn_vec3 a, spn_vec3 b, spn_vec3 c, spn_vec3 d)
     return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
 }
 
-/* Pairs of springs of kind `a` and kind `b` that cross away from their ends. */
+/* Pairs of springs of kind `ka` and kind `kb` that cross away from their
+ * ends. Springs of kind kb are binned on a grid so the check stays linear. */
 static inline int web_crossings(const spn_world *w, uint32_t ka, uint32_t kb)
 {
+    enum { G = 64 };
     uint32_t ns = spn_world_spring_count(w);
-    uint32_t *ia = malloc(ns * sizeof *ia), *ib = malloc(ns * sizeof *ib), na = 0, nb = 0;
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (uint32_t i = 0; i < spn_world_particle_count(w); i++) {
+        spn_vec3 p = spn_world_position(w, i);
+        lo[0] = fmin(lo[0], p.x), lo[1] = fmin(lo[1], p.y), hi[0] = fmax(hi[0], p.x), hi[1] = fmax(hi[1], p.y);
+    }
+    double cw = (hi[0] - lo[0]) / G + 1e-12, ch = (hi[1] - lo[1]) / G + 1e-12;
+    uint32_t *count = calloc(G * G + 1, sizeof *count), *start, *items;
+#define CELLS(S, ...)                                                                                    \
+    do {                                                                                                 \
+        spn_vec3 pa_ = spn_world_position(w, (S).a), pb_ = spn_world_position(w, (S).b);                \
+        int x0 = (int)((fmin(pa_.x, pb_.x) - lo[0]) / cw), x1 = (int)((fmax(pa_.x, pb_.x) - lo[0]) / cw); \
+        int y0 = (int)((fmin(pa_.y, pb_.y) - lo[1]) / ch), y1 = (int)((fmax(pa_.y, pb_.y) - lo[1]) / ch); \
+        if (x1 >= G) x1 = G - 1;                                                                         \
+        if (y1 >= G) y1 = G - 1;                                                                         \
+        for (int cy = y0; cy <= y1; cy++)                                                                \
+            for (int cx = x0; cx <= x1; cx++) {                                                          \
+                int cell = cy * G + cx;                                                                  \
+                __VA_ARGS__;                                                                              \
+            }                                                                                            \
+    } while (0)
     for (uint32_t s = 0; s < ns; s++) {
-        uint32_t t = spn_world_spring(w, s).tag;
-        if (t == ka) ia[na++] = s;
-        if (t == kb) ib[nb++] = s;
+        spn_spring_info si = spn_world_spring(w, s);
+        if (si.tag == kb) CELLS(si, count[cell + 1]++);
+    }
+    for (int c = 0; c < G * G; c++) count[c + 1] += count[c];
+    start = malloc((G * G + 1) * sizeof *start);
+    memcpy(start, count, (G * G + 1) * sizeof *start);
+    items = malloc((count[G * G] + 1) * sizeof *items);
+    for (uint32_t s = 0; s < ns; s++) {
+        spn_spring_info si = spn_world_spring(w, s);
+        if (si.tag == kb) CELLS(si, items[start[cell]++] = s);
     }
     int n = 0;
-    for (uint32_t i = 0; i < na; i++) {
-        spn_spring_info p = spn_world_spring(w, ia[i]);
+    for (uint32_t s = 0; s < ns; s++) {
+        spn_spring_info p = spn_world_spring(w, s);
+        if (p.tag != ka) continue;
         spn_vec3 a = spn_world_position(w, p.a), b = spn_world_position(w, p.b);
-        for (uint32_t j = 0; j < nb; j++) {
-            if (ka == kb && ib[j] <= ia[i]) continue;
-            spn_spring_info q = spn_world_spring(w, ib[j]);
-            if (q.a == p.a || q.a == p.b || q.b == p.a || q.b == p.b) continue;
-            if (seg_cross(a, b, spn_world_position(w, q.a), spn_world_position(w, q.b))) n++;
-        }
+        CELLS(p, {
+            for (uint32_t k = count[cell]; k < count[cell + 1]; k++) {
+                uint32_t q_id = items[k];
+                if (ka == kb && q_id <= s) continue;
+                spn_spring_info q = spn_world_spring(w, q_id);
+                if (q.a == p.a || q.a == p.b || q.b == p.a || q.b == p.b) continue;
+                /* A pair sharing several cells is counted once: in the first shared cell. */
+                spn_vec3 c = spn_world_position(w, q.a), d = spn_world_position(w, q.b);
+                int qx = (int)((fmin(c.x, d.x) - lo[0]) / cw), qy = (int)((fmin(c.y, d.y) - lo[1]) / ch);
+                int px = (int)((fmin(a.x, b.x) - lo[0]) / cw), py = (int)((fmin(a.y, b.y) - lo[1]) / ch);
+                if (cx != (qx > px ? qx : px) || cy != (qy > py ? qy : py)) continue;
+                if (seg_cross(a, b, c, d)) n++;
+            }
+        });
     }
-    free(ia);
-    free(ib);
+#undef CELLS
+    free(count);
+    free(start);
+    free(items);
     return n;
 }
 

@@ -202,7 +202,7 @@ static spn_status build(opts *o, spn_world **w)
         o->sp.materials = mat;
         o->sp.anchors = anchors;
         o->sp.anchor_count = o->anchor_count;
-        o->sp.keep_aux_spiral = o->keep_aux;
+        o->sp.keep_aux_spiral = o->keep_aux || o->frames; /* the animation shows it go */
         return spn_web_build_species(&o->sp, w);
     }
     if (!anchors) return spn_error(SPN_ERR_INVALID, "--anchors: needed with --method (at least 3)");
@@ -225,7 +225,7 @@ static spn_status write_frames(const spn_world *w, const char *dir, int count)
 {
     spn_render_def rd = spn_render_def_default();
     rd.width = rd.height = 800;
-    uint32_t np = spn_world_particle_count(w), ns = spn_world_spring_count(w);
+    uint32_t np = spn_world_particle_count(w);
     spn_vec3 lo = spn_world_position(w, 0), hi = lo;
     for (uint32_t i = 0; i < np; i++) {
         spn_vec3 p = spn_world_position(w, i);
@@ -235,21 +235,12 @@ static spn_status write_frames(const spn_world *w, const char *dir, int count)
     rd.camera.fixed_bounds = true;
     rd.camera.bounds_min = lo;
     rd.camera.bounds_max = hi;
-    uint32_t last = 0;
-    for (uint32_t s = 0; s < ns; s++) last = fmax(last, spn_world_spring(w, s).order);
     uint8_t *rgba = malloc((size_t)rd.width * (size_t)rd.height * 4);
-    bool *rm = malloc((ns ? ns : 1) * sizeof *rm);
     spn_frames *fr = NULL;
-    spn_status st = rgba && rm ? spn_frames_open(dir, rd.width, rd.height, 24, &fr) : SPN_ERR_NOMEM;
+    spn_status st = rgba ? spn_frames_open(dir, rd.width, rd.height, 24, &fr) : SPN_ERR_NOMEM;
     for (int f = 1; f <= count && st == SPN_OK; f++) {
-        double cut = (double)(last + 1) * f / count;
-        spn_world *part = spn_world_clone(w);
-        if (!part) {
-            st = spn_error(SPN_ERR_NOMEM, "out of memory");
-            break;
-        }
-        for (uint32_t s = 0; s < ns; s++) rm[s] = spn_world_spring(w, s).order >= cut;
-        st = spn_world_remove_springs(part, rm);
+        spn_world *part = NULL;
+        st = spn_web_construction_state(w, (double)f / count, &part);
         if (st == SPN_OK) st = spn_render_rgba(part, &rd, rgba);
         if (st == SPN_OK) st = spn_frames_add(fr, rgba);
         spn_world_destroy(part);
@@ -259,6 +250,16 @@ static spn_status write_frames(const spn_world *w, const char *dir, int count)
         if (st == SPN_OK) st = cs;
     }
     free(rgba);
+    return st;
+}
+
+static spn_status drop_aux(spn_world *w)
+{
+    uint32_t ns = spn_world_spring_count(w);
+    bool *rm = malloc((ns ? ns : 1) * sizeof *rm);
+    if (!rm) return spn_error(SPN_ERR_NOMEM, "out of memory");
+    for (uint32_t s = 0; s < ns; s++) rm[s] = spn_world_spring(w, s).tag == SPN_THREAD_AUX_SPIRAL;
+    spn_status st = spn_world_remove_springs(w, rm);
     free(rm);
     return st;
 }
@@ -300,6 +301,7 @@ int cmd_build(int argc, char **argv)
                 rep.reason == SPN_SETTLE_CONVERGED ? "to rest" : "(time out)", rep.time, rep.residual);
     }
     if (o.frames) st = write_frames(w, o.frames, (int)o.frame_count);
+    if (st == SPN_OK && o.frames && !o.keep_aux) st = drop_aux(w);
     if (st == SPN_OK && o.png) {
         spn_render_def rd = spn_render_def_default();
         rd.width = rd.height = 1000;

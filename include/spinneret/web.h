@@ -203,6 +203,13 @@ SPN_API spn_status spn_web_check_anchors(const spn_vec3 *anchors, int count);
 /// web's own weight. At most `max_time` simulated seconds.
 SPN_API spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *report);
 
+/// The web as it stood when `fraction` (0..1) of its springs, in construction
+/// order, had been laid: a new world holding those springs. The auxiliary
+/// spiral is taken away as the capture spiral passes it (the spider eats it
+/// as it goes), so a web built with keep_aux_spiral animates as a spider
+/// builds. For building animations (`spinneret build --frames`).
+SPN_API spn_status spn_web_construction_state(const spn_world *w, double fraction, spn_world **out);
+
 /* ==== Web measures ======================================================= */
 
 /// What `spinneret info` reports for a web. Lengths in metres, areas m^2.

@@ -203,7 +203,10 @@ static void lay_spiral(sweb *w, double from, double to, gap_fn gap, double scale
                 if (!p) break;
                 run = p;
             }
-            run[n++] = point_on(w, r, rho, SPN_PARTICLE_SPIRAL);
+            /* A little irregularity per crossing, as a spider's legs measure it;
+             * well under half a gap, so turns keep their order on every radius. */
+            double wobble = 0.12 * w->d->jitter / 0.08 * gap(w, rho) * spn_rng_range(&w->rng, -1, 1);
+            run[n++] = point_on(w, r, rho + wobble, SPN_PARTICLE_SPIRAL);
             if (kind == SPN_THREAD_CAPTURE) w->capon[r]++;
         }
         if (!fits || open_between(w, r)) {
@@ -278,6 +281,34 @@ static void lay_stabilimentum(sweb *w, double toward)
     free(zz);
 }
 
+/* Frame threads pulled in by the radii curve smoothly toward the hub (the
+ * contraction of the Japanese thesis, sec. 3.4): each side and arch becomes a
+ * parabola whose middle has moved `contraction` of the way toward G. The
+ * thesis' jittered radius ends are kept for the geometric method, where
+ * radii end there; here radii end where they meet the curve. */
+static void smooth_line(spn_vec3 *pts, int *count, int want, spn_vec3 g, double sag_fraction)
+{
+    spn_vec3 a = pts[0], b = pts[*count - 1], mid = spn__lerp(a, b, 0.5);
+    spn_vec3 chord = spn_v3_norm(spn_v3_sub(b, a)), in = spn_v3_sub(g, mid);
+    in = spn_v3_sub(in, spn_v3_scale(chord, spn_v3_dot(in, chord)));
+    double sag = sag_fraction * spn_v3_len(in);
+    in = spn_v3_norm(in);
+    for (int k = 0; k < want; k++) {
+        double u = (double)k / (want - 1);
+        pts[k] = spn_v3_add(spn__lerp(a, b, u), spn_v3_scale(in, 4 * u * (1 - u) * sag));
+    }
+    *count = want;
+}
+
+static void smooth_frame(sweb *w)
+{
+    double m = w->d->contraction;
+    for (int i = 0; i < w->f.n; i++) {
+        smooth_line(w->f.side[i], &w->f.ns[i], 12, w->f.g, 0.6 * m);
+        smooth_line(w->f.arch[i], &w->f.na[i], 6, w->f.g, 0.5 * m);
+    }
+}
+
 static spn_status check_def(const spn_species_def *d)
 {
     if (d->anchors) {
@@ -348,6 +379,7 @@ spn_status spn_web_build_species(const spn_species_def *def, spn_world **out)
     }
     spn__geo_params gp = {0.15, 0.28, 0.3, 0.7, def->contraction, 3, 8};
     spn__geo_frame_make(anchors, count, &gp, &w->rng, &w->f);
+    smooth_frame(w);
     weave(w);
     double pre[SPN_WEB_KINDS];
     for (int k = 0; k < SPN_WEB_KINDS; k++) pre[k] = def->prestrain;
