@@ -144,9 +144,10 @@ static void test_species_ranges(void **state)
     const struct {
         spn_species sp;
         int rmin, rmax;
+        int tmin, tmax; /* capture turns below the hub */
         int seeds;
-    } cases[] = {{SPN_SPECIES_ARANEUS, 25, 35, 20}, {SPN_SPECIES_ZYGIELLA, 24, 32, 20},
-                 {SPN_SPECIES_ZILLA, 33, 43, 5},    {SPN_SPECIES_ARGIOPE, 28, 36, 5}};
+    } cases[] = {{SPN_SPECIES_ARANEUS, 25, 35, 20, 50, 20}, {SPN_SPECIES_ZYGIELLA, 24, 32, 25, 60, 20},
+                 {SPN_SPECIES_ZILLA, 33, 43, 30, 65, 5},    {SPN_SPECIES_ARGIOPE, 28, 36, 30, 70, 5}};
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++)
         for (int seed = 1; seed <= cases[c].seeds; seed++) {
             spn_species_def d = spn_species_def_preset(cases[c].sp);
@@ -159,6 +160,7 @@ static void test_species_ranges(void **state)
             assert_true(radii >= cases[c].rmin && radii <= cases[c].rmax);
             assert_true(m.asymmetry > 0.3 && m.asymmetry < 1.0); /* larger below the hub */
             assert_true(m.turns_below > m.turns_above);
+            assert_true(m.turns_below >= cases[c].tmin && m.turns_below <= cases[c].tmax);
             assert_true(m.mesh_outer >= m.mesh_inner * 0.9);
             assert_true(web_all_anchored(w));
             assert_int_equal(web_crossings(w, SPN_THREAD_CAPTURE, SPN_THREAD_CAPTURE), 0);

@@ -194,12 +194,32 @@ static void test_same_seed_same_web(void **state)
     spn_world_destroy(b);
 }
 
+/* The alternative the thesis compared: strands laid at rest, Provot limit on. */
+static void test_provot_lays_at_rest(void **state)
+{
+    (void)state;
+    spn_physical_def d = spn_physical_def_default();
+    d.anchors = square;
+    d.anchor_count = 4;
+    d.move_outer = 0.03;
+    d.provot = true;
+    d.provot_max_strain = 0.05;
+    spn_world *w = NULL;
+    assert_int_equal(spn_web_build_physical(&d, &w), SPN_OK);
+    assert_true(fabs(spn_world_get_def(w)->provot_max_strain - 0.05) < 1e-12);
+    for (uint32_t s = 0; s < spn_world_spring_count(w); s++) {
+        spn_spring_info si = spn_world_spring(w, s);
+        assert_true(fabs(si.length - si.rest) < 1e-9 * si.rest + 1e-12);
+    }
+    spn_world_destroy(w);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_structure),       cmocka_unit_test(test_settles_taut),
         cmocka_unit_test(test_spiral_table),    cmocka_unit_test(test_spoke_table),
-        cmocka_unit_test(test_same_seed_same_web),
+        cmocka_unit_test(test_same_seed_same_web), cmocka_unit_test(test_provot_lays_at_rest),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -41,6 +41,7 @@ static void usage(FILE *out)
             "  --segment M (0.01)  --prestrain F (0.02)  --capture-prestrain F (0.3)\n\n"
             "species (the preset's values unless given):\n"
             "  --size M  --radii N  --mesh-inner M  --mesh-outer M  --hub-offset F  --contraction F\n"
+            "  --hub-radius M  --free-zone M  --jitter F (natural variation)  --margin M\n"
             "  --keep-aux             keep the auxiliary spiral (normally removed)\n");
 }
 
@@ -55,7 +56,6 @@ typedef struct opts {
     spn_physical_def phys;
     spn_geometric_def geo;
     spn_species_def sp;
-    bool sp_set[8];
 } opts;
 
 static bool parse_anchors(const char *text, opts *o)
@@ -109,7 +109,13 @@ static const num_opt nums[] = {
     {"size", S(size), false, 0.02, 5},                      {"radii", S(radii), true, 6, 200},
     {"mesh-inner", S(mesh_inner), false, 1e-4, 0.1},        {"mesh-outer", S(mesh_outer), false, 1e-4, 0.1},
     {"hub-offset", S(hub_offset), false, -0.3, 0.3},        {"contraction", S(contraction), false, 0, 0.6},
+    {"jitter", S(jitter), false, 0, 0.3},                   {"margin", S(margin), false, 0, 0.1},
 };
+/* Options both the physical builder and the species presets take. */
+static const struct {
+    const char *name;
+    size_t species_offset;
+} shared[] = {{"hub-radius", offsetof(spn_species_def, hub_radius)}, {"free-zone", offsetof(spn_species_def, free_zone)}};
 #define NNUM (sizeof nums / sizeof nums[0])
 
 static bool set_num(opts *o, const num_opt *n, const char *text)
@@ -126,7 +132,8 @@ static bool set_num(opts *o, const num_opt *n, const char *text)
         if (!cli_double(CMD, name, text, n->lo, n->hi, &v)) return false;
         *(double *)(base + n->offset) = v;
     }
-    if (n->which == 2) o->sp_set[0] = true;
+    for (size_t i = 0; i < sizeof shared / sizeof shared[0]; i++)
+        if (strcmp(shared[i].name, n->name) == 0) *(double *)((char *)&o->sp + shared[i].species_offset) = *(double *)(base + n->offset);
     return true;
 }
 

@@ -176,6 +176,16 @@ spn_status spn_web_measure(spn_world *w, spn_web_measures *m)
     mesh_widths(ys, n, m);
     free(ys);
     capture_extent(w, m->hub, m);
+    /* The free zone is the gap between the hub (its mesh or ring) and the
+     * innermost capture turn, not the distance from the hub's centre. */
+    double hub_reach = 0;
+    for (uint32_t s = 0; s < ns; s++) {
+        spn_spring_info si = spn_world_spring(w, s);
+        if (si.tag != SPN_THREAD_HUB) continue;
+        hub_reach = fmax(hub_reach, fmax(spn_v3_len(spn_v3_sub(spn_world_position(w, si.a), m->hub)),
+                                         spn_v3_len(spn_v3_sub(spn_world_position(w, si.b), m->hub))));
+    }
+    if (m->free_zone > 0) m->free_zone = fmax(0, m->free_zone - hub_reach);
     m->max_residual = np ? spn_world_max_residual(w, NULL) : 0;
     return SPN_OK;
 }

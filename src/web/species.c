@@ -47,13 +47,13 @@ spn_species_def spn_species_def_preset(spn_species species)
     d.world = spn_world_def_default();
     switch (species) {
     case SPN_SPECIES_ARANEUS: /* Witt et al. 1968; Zschokke 2011; Herberstein & Heiling 1999 */
-        d.size = 0.32;
+        d.size = 0.26;
         d.radii = 30;
         d.hub_radius = 0.012;
         d.free_zone = 0.015;
-        d.mesh_inner = 0.0025;
-        d.mesh_outer = 0.0045;
-        d.hub_offset = 0.12;
+        d.mesh_inner = 0.0030;
+        d.mesh_outer = 0.0050;
+        d.hub_offset = 0.09;
         break;
     case SPN_SPECIES_ZILLA: /* Mehla 2005 fig. 3.4; Jones 1978 (BAS newsletter 21) */
         d.size = 0.20;
