@@ -50,7 +50,7 @@ typedef struct opts {
     int anchor_count;
     const char *method, *species, *preset, *output, *frames, *png;
     uint64_t seed;
-    bool settle, keep_aux;
+    bool settle, keep_aux, silk;
     double settle_time;
     long frame_count;
     spn_physical_def phys;
@@ -202,6 +202,7 @@ static spn_status build(opts *o, spn_world **w)
     if (!o->species && !o->method) physical = true;
     if (!o->preset) preset = physical ? SPN_MATERIAL_THESIS : SPN_MATERIAL_SILK;
     else if (spn_material_preset_parse(o->preset, &preset) != SPN_OK) return SPN_ERR_INVALID;
+    o->silk = preset == SPN_MATERIAL_SILK;
     spn_web_materials mat = spn_web_materials_preset(preset);
     const spn_vec3 *anchors = o->anchor_count ? o->anchors : NULL;
     if (o->species && !o->method) {
@@ -298,7 +299,8 @@ int cmd_build(int argc, char **argv)
     if (st != SPN_OK) return cli_fail_status(CMD, st);
     if (o.settle) {
         spn_settle_report rep;
-        if (o.preset && strcmp(o.preset, "silk") == 0) spn_world_set_integrator(w, SPN_INTEGRATOR_IMPLICIT);
+        /* Silk is far too stiff for explicit steps (DESIGN): settle it implicitly. */
+        if (o.silk) spn_world_set_integrator(w, SPN_INTEGRATOR_IMPLICIT);
         st = spn_web_settle(w, o.settle_time, &rep);
         if (st != SPN_OK) {
             spn_world_destroy(w);

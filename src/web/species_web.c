@@ -96,6 +96,11 @@ static void add_on(sweb *w, int r, double rho, uint32_t id)
 
 static uint32_t point_on(sweb *w, int r, double rho, uint32_t tag)
 {
+    /* Threads meeting a radius almost at one place share the junction: a
+     * segment of a few micrometres of dragline would be stiffer than the rest
+     * of the web by orders of magnitude and stall any solver. */
+    for (int k = 0; k < w->non[r]; k++)
+        if (fabs(w->on[r][k].rho - rho) < 0.25 * w->d->mesh_inner) return w->on[r][k].id;
     uint32_t id = spn__lay_point(&w->l, spn_v3_add(w->hub, spn_v3_scale(w->dir[r], rho)), tag, false);
     add_on(w, r, rho, id);
     return id;
@@ -384,6 +389,12 @@ spn_status spn_web_build_species(const spn_species_def *def, spn_world **out)
     double pre[SPN_WEB_KINDS];
     for (int k = 0; k < SPN_WEB_KINDS; k++) pre[k] = def->prestrain;
     pre[SPN_THREAD_CAPTURE] = def->capture_prestrain;
+    /* Frame and mooring threads carry several times the radii's tension
+     * (Wirth & Barth 1992, forces in the orb web of Araneus diadematus); laid
+     * with the radii's strain, the frame would have to stretch far before the
+     * web could balance, and a stiff-silk solver would crawl there. */
+    pre[SPN_THREAD_FRAME] = 4 * def->prestrain;
+    pre[SPN_THREAD_ANCHOR] = 5 * def->prestrain;
     spn__weaver wv;
     spn_world_def wd = def->world;
     wd.seed = def->seed;
