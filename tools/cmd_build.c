@@ -195,6 +195,18 @@ static const char *find_species(int argc, char **argv)
     return NULL;
 }
 
+/* The thesis' 75-250% over-extension is for its soft springs; silk breaks
+ * near 30%. With silk, strands left at the thesis' defaults are laid with a
+ * silk web's pre-strain instead: radii 2%, frame 8%, mooring 10%, spiral 30%. */
+static void silk_strains(spn_physical_def *p)
+{
+    spn_physical_def d = spn_physical_def_default();
+    if (p->outer_rest == d.outer_rest) p->outer_rest = p->outer_placement / 1.10;
+    if (p->frame_rest == d.frame_rest) p->frame_rest = p->frame_placement / 1.08;
+    if (p->spoke_rest == d.spoke_rest) p->spoke_rest = p->spoke_placement / 1.02;
+    if (p->spiral_extension == d.spiral_extension) p->spiral_extension = 0.3;
+}
+
 static spn_status build(opts *o, spn_world **w)
 {
     spn_material_preset preset = SPN_MATERIAL_SILK;
@@ -215,6 +227,7 @@ static spn_status build(opts *o, spn_world **w)
     }
     if (!anchors) return spn_error(SPN_ERR_INVALID, "--anchors: needed with --method (at least 3)");
     if (physical) {
+        if (o->silk) silk_strains(&o->phys);
         o->phys.anchors = anchors;
         o->phys.anchor_count = o->anchor_count;
         o->phys.materials = mat;
