@@ -31,6 +31,7 @@ static void test_structure(void **state)
         assert_true(web_all_anchored(w));
         assert_int_equal(web_crossings(w, SPN_THREAD_CAPTURE, SPN_THREAD_CAPTURE), 0);
         assert_int_equal(web_crossings(w, SPN_THREAD_CAPTURE, SPN_THREAD_RADIUS), 0);
+        assert_int_equal(web_capture_off_neighbours(w), 0);
         spn_web_measures m;
         assert_int_equal(spn_web_measure(w, &m), SPN_OK);
         /* Radii: U in [1, 3] per arch and V in [4, 8] per side. */
@@ -164,6 +165,7 @@ static void test_species_ranges(void **state)
             assert_true(m.mesh_outer >= m.mesh_inner * 0.9);
             assert_true(web_all_anchored(w));
             assert_int_equal(web_crossings(w, SPN_THREAD_CAPTURE, SPN_THREAD_CAPTURE), 0);
+            if (seed <= 3) assert_int_equal(web_capture_off_neighbours(w), 0);
             assert_int_equal(web_count(w, SPN_THREAD_AUX_SPIRAL), 0); /* laid, then removed */
             if (cases[c].sp == SPN_SPECIES_ZYGIELLA) assert_true(web_count(w, SPN_THREAD_SIGNAL) > 0);
             if (cases[c].sp == SPN_SPECIES_ARGIOPE) assert_true(web_count(w, SPN_THREAD_STABILIMENTUM) > 0);

@@ -113,4 +113,80 @@ static inline uint32_t web_count(const spn_world *w, uint32_t kind)
     return n;
 }
 
+/* Capture threads run between neighbouring radii: walk every capture chain
+ * from one radius junction to the next and check that the two radii (found
+ * by angle round the hub particle) are neighbours. Returns the bad pieces. */
+static inline int web_capture_off_neighbours(const spn_world *w)
+{
+    uint32_t np = spn_world_particle_count(w), ns = spn_world_spring_count(w), hub = UINT32_MAX;
+    for (uint32_t i = 0; i < np; i++)
+        if (spn_world_particle_tag(w, i) == SPN_PARTICLE_HUB) hub = i;
+    if (hub == UINT32_MAX) return -1;
+    spn_vec3 h = spn_world_position(w, hub);
+    double *ang = malloc(ns * sizeof *ang);
+    int nr = 0;
+    bool *on_radius = calloc(np, 1);
+    int *cap_deg = calloc(np, sizeof *cap_deg);
+    for (uint32_t s = 0; s < ns; s++) {
+        spn_spring_info si = spn_world_spring(w, s);
+        if (si.tag == SPN_THREAD_RADIUS || si.tag == SPN_THREAD_SIGNAL) {
+            on_radius[si.a] = on_radius[si.b] = true;
+            if (si.a == hub || si.b == hub) {
+                spn_vec3 o = spn_world_position(w, si.a == hub ? si.b : si.a);
+                ang[nr++] = atan2(o.y - h.y, o.x - h.x);
+            }
+        }
+        if (si.tag == SPN_THREAD_CAPTURE) cap_deg[si.a]++, cap_deg[si.b]++;
+    }
+    /* Index of the radius nearest in angle. */
+#define NEAREST(P, OUT)                                                                    \
+    do {                                                                                   \
+        spn_vec3 q_ = spn_world_position(w, (P));                                          \
+        double a_ = atan2(q_.y - h.y, q_.x - h.x), best_ = 10;                             \
+        for (int r_ = 0; r_ < nr; r_++) {                                                  \
+            double d_ = fabs(remainder(a_ - ang[r_], 2 * SPN_PI));                         \
+            if (d_ < best_) best_ = d_, (OUT) = r_;                                        \
+        }                                                                                  \
+    } while (0)
+    /* Sort radii by angle so neighbours are adjacent indices. */
+    for (int a = 1; a < nr; a++)
+        for (int b = a; b > 0 && ang[b] < ang[b - 1]; b--) {
+            double t = ang[b];
+            ang[b] = ang[b - 1], ang[b - 1] = t;
+        }
+    int bad = 0;
+    for (uint32_t s = 0; s < ns; s++) {
+        spn_spring_info si = spn_world_spring(w, s);
+        if (si.tag != SPN_THREAD_CAPTURE || !on_radius[si.a]) continue;
+        /* Walk from the junction si.a through si.b until the next junction. */
+        uint32_t prev = si.a, cur = si.b;
+        int guard = 0;
+        while (!on_radius[cur] && guard++ < 1000) {
+            uint32_t next = UINT32_MAX;
+            for (uint32_t t = 0; t < ns && next == UINT32_MAX; t++) {
+                spn_spring_info ti = spn_world_spring(w, t);
+                if (ti.tag != SPN_THREAD_CAPTURE) continue;
+                if (ti.a == cur && ti.b != prev) next = ti.b;
+                else if (ti.b == cur && ti.a != prev) next = ti.a;
+            }
+            if (next == UINT32_MAX) break;
+            prev = cur, cur = next;
+        }
+        if (!on_radius[cur]) {
+            bad++;
+            continue;
+        }
+        int ra = 0, rb = 0;
+        NEAREST(si.a, ra);
+        NEAREST(cur, rb);
+        int d = abs(ra - rb);
+        if (d != 1 && d != nr - 1) bad++;
+    }
+#undef NEAREST
+    free(ang);
+    free(on_radius);
+    free(cap_deg);
+    return bad;
+}
+
 #endif
