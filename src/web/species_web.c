@@ -372,7 +372,8 @@ spn_status spn_web_build_species(const spn_species_def *def, spn_world **out)
     sweb *w = calloc(1, sizeof *w);
     if (!w) return spn_error(SPN_ERR_NOMEM, "out of memory");
     w->d = def;
-    spn_rng_seed(&w->rng, def->seed);
+    /* Each species draws its own site and variation from the same seed. */
+    spn_rng_seed(&w->rng, def->seed * 0x9E3779B97F4A7C15ull + (uint64_t)def->species);
     spn_vec3 site[8];
     const spn_vec3 *anchors = def->anchors;
     int count = def->anchor_count;
