@@ -9,5 +9,6 @@
 #include "io.h"
 #include "scenes.h"
 #include "render.h"
+#include "export.h"
 
 #endif
