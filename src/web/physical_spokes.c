@@ -141,28 +141,42 @@ static int split_primaries(spn__physical *b, primary *pr, int np, ring_mass *rin
     return nr;
 }
 
-/* Hub strands round the ring; every mass on them can take a secondary spoke. */
-static uint32_t *lay_ring(spn__physical *b, spn__spoke_fn lay, ring_mass *ring, int nr, int *count)
+/* Hub strands round the ring, laid on a circle about the hub with masses a
+ * third of the spoke spacing apart: every mass can take secondary spokes, so
+ * the spokes fan in evenly instead of in a few bundles with gaps between. */
+static uint32_t *lay_ring(spn__physical *b, ring_mass *ring, int nr, int *count)
 {
+    const spn_physical_def *d = b->def;
     qsort(ring, (size_t)nr, sizeof *ring, by_angle);
-    uint32_t *all = NULL;
-    int n = 0;
-    for (int i = 0; i < nr && b->wv.st == SPN_OK; i++) {
-        if (ring[i].id == ring[(i + 1) % nr].id) continue; /* two primaries leave the hub at one mass */
-        int k = 0;
-        uint32_t *ids = lay(b, ring[i].id, ring[(i + 1) % nr].id, SPN_THREAD_HUB, &k);
-        uint32_t *grown = ids ? realloc(all, ((size_t)n + (size_t)k) * sizeof *grown) : NULL;
-        if (!grown) {
-            free(ids);
-            if (b->wv.st == SPN_OK) b->wv.st = spn_error(SPN_ERR_NOMEM, "out of memory");
-            break;
+    double place = d->spoke_placement / 3, ratio = d->provot ? 1 : d->spoke_rest / d->spoke_placement;
+    size_t cap = 64, n = 0;
+    uint32_t *all = malloc(cap * sizeof *all);
+    for (int i = 0; i < nr && all && b->wv.st == SPN_OK; i++) {
+        uint32_t a = ring[i].id, c = ring[(i + 1) % nr].id;
+        if (a == c) continue; /* two primaries leave the hub at one mass */
+        double t0 = ring[i].angle, t1 = ring[(i + 1) % nr].angle;
+        if (t1 <= t0) t1 += 2 * SPN_PI;
+        double r0 = spn_v3_len(spn_v3_sub(pos(b, a), b->hub)), r1 = spn_v3_len(spn_v3_sub(pos(b, c), b->hub));
+        int k = (int)lround((t1 - t0) * 0.5 * (r0 + r1) / place);
+        if (k < 1) k = 1;
+        uint32_t prev = a;
+        for (int j = 1; j <= k && b->wv.st == SPN_OK; j++) {
+            double u = (double)j / k, t = t0 + u * (t1 - t0), r = r0 + u * (r1 - r0);
+            uint32_t cur = j == k ? c : spn__particle(&b->wv, spn_v3_add(b->hub, spn_v3(r * cos(t), r * sin(t), 0)), false,
+                                                     SPN_PARTICLE_HUB);
+            double len = spn_v3_len(spn_v3_sub(pos(b, cur), pos(b, prev)));
+            spn__spring(&b->wv, prev, cur, SPN_THREAD_HUB, SPN_STAGE_RADII, len * ratio);
+            if (n + 1 >= cap) {
+                uint32_t *grown = realloc(all, (cap *= 2) * sizeof *grown);
+                if (!grown) break;
+                all = grown;
+            }
+            all[n++] = prev;
+            prev = cur;
         }
-        all = grown;
-        memcpy(all + n, ids, (size_t)(k - 1) * sizeof *ids); /* the last is the next ring mass */
-        n += k - 1;
-        free(ids);
     }
-    *count = n;
+    if (!all && b->wv.st == SPN_OK) b->wv.st = spn_error(SPN_ERR_NOMEM, "out of memory");
+    *count = (int)n;
     return all;
 }
 
@@ -218,7 +232,7 @@ void spn__physical_spokes(spn__physical *b, spn__spoke_fn lay)
         b->hub = crossing(b, pr, np);
         int nr = split_primaries(b, pr, np, ring);
         int nring = 0;
-        uint32_t *ringids = nr >= 2 ? lay_ring(b, lay, ring, nr, &nring) : NULL;
+        uint32_t *ringids = nr >= 2 ? lay_ring(b, ring, nr, &nring) : NULL;
         if (ringids) lay_secondaries(b, lay, pr, np, ringids, nring);
         free(ringids);
         for (int s = 0; s < b->nspokes; s++) {
