@@ -222,7 +222,7 @@ static spn_status build(opts *o, spn_world **w)
         o->sp.materials = mat;
         o->sp.anchors = anchors;
         o->sp.anchor_count = o->anchor_count;
-        o->sp.keep_aux_spiral = o->keep_aux || o->frames; /* the animation shows it go */
+        o->sp.keep_aux_spiral = o->keep_aux;
         return spn_web_build_species(&o->sp, w);
     }
     if (!anchors) return spn_error(SPN_ERR_INVALID, "--anchors: needed with --method (at least 3)");
@@ -274,17 +274,6 @@ static spn_status write_frames(const spn_world *w, const char *dir, int count)
     return st;
 }
 
-static spn_status drop_aux(spn_world *w)
-{
-    uint32_t ns = spn_world_spring_count(w);
-    bool *rm = malloc((ns ? ns : 1) * sizeof *rm);
-    if (!rm) return spn_error(SPN_ERR_NOMEM, "out of memory");
-    for (uint32_t s = 0; s < ns; s++) rm[s] = spn_world_spring(w, s).tag == SPN_THREAD_AUX_SPIRAL;
-    spn_status st = spn_world_remove_springs(w, rm);
-    free(rm);
-    return st;
-}
-
 int cmd_build(int argc, char **argv)
 {
     if (cli_wants_help(argc, argv)) {
@@ -310,7 +299,18 @@ int cmd_build(int argc, char **argv)
     spn_world *w = NULL;
     spn_status st = build(&o, &w);
     if (st != SPN_OK) return cli_fail_status(CMD, st);
-    if (o.settle) {
+    if (o.frames) {
+        /* The animation shows the auxiliary spiral laid and eaten again, so it
+         * is drawn from the same build with that spiral kept. */
+        bool keep = o.keep_aux;
+        o.keep_aux = true;
+        spn_world *anim = NULL;
+        st = build(&o, &anim);
+        o.keep_aux = keep;
+        if (st == SPN_OK) st = write_frames(anim, o.frames, (int)o.frame_count);
+        spn_world_destroy(anim);
+    }
+    if (st == SPN_OK && o.settle) {
         spn_settle_report rep;
         /* Silk is far too stiff for explicit steps (DESIGN): settle it implicitly. */
         if (o.silk) spn_world_set_integrator(w, SPN_INTEGRATOR_IMPLICIT);
@@ -322,8 +322,6 @@ int cmd_build(int argc, char **argv)
         fprintf(stderr, "spinneret build: settled %s after %.3g s (largest residual %.3g N)\n",
                 rep.reason == SPN_SETTLE_CONVERGED ? "to rest" : "(time out)", rep.time, rep.residual);
     }
-    if (o.frames) st = write_frames(w, o.frames, (int)o.frame_count);
-    if (st == SPN_OK && o.frames && !o.keep_aux) st = drop_aux(w);
     if (st == SPN_OK && o.png) {
         spn_render_def rd = spn_render_def_default();
         rd.width = rd.height = 1000;

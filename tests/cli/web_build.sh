@@ -22,6 +22,15 @@ cmp -s "$T/a.json" "$T/c.json" && fail "another seed should give another web"
     --frame-placement 0.04 --frame-rest 0.035 -o "$T/p.json" || fail "physical build"
 grep -q '"builder": *"physical"' "$T/p.json" || grep -q 'physical' "$T/p.json" || fail "metadata names the builder"
 
+# A building animation: N frames, the web file without the auxiliary spiral.
+"$SPN" build --species araneus --seed 2 --frames "$T/frames" --frame-count 6 -o "$T/f.json" || fail "build --frames"
+[ "$(ls "$T/frames" | grep -c '\.png$')" -eq 6 ] || fail "6 frames expected, got $(ls "$T/frames")"
+"$SPN" info --json "$T/f.json" | grep -q '"aux-spiral"' && fail "the auxiliary spiral should be gone from the file"
+# Frames grow: the last frame has more ink than the first (bigger PNG of the same size).
+first=$(stat -c %s "$T/frames/$(ls "$T/frames" | head -1)")
+last=$(stat -c %s "$T/frames/$(ls "$T/frames" | tail -1)")
+[ "$last" -gt "$first" ] || fail "the last frame ($last bytes) should hold more web than the first ($first)"
+
 check_bad() { # expected-text args...
     local want=$1; shift
     "$SPN" build "$@" -o "$T/bad.json" 2>"$T/err" && fail "should fail: $*"
