@@ -62,7 +62,7 @@ static void camera_matrices(const view_state *v, double *proj, double *view)
 void view_frame_camera(view_state *v)
 {
     uint32_t n = v->world ? spn_world_particle_count(v->world) : 0;
-    spn_vec3 lo = spn_v3(-0.1, -0.1, 0), hi = spn_v3(0.1, 0.1, 0);
+    spn_vec3 lo = spn_v3(-0.3, -0.3, 0), hi = spn_v3(0.3, 0.3, 0); /* build mode: a canvas of 0.6 m */
     if (n > 0) {
         const spn_vec3 *x = spn_world_positions(v->world);
         lo = hi = x[0];

@@ -41,6 +41,7 @@ typedef struct view_opts {
     uint64_t seed;
     const char *species;
     const char *method;
+    bool method_given;        /* --method was on the command line */
 } view_opts;
 
 struct view_state {

@@ -29,7 +29,7 @@ void view_set_world(view_state *v, spn_world *w)
     if (spn_v3_len(v->base_gravity) == 0) v->base_gravity = spn_v3(0, -9.81, 0);
     spn_world_set_integrator(w, v->opt.solver);
     v->grabbed = -1;
-    view_frame_camera(v);
+    if (!v->opt.build_mode) view_frame_camera(v); /* a built web stays where it was clicked */
 }
 
 void view_step(view_state *v, double frame_dt)
@@ -61,7 +61,8 @@ static void usage(FILE *out)
             "  --dt S                simulation sub-step in seconds (default 1/240)\n"
             "  --background FILE     PNG shown behind the web (F5)\n"
             "  --species NAME        build mode: web species (default generic)\n"
-            "  --method NAME         build mode: physical or geometric (default geometric)\n"
+            "  --method NAME         build mode: physical (Mehla) or geometric (the 2011 thesis);\n"
+            "                        default: the species builder (geometric frame, species' radii and spiral)\n"
             "  --seed N              build mode: seed (n picks a new one)\n"
             "  --headless-frames N   run N frames at 1/60 s each, then quit\n"
             "  --screenshot FILE     write a PNG of the last frame\n"
@@ -93,7 +94,12 @@ static int parse_args(int argc, char **argv, view_opts *o)
         case 't': if (!cli_double("view", "--dt", optarg, 1e-7, 0.1, &o->dt)) return 2; break;
         case 'B': o->background = optarg; break;
         case 'p': o->species = optarg; break;
-        case 'm': o->method = optarg; break;
+        case 'm':
+            if (strcmp(optarg, "physical") != 0 && strcmp(optarg, "geometric") != 0)
+                return cli_usage("view", "--method: expected physical or geometric, got '%s'", optarg);
+            o->method = optarg;
+            o->method_given = true;
+            break;
         case 's': if (!cli_u64("view", "--seed", optarg, &o->seed)) return 2; break;
         case 'H': if (!cli_int("view", "--headless-frames", optarg, 1, 1000000, &n)) return 2; o->headless_frames = (int)n; break;
         case 'o': o->screenshot = optarg; break;

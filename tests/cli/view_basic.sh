@@ -46,4 +46,30 @@ d=$(at "$tmp/drag.png" 485 205); s=$(at "$tmp/still.png" 485 205)
 awk -v d="$d" -v s="$s" 'BEGIN { exit !(d > 0.01 && s == 0) }' || fail "dragged particle not at the mouse (drag $d, still $s)"
 nb=$(at "$tmp/drag.png" 435 255)
 awk -v n="$nb" 'BEGIN { exit !(n > 0.005) }' || fail "neighbours did not follow the dragged particle ($nb)"
+
+# Build mode: click five anchors, press Enter (paused, so the web is seen as
+# built), toggle F3 and take a screenshot: the web's ink lies at each clicked
+# anchor and at the centre, and none of it before Enter.
+cat > "$tmp/build.txt" <<EOS
+0.10 click 500 150
+0.20 click 738 323
+0.30 click 647 602
+0.40 click 353 602
+0.50 click 262 323
+0.55 key F2
+0.60 screenshot $tmp/anchors.png
+0.62 key F2
+0.65 key Space
+0.70 key Enter
+0.80 key F3
+0.90 screenshot $tmp/built.png
+EOS
+xrun --build --headless-frames 60 --script "$tmp/build.txt" 2>/dev/null || fail "build-mode run"
+for xy in "500 150" "738 323" "647 602" "353 602" "262 323" "500 400"; do
+  set -- $xy
+  b=$("$PROBE" "$tmp/built.png" $(($1 - 10)) $(($2 - 10)) 20 20 | sed 's/.*bright=//')
+  awk -v b="$b" 'BEGIN { exit !(b > 0.02) }' || fail "no web ink at ($1, $2) after Enter ($b)"
+done
+c=$("$PROBE" "$tmp/anchors.png" 480 380 40 40 | sed 's/.*bright=//')
+awk -v c="$c" 'BEGIN { exit !(c == 0) }' || fail "ink at the centre before the web was built ($c)"
 echo "view basics ok"
