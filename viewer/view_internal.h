@@ -85,6 +85,8 @@ struct view_state {
     double sim_time;          /* viewer clock [s] (fixed 1/60 per frame headless) */
     uint64_t frames;
     double fps, sim_ms;
+    uint64_t stepped_frames;  /* frames in which the world was stepped */
+    double sim_ms_total;
     unsigned bg_texture;
     int bg_w, bg_h;
     unsigned text_texture;

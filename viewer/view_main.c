@@ -35,6 +35,7 @@ void view_set_world(view_state *v, spn_world *w)
 void view_step(view_state *v, double frame_dt)
 {
     if (!v->world) return;
+    v->stepped_frames++;
     int n = (int)ceil(frame_dt / v->opt.dt - 1e-9);
     if (n < 1) n = 1;
     double t0 = now_seconds();
@@ -46,7 +47,9 @@ void view_step(view_state *v, double frame_dt)
             break;
         }
     }
-    v->sim_ms = 0.9 * v->sim_ms + 0.1 * (now_seconds() - t0) * 1e3;
+    double ms = (now_seconds() - t0) * 1e3;
+    v->sim_ms = v->stepped_frames == 1 ? ms : 0.9 * v->sim_ms + 0.1 * ms;
+    v->sim_ms_total += ms;
 }
 
 static void usage(FILE *out)
@@ -58,7 +61,8 @@ static void usage(FILE *out)
             "  --build               build mode\n"
             "  --size WxH            window size (default 1000x800)\n"
             "  --solver NAME         euler, symplectic, rk4, adaptive, implicit (default implicit)\n"
-            "  --dt S                simulation sub-step in seconds (default 1/240)\n"
+            "  --dt S                simulation sub-step in seconds (default: 1/60 for implicit,\n"
+            "                        which is stable at a step per frame; 1/2000 for the others)\n"
             "  --background FILE     PNG shown behind the web (F5)\n"
             "  --species NAME        build mode: web species (default generic)\n"
             "  --method NAME         build mode: physical (Mehla) or geometric (the 2011 thesis);\n"
@@ -172,8 +176,10 @@ int spn_view_main(int argc, char **argv)
     v->opt.seed = 1;
     v->opt.species = "generic";
     v->opt.method = "geometric";
+    v->opt.dt = 0;
     int rc = parse_args(argc, argv, &v->opt);
     if (rc) return rc < 0 ? 0 : rc;
+    if (v->opt.dt == 0) v->opt.dt = v->opt.solver == SPN_INTEGRATOR_IMPLICIT ? 1.0 / 60.0 : 1.0 / 2000.0;
     if (v->opt.script && view_load_script(v, v->opt.script) != SPN_OK) return cli_fail("view", "%s", spn_last_error());
 
     glfwSetErrorCallback(quiet_glfw_error);
@@ -202,6 +208,10 @@ int spn_view_main(int argc, char **argv)
             if (view_screenshot(v, v->opt.screenshot) != SPN_OK) code = cli_fail("view", "%s", spn_last_error());
         }
         if (v->exit_code) code = v->exit_code;
+        if (v->opt.headless_frames > 0 && v->stepped_frames > 0)
+            fprintf(stderr, "spinneret view: %llu frames simulated, %.2f ms of simulation per frame on average "
+                            "(real time allows 16.7)\n",
+                    (unsigned long long)v->stepped_frames, v->sim_ms_total / (double)v->stepped_frames);
     }
     view_set_world(v, NULL);
     free(v->tris);
