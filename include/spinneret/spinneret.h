@@ -10,5 +10,7 @@
 #include "scenes.h"
 #include "render.h"
 #include "export.h"
+#include "mesh.h"
+#include "shoot.h"
 
 #endif
