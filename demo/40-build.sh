@@ -7,8 +7,14 @@ set -eu
 D="$OUT/build"
 mkdir -p "$D"
 LOOK="--size 1000x1000 --glow 0.4 --sheen 0.6 --smooth --quiet"
+# Silk webs settle with the implicit solver; builds without it show them as laid.
+SETTLE=""
+if "$SPN" build --species zilla --size 0.04 --settle --settle-time 0.05 -o "$D/probe.json" 2>/dev/null; then
+  SETTLE="--settle --settle-time 1"
+fi
+rm -f "$D/probe.json"
 for sp in generic araneus zilla argiope zygiella; do
-  "$SPN" build --species $sp --seed 7 -o "$D/species-$sp.json"
+  "$SPN" build --species $sp --seed 7 $SETTLE -o "$D/species-$sp.json"
   "$SPN" render "$D/species-$sp.json" -o "$D/species-$sp.png" $LOOK --dew --dew-spacing 0.004 --dew-radius 0.0004
 done
 SQ="-0.4,0.42;0.42,0.38;0.4,-0.45;-0.42,-0.38"
