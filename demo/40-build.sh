@@ -17,7 +17,7 @@ for sp in generic araneus zilla argiope zygiella; do
   "$SPN" build --species $sp --seed 7 $SETTLE -o "$D/species-$sp.json"
   "$SPN" render "$D/species-$sp.json" -o "$D/species-$sp.png" $LOOK --dew --dew-spacing 0.004 --dew-radius 0.0004
 done
-SQ="-0.4,0.42;0.42,0.38;0.4,-0.45;-0.42,-0.38"
+SQ="-0.3,0.32;0.32,0.28;0.3,-0.34;-0.32,-0.28"
 i=0
 for pr in "0.007 0.003" "0.009 0.003" "0.011 0.005" "0.015 0.007"; do
   set -- $pr; i=$((i + 1))
@@ -44,9 +44,10 @@ for a in "$A3" "$A4" "$A5" "$A6"; do
 done
 "$SPN" build --method geometric --anchors "$A6" --m 0.4 -o "$D/geometric-6-m40.json"
 "$SPN" render "$D/geometric-6-m40.json" -o "$D/geometric-6-m40.png" $LOOK
-"$SPN" build --species araneus --seed 3 --frames "$D/building" --frame-count 48 -o "$D/building.json"
 if command -v ffmpeg >/dev/null; then
   "$SPN" build --species araneus --seed 3 --frames "$D/building.gif" --frame-count 48 -o "$D/building.json"
+else
+  "$SPN" build --species araneus --seed 3 --frames "$D/building" --frame-count 48 -o "$D/building.json"
 fi
 if command -v montage >/dev/null; then
   montage "$D"/thesis-spiral-?.png -tile 4x1 -geometry 400x400+4+4 "$D/thesis-spirals.png"
