@@ -25,11 +25,11 @@ static void settle_or_skip(spn_world *w, double max_time)
 static void test_physical_silk(void **state)
 {
     (void)state;
-    static const spn_vec3 an[4] = {{-0.21, 0.22, 0}, {0.22, 0.2, 0}, {0.2, -0.22, 0}, {-0.22, -0.19, 0}};
+    static const spn_vec3 an[4] = {{-0.14, 0.15, 0}, {0.15, 0.13, 0}, {0.13, -0.15, 0}, {-0.15, -0.12, 0}};
     spn_physical_def d = spn_physical_def_default();
     d.anchors = an;
     d.anchor_count = 4;
-    d.move_outer = 0.03;
+    d.move_outer = 0.02;
     d.materials = spn_web_materials_preset(SPN_MATERIAL_SILK);
     d.outer_rest = d.outer_placement / 1.10;
     d.frame_rest = d.frame_placement / 1.08;
@@ -46,7 +46,7 @@ static void test_species_silk(void **state)
 {
     (void)state;
     spn_species_def d = spn_species_def_preset(SPN_SPECIES_ZILLA);
-    d.size = 0.12;
+    d.size = 0.08;
     spn_world *w = NULL;
     assert_int_equal(spn_web_build_species(&d, &w), SPN_OK);
     spn_web_measures before, after;

@@ -160,7 +160,7 @@ spn_status spn_web_build_geometric(const spn_geometric_def *def, spn_world **out
     spn__layout_free(&l);
     spn__meta m;
     spn__meta_begin(&m, "geometric", def->seed, def->anchors, def->anchor_count);
-    spn__meta_str(&m, "materials", def->materials.kind[SPN_THREAD_RADIUS].ea > 1e-3 ? "silk" : "thesis");
+    spn__meta_materials(&m, &def->materials);
     spn__meta_num(&m, "t", def->t);
     spn__meta_num(&m, "s", def->s);
     spn__meta_num(&m, "U", def->u);

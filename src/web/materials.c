@@ -58,7 +58,7 @@ spn_web_materials spn_web_materials_preset(spn_material_preset preset)
         mat(stiffer * 0.001 * 0.002, heavier * particle / 0.002, 3e-6, zeta);
     m.kind[SPN_THREAD_FRAME] = mat(stiffer * 0.001 * 0.015, heavier * particle / 0.015, 3e-6, zeta);
     /* The hub ring gathers every secondary spoke: it is many strands thick. */
-    m.kind[SPN_THREAD_HUB] = mat(50 * 0.01 * 0.003, 5 * particle / 0.003, 4e-6, zeta);
+    m.kind[SPN_THREAD_HUB] = mat(15 * 0.01 * 0.003, 5 * particle / 0.003, 4e-6, zeta);
     /* The thesis gives every particle 10 ug, and the spiral adds no particles
      * (it joins spoke masses), so its threads carry almost no mass of their own. */
     m.kind[SPN_THREAD_CAPTURE] = m.kind[SPN_THREAD_AUX_SPIRAL] = mat(0.0003 * 0.003, 0.05 * particle / 0.003, 1.5e-6, zeta);

@@ -183,7 +183,7 @@ spn_status spn_web_build_physical(const spn_physical_def *def, spn_world **out)
     if (b.wv.st == SPN_OK) spn__physical_spiral(&b);
     spn__meta m;
     spn__meta_begin(&m, "physical", def->seed, def->anchors, def->anchor_count);
-    spn__meta_str(&m, "materials", b.wv.mat.kind[SPN_THREAD_RADIUS].ea > 1e-3 ? "silk" : "thesis");
+    spn__meta_materials(&m, &b.wv.mat);
     spn__meta_num(&m, "move_outer", def->move_outer);
     spn__meta_num(&m, "outer_placement", def->outer_placement);
     spn__meta_num(&m, "outer_rest", def->outer_rest);

@@ -32,10 +32,17 @@ spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *repo
     for (uint32_t i = 0; i < np; i++)
         if (!spn_world_is_fixed(w, i)) lightest = fmin(lightest, spn_world_mass(w, i));
     if (!isfinite(lightest)) lightest = 1e-9;
+    /* At rest: no particle feels more than a thousandth of a mean particle's
+     * weight or a hundred-thousandth of a mean thread tension. */
+    double mass = 0, tension = 0;
+    for (uint32_t i = 0; i < np; i++) mass += spn_world_mass(w, i);
+    uint32_t ns = spn_world_spring_count(w);
+    for (uint32_t s = 0; s < ns; s++) tension += spn_world_spring(w, s).tension;
+    double floor_force = fmax(1e-3 * 9.81 * mass / (np ? np : 1), 1e-5 * tension / (ns ? ns : 1));
     spn_settle_def sd = spn_settle_def_default();
     sd.dt = stable_step(w);
     sd.max_time = max_time;
-    sd.max_residual = 1e-3 * lightest * 9.81;
+    sd.max_residual = floor_force;
     sd.max_kinetic = 1e-9 * lightest * 9.81 * 1e-3 * np;
     sd.check_interval = fmax(50 * sd.dt, 0.02);
     /* About critical for the web's slow modes (a few Hz). */

@@ -404,7 +404,7 @@ spn_status spn_web_build_species(const spn_species_def *def, spn_world **out)
     spn__meta m;
     spn__meta_begin(&m, "species", def->seed, anchors, count);
     spn__meta_str(&m, "species", spn_species_name(def->species));
-    spn__meta_str(&m, "materials", def->materials.kind[SPN_THREAD_RADIUS].ea > 1e-3 ? "silk" : "thesis");
+    spn__meta_materials(&m, &def->materials);
     spn__meta_num(&m, "radii", w->nr);
     spn__meta_num(&m, "hub_x", w->hub.x);
     spn__meta_num(&m, "hub_y", w->hub.y);

@@ -274,6 +274,19 @@ void spn__meta_str(spn__meta *m, const char *key, const char *v)
     spn_sink_printf(&m->sink, "%s\"%s\": \"%s\"", m->fields++ ? ", " : "", key, v);
 }
 
+void spn__meta_materials(spn__meta *m, const spn_web_materials *mat)
+{
+    spn_sink_printf(&m->sink, "%s\"materials\": {", m->fields++ ? ", " : "");
+    int first = 1;
+    for (uint32_t k = 1; k < SPN_WEB_KINDS; k++) {
+        const spn_thread_material *t = &mat->kind[k];
+        spn_sink_printf(&m->sink, "%s\"%s\": {\"ea\": %.6g, \"linear_density\": %.6g, \"diameter\": %.6g, \"damping_ratio\": %.6g}",
+                        first ? "" : ", ", spn_thread_kind_name(k), t->ea, t->linear_density, t->diameter, t->damping_ratio);
+        first = 0;
+    }
+    spn_sink_printf(&m->sink, "}");
+}
+
 const char *spn__meta_end(spn__meta *m)
 {
     spn_sink_printf(&m->sink, "}}");

@@ -69,6 +69,8 @@ typedef struct spn__meta {
 void spn__meta_begin(spn__meta *m, const char *builder, uint64_t seed, const spn_vec3 *anchors, int count);
 void spn__meta_num(spn__meta *m, const char *key, double v);
 void spn__meta_str(spn__meta *m, const char *key, const char *v);
+/* Every thread kind's material, as "materials": {kind: {ea, ...}}. */
+void spn__meta_materials(spn__meta *m, const spn_web_materials *mat);
 const char *spn__meta_end(spn__meta *m);
 void spn__meta_free(spn__meta *m);
 
