@@ -66,15 +66,26 @@ static bool parse_anchors(const char *text, opts *o)
     bool ok = true;
     for (char *tok = strtok_r(copy, ";", &save); tok && ok; tok = strtok_r(NULL, ";", &save)) {
         if (o->anchor_count == SPN_WEB_MAX_ANCHORS) {
-            cli_usage(CMD, "--anchors: at most %d anchors", SPN_WEB_MAX_ANCHORS);
+            cli_usage(CMD, "--anchors: expected 3 to %d anchors, got more", SPN_WEB_MAX_ANCHORS);
             ok = false;
             break;
         }
         char name[32];
         snprintf(name, sizeof name, "--anchors (anchor %d)", o->anchor_count + 1);
-        ok = cli_vec3(CMD, name, tok, true, &o->anchors[o->anchor_count++]);
+        ok = cli_vec3(CMD, name, tok, true, &o->anchors[o->anchor_count]);
+        /* Within a thousand kilometres: sums and cross products of anchors stay finite. */
+        spn_vec3 a = o->anchors[o->anchor_count++];
+        if (ok && !(fabs(a.x) <= CLI_MAX_COORD && fabs(a.y) <= CLI_MAX_COORD && fabs(a.z) <= CLI_MAX_COORD)) {
+            cli_usage(CMD, "%s: expected coordinates in [%g, %g] m, got '%s'", name, -CLI_MAX_COORD, CLI_MAX_COORD, tok);
+            ok = false;
+        }
     }
     free(copy);
+    if (ok && o->anchor_count < 3) {
+        cli_usage(CMD, "--anchors: expected 3 to %d anchors \"x,y[,z];...\", got %d", SPN_WEB_MAX_ANCHORS,
+                  o->anchor_count);
+        ok = false;
+    }
     return ok;
 }
 
@@ -225,7 +236,7 @@ static spn_status build(opts *o, spn_world **w)
         o->sp.keep_aux_spiral = o->keep_aux;
         return spn_web_build_species(&o->sp, w);
     }
-    if (!anchors) return spn_error(SPN_ERR_INVALID, "--anchors: needed with --method (at least 3)");
+    if (!anchors) return spn_error(SPN_ERR_INVALID, "--anchors: needed with --method (3 to %d anchors)", SPN_WEB_MAX_ANCHORS);
     if (physical) {
         if (o->silk) silk_strains(&o->phys);
         o->phys.anchors = anchors;
@@ -298,6 +309,9 @@ int cmd_build(int argc, char **argv)
     if (o.species && o.method) return cli_usage(CMD, "--species builds its own web; leave out --method");
     spn_world *w = NULL;
     spn_status st = build(&o, &w);
+    if (st != SPN_OK && strncmp(spn_last_error(), "anchors:", 8) == 0) /* the builder's word for --anchors */
+        return cli_usage(CMD, "--%s (expected 3 to %d points around an area in the x-y plane)", spn_last_error(),
+                         SPN_WEB_MAX_ANCHORS);
     if (st != SPN_OK) return cli_fail_status(CMD, st);
     if (o.frames) {
         /* The animation shows the auxiliary spiral laid and eaten again, so it

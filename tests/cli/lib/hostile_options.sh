@@ -34,6 +34,9 @@ values() { # kind lo hi -> one value a line
   size) printf '%s\n' 0x0 -1x5 1e300x1 nanx5 5x x5 "1x$((hi + 1))" "$((hi + 1))x1" "${hi}x${hi}" ;;
   vec) printf '%s\n' 0,0,0 nan,0,0 inf,0,0 1e300,1e300,1e300 -1e300,0,0 1e-300,1e-300,1e-300 1,2 ;;
   rgb) printf '%s\n' 0,0,0 -1,0,0 nan,0,0 inf,0,0 1e300,0,0 1e-300,0,0 "$(above "$hi"),0,0" 1,1 ;;
+  anchors) printf '%s\n' '0,0;0,0;0,0' 'nan,0;1,0;0,1' '1e300,0;0,1e300;-1e300,0' '0,0;1,0' '' ';;;' \
+             '1e-300,0;0,1e-300;-1e-300,0' '0,0;1,0;2,0' '-1,-1;1,-1;1,1;-1,1' \
+             "$(for i in $(seq 0 64); do printf '%s,%s;' "$i" "$((i % 2))"; done)" ;;
   scene) printf '%s\n' 0x5 -1x5 1e300x5 nanx3 "$((hi + 1))x1" 1x1 2x3 "x" ;;
   esac
 }
