@@ -253,6 +253,8 @@ static spn_status build(opts *o, spn_world **w)
 }
 
 /* Frames of the construction: the springs laid so far, framed like the whole web. */
+static int frames_done; /* for the message when a signal stops the frames */
+
 static spn_status write_frames(const spn_world *w, const char *dir, int count)
 {
     spn_render_def rd = spn_render_def_default();
@@ -270,11 +272,14 @@ static spn_status write_frames(const spn_world *w, const char *dir, int count)
     uint8_t *rgba = malloc((size_t)rd.width * (size_t)rd.height * 4);
     spn_frames *fr = NULL;
     spn_status st = rgba ? spn_frames_open(dir, rd.width, rd.height, 24, &fr) : SPN_ERR_NOMEM;
-    for (int f = 1; f <= count && st == SPN_OK; f++) {
+    cli_interruptible((uint64_t)count);
+    for (int f = 1; f <= count && st == SPN_OK && !spn_interrupted(); f++) {
+        spn_interrupt_progress((uint64_t)f - 1, (uint64_t)count);
         spn_world *part = NULL;
         st = spn_web_construction_state(w, (double)f / count, &part);
         if (st == SPN_OK) st = spn_render_rgba(part, &rd, rgba);
         if (st == SPN_OK) st = spn_frames_add(fr, rgba);
+        if (st == SPN_OK) frames_done = f;
         spn_world_destroy(part);
     }
     if (fr) {
@@ -323,6 +328,11 @@ int cmd_build(int argc, char **argv)
         o.keep_aux = keep;
         if (st == SPN_OK) st = write_frames(anim, o.frames, (int)o.frame_count);
         spn_world_destroy(anim);
+        if (st == SPN_OK && spn_interrupted()) { /* the frames so far are kept; no web file */
+            spn_world_destroy(w);
+            return cli_report_interrupt(CMD, (uint64_t)frames_done, (uint64_t)o.frame_count, "the complete frames are kept, no web file written", 0);
+        }
+        spn_interrupt_graceful(false);
     }
     if (st == SPN_OK && o.settle) {
         spn_settle_report rep;
