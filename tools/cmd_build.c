@@ -82,8 +82,8 @@ static bool parse_anchors(const char *text, opts *o)
     }
     free(copy);
     if (ok && o->anchor_count < 3) {
-        cli_usage(CMD, "--anchors: expected 3 to %d anchors \"x,y[,z];...\", got %d", SPN_WEB_MAX_ANCHORS,
-                  o->anchor_count);
+        cli_usage(CMD, "--anchors: expected at least 3 (at most %d) anchors \"x,y[,z];...\", got %d",
+                  SPN_WEB_MAX_ANCHORS, o->anchor_count);
         ok = false;
     }
     return ok;
