@@ -101,6 +101,11 @@ SPN_API double spn_thread_diameter(uint32_t tag);
 /// viscid capture silk 2.7); INFINITY for kinds that never break.
 SPN_API double spn_thread_breaking_strain(uint32_t tag);
 
+/// Strain at which a thread kind yields (dragline ~0.04); past it the thread
+/// flows plastically with `SPN_POST_YIELD` of its stiffness; INFINITY: elastic.
+SPN_API double spn_thread_yield_strain(uint32_t tag);
+#define SPN_POST_YIELD 0.3
+
 /* ---- prey ---------------------------------------------------------------- */
 
 /// Particle tag given to prey particles.
@@ -120,6 +125,10 @@ typedef struct spn_impact_def {
     double contact_stiffness;  ///< penalty stiffness [N/m]; 0 (default): the stiffest spring's k
     double breaking_scale;     ///< multiplies every breaking strain, default 1
     bool breakage;             ///< set break lengths from the breaking strains, default true
+    bool prey_gravity;         ///< prey fall (a pellet); false (default): they fly, lift balancing weight
+    bool plastic;              ///< threads yield past spn_thread_yield_strain (silk's hysteresis), default true
+    double glue_strength;      ///< capture-thread glue: a droplet holding the prey lets go past this pull [N],
+                               ///< default 4e-5 (tens of uN, Opell & Hendricks 2007); 0: not sticky
 } spn_impact_def;
 
 SPN_API spn_impact_def spn_impact_def_default(void);
@@ -129,6 +138,7 @@ typedef struct spn_kind_energy {
     uint32_t tag;
     double elastic;     ///< elastic energy now minus at the start
     double damping;     ///< dissipated by the springs' damping
+    double plastic;     ///< dissipated by yielding (permanent stretch)
     double broken;      ///< elastic energy lost when springs broke
     uint32_t breaks;    ///< springs broken
 } spn_kind_energy;
@@ -154,6 +164,8 @@ typedef struct spn_impact_report {
     double air_work;              ///< work done by the air on the web (negative: drag absorbed) [J]
     double wind_work;             ///< work of the force callback wind [J]
     double viscous;               ///< dissipated by the world's viscous drag [J]
+    double glue;                  ///< lost when glue droplets let go [J]
+    int glue_held;                ///< droplets holding prey at the end
     double contact_energy;        ///< penalty energy stored in contacts now [J]
     double balance_error;         ///< |total_now + dissipated + broken - air - wind - total_start| [J]
     uint32_t breaks;
@@ -180,7 +192,7 @@ SPN_API uint32_t spn_impact_prey_particle(const spn_impact *impact, int i);
 SPN_API void spn_impact_track_air(spn_impact *impact, spn_air_fn fn, void *user, double rho, double mu);
 SPN_API void spn_impact_track_wind(spn_impact *impact, spn_force_fn fn, void *user);
 /// Update the energy ledger after a step of `dt` (call after every step).
-SPN_API void spn_impact_after_step(spn_impact *impact, const spn_world *w, double dt);
+SPN_API void spn_impact_after_step(spn_impact *impact, spn_world *w, double dt);
 SPN_API void spn_impact_report_get(spn_impact *impact, const spn_world *w, spn_impact_report *report);
 /// Write the report as JSON.
 SPN_API spn_status spn_impact_report_write(const spn_impact_report *report, spn_sink *sink);

@@ -17,4 +17,9 @@ void spn__web_bounds(const spn_world *w, spn_vec3 *lo, spn_vec3 *hi);
  * whose intact springs of a breakable kind get break_max = rest * (1 + strain * scale). */
 spn_status spn__world_with_breaks(const spn_world *w, double scale, spn_world **out);
 
+/* True when this build's world applies aerodynamic drag (probed once on a
+ * single segment in a steady wind), so the energy ledger counts the air's work
+ * only when the air really acts. */
+bool spn__world_applies_air(void);
+
 #endif

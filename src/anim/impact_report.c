@@ -12,7 +12,7 @@ static const char *kind_name(uint32_t tag)
     return n ? n : "other";
 }
 
-static double absorbed(const spn_kind_energy *k) { return k->elastic + k->damping + k->broken; }
+static double absorbed(const spn_kind_energy *k) { return k->elastic + k->damping + k->plastic + k->broken; }
 
 static spn_status write_prey(const spn_impact_report *r, spn_sink *s)
 {
@@ -30,9 +30,9 @@ static spn_status write_kinds(const spn_impact_report *r, spn_sink *s, double lo
         const spn_kind_energy *k = &r->kinds[i];
         st = spn_sink_printf(s,
                              "%s\n    \"%s\": {\"absorbed\": %.9g, \"fraction\": %.6f, \"elastic\": %.9g, "
-                             "\"damping\": %.9g, \"broken_energy\": %.9g, \"broken\": %u}",
+                             "\"damping\": %.9g, \"plastic\": %.9g, \"broken_energy\": %.9g, \"broken\": %u}",
                              i ? "," : "", kind_name(k->tag), absorbed(k), lost > 0 ? absorbed(k) / lost : 0,
-                             k->elastic, k->damping, k->broken, k->breaks);
+                             k->elastic, k->damping, k->plastic, k->broken, k->breaks);
     }
     if (st == SPN_OK) st = spn_sink_printf(s, "\n  },\n");
     return st;
@@ -48,11 +48,11 @@ spn_status spn_impact_report_write(const spn_impact_report *r, spn_sink *s)
         st = spn_sink_printf(s,
                              "  \"energy\": {\"prey_kinetic_start\": %.9g, \"prey_kinetic_end\": %.9g, "
                              "\"prey_kinetic_lost\": %.9g,\n    \"air_drag\": %.9g, \"air_drag_fraction\": %.6f, "
-                             "\"viscous\": %.9g, \"wind_work\": %.9g, \"contact\": %.9g,\n"
+                             "\"viscous\": %.9g, \"glue\": %.9g, \"glue_droplets_holding\": %d, \"wind_work\": %.9g, \"contact\": %.9g,\n"
                              "    \"total_start\": %.9g, \"total_end\": %.9g, \"balance_error\": %.9g, "
                              "\"balance_error_relative\": %.6g},\n",
                              r->prey_kinetic_start, r->prey_kinetic_end, lost, air, lost > 0 ? air / lost : 0,
-                             r->viscous, r->wind_work, r->contact_energy, r->total_start, r->total_now,
+                             r->viscous, r->glue, r->glue_held, r->wind_work, r->contact_energy, r->total_start, r->total_now,
                              r->balance_error, r->prey_kinetic_start > 0 ? r->balance_error / r->prey_kinetic_start : 0);
     if (st == SPN_OK) st = write_kinds(r, s, lost);
     if (st == SPN_OK) st = spn_sink_printf(s, "  \"broken\": {");
