@@ -169,6 +169,9 @@ typedef struct spn_impact_report {
     double contact_energy;        ///< penalty energy stored in contacts now [J]
     double balance_error;         ///< |total_now + dissipated + broken - air - wind - total_start| [J]
     uint32_t breaks;
+    double web_radius;            ///< largest distance of a web particle from the hub [m]
+    double break_distance_max;    ///< broken springs' largest distance from the strike point [m]
+    double break_distance_mean;
     int nkinds;
     spn_kind_energy kinds[SPN_KIND_SLOTS];
 } spn_impact_report;

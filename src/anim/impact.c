@@ -110,6 +110,16 @@ static void on_break(void *user, uint32_t s, double t, double length)
     if (d > 0 || !im->tension_only[s]) ke->broken += 0.5 * im->k[s] * d * d;
     ke->breaks++;
     im->breaks++;
+    /* How far from the strike the damage is (Cranford et al. 2012: local). */
+    const spn_vec3 *x = spn_world_positions(im->world);
+    spn_vec3 mid = spn_v3_scale(spn_v3_add(x[im->sa[s]], x[im->sb[s]]), 0.5);
+    double best = INFINITY;
+    for (int p = 0; p < im->nprey; p++)
+        if (im->hit_known[p]) best = fmin(best, spn_v3_len(spn_v3_sub(mid, im->hit[p])));
+    if (isfinite(best)) {
+        im->break_dist_max = fmax(im->break_dist_max, best);
+        im->break_dist_sum += best;
+    }
 }
 
 spn_status spn_prey_parse(const char *text, spn_prey_def *out)
@@ -176,6 +186,8 @@ spn_status spn_impact_create(spn_world **w, const spn_prey_def *prey, int nprey,
         return st;
     }
     spn_world_set_break_callback(*w, on_break, im);
+    im->world = *w;
+    im->web_radius = spn__web_radius(*w, spn__hub_particle(*w));
     spn__impact_ledger_start(im, *w);
     *out = im;
     return SPN_OK;

@@ -24,6 +24,11 @@ struct spn_impact {
     double radius[MAX_PREY];
     spn_vec3 dir0[MAX_PREY];
     bool touched[MAX_PREY];
+    bool hit_known[MAX_PREY];
+    spn_vec3 hit[MAX_PREY];      /* prey centre at the end of its first step in contact */
+    const spn_world *world;      /* for the break callback */
+    double web_radius;
+    double break_dist_max, break_dist_sum; /* broken springs' distance from the nearest hit */
     double kc;
     /* springs, cached at creation (the graph does not change) */
     uint32_t ns, np;

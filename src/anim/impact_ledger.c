@@ -122,6 +122,11 @@ void spn_impact_after_step(spn_impact *im, spn_world *w, double dt)
     im->wind_work += 0.5 * dt * (im->wind_prev + pw);
     im->viscous_prev = pv;
     spn__impact_glue_update(im, w);
+    for (int p = 0; p < im->nprey; p++)
+        if (im->touched[p] && !im->hit_known[p]) {
+            im->hit_known[p] = true;
+            im->hit[p] = x[im->prey[p]];
+        }
     im->air_prev = pa;
     im->wind_prev = pw;
 }
@@ -167,6 +172,9 @@ void spn_impact_report_get(spn_impact *im, const spn_world *w, spn_impact_report
     r->viscous = im->viscous;
     r->contact_energy = im->contact;
     r->breaks = im->breaks;
+    r->web_radius = im->web_radius;
+    r->break_distance_max = im->break_dist_max;
+    r->break_distance_mean = im->breaks ? im->break_dist_sum / im->breaks : 0;
     r->nkinds = im->nkinds;
     r->glue = im->glue_lost;
     r->glue_held = im->ntethers;

@@ -62,6 +62,10 @@ spn_status spn_impact_report_write(const spn_impact_report *r, spn_sink *s)
         st = spn_sink_printf(s, "%s\"%s\": %u", first ? "" : ", ", kind_name(r->kinds[i].tag), r->kinds[i].breaks);
         first = 0;
     }
-    if (st == SPN_OK) st = spn_sink_printf(s, "},\n  \"broken_total\": %u\n}\n", r->breaks);
+    if (st == SPN_OK)
+        st = spn_sink_printf(s,
+                             "},\n  \"broken_total\": %u,\n  \"damage\": {\"web_radius\": %.6g, "
+                             "\"break_distance_max\": %.6g, \"break_distance_mean\": %.6g}\n}\n",
+                             r->breaks, r->web_radius, r->break_distance_max, r->break_distance_mean);
     return st;
 }
