@@ -65,7 +65,7 @@ typedef struct spn_air_def {
     double gust_period;    ///< typical gust period [s], default 4
     double turbulence;     ///< intensity: rms turbulent speed / speed, default 0.15
     double integral_scale; ///< largest eddies [m], default 1
-    double small_scale;    ///< smallest eddies [m], default 0.05
+    double small_scale;    ///< smallest eddies [m], default 0.15 (smaller ones average out over the threads)
     int modes;             ///< Fourier modes, default 64
     double rho;            ///< air density [kg/m^3], default 1.204
     double mu;             ///< air viscosity [Pa s], default 1.81e-5

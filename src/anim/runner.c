@@ -129,7 +129,14 @@ static spn_status make_air(runner *r, spn_world *w)
     double size = fmax(fmax(hi.x - lo.x, hi.y - lo.y), fmax(hi.z - lo.z, 1e-3)), pad = 0.5 * size;
     lo = spn_v3_sub(lo, spn_v3(pad, pad, pad));
     hi = spn_v3_add(hi, spn_v3(pad, pad, pad));
-    if (ad.turbulence > 0) st = spn_air_set_grid(r->air, lo, hi, 12, 12, 6, 5e-3);
+    /* Five nodes per smallest eddy keep the interpolation within ~10% of it. */
+    if (ad.turbulence > 0) {
+        double h = ad.small_scale / 5;
+        int n[3];
+        double ext[3] = {hi.x - lo.x, hi.y - lo.y, hi.z - lo.z};
+        for (int a = 0; a < 3; a++) n[a] = (int)fmin(48, fmax(3, ceil(ext[a] / h) + 1));
+        st = spn_air_set_grid(r->air, lo, hi, n[0], n[1], n[2], 5e-3);
+    }
     if (st != SPN_OK) return st;
     spn_air_attach(r->air, w);
     spn_world_set_air(w, runner_air, r, ad.rho, ad.mu);

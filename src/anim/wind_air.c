@@ -63,7 +63,7 @@ spn_air_def spn_air_def_default(void)
     d.gust_period = 4;
     d.turbulence = 0.15;
     d.integral_scale = 1;
-    d.small_scale = 0.05;
+    d.small_scale = 0.15;
     d.modes = 64;
     d.rho = 1.204;
     d.mu = 1.81e-5;
