@@ -167,6 +167,7 @@ typedef struct spn_impact_report {
     double glue;                  ///< lost when glue droplets let go [J]
     int glue_held;                ///< droplets holding prey at the end
     double contact_energy;        ///< penalty energy stored in contacts now [J]
+    double web_kinetic;           ///< kinetic energy of the web now (still swinging) [J]
     double balance_error;         ///< |total_now + dissipated + broken - air - wind - total_start| [J]
     uint32_t breaks;
     double web_radius;            ///< largest distance of a web particle from the hub [m]

@@ -171,6 +171,7 @@ void spn_impact_report_get(spn_impact *im, const spn_world *w, spn_impact_report
     r->wind_work = im->wind_work;
     r->viscous = im->viscous;
     r->contact_energy = im->contact;
+    r->web_kinetic = spn_world_energy(w).kinetic - r->prey_kinetic_end;
     r->breaks = im->breaks;
     r->web_radius = im->web_radius;
     r->break_distance_max = im->break_dist_max;
