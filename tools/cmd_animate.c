@@ -29,7 +29,7 @@ static void usage(FILE *out)
             "  -o, --output OUT        the video, GIF or frame folder (required)\n"
             "      --duration S        seconds, in [0, 3600]; default 5\n"
             "      --fps N             frames per second, in [1, 240]; default 25\n"
-            "      --solver NAME       euler, symplectic, rk4, adaptive or implicit; default symplectic\n"
+            "      --solver NAME       euler, symplectic, rk4, adaptive or implicit; default: WEB's\n"
             "      --substeps N        steps per frame, in [1, 1e7]; default: stable for the solver\n"
             "      --seed N            seeds the wind; default 1\n"
             "      --frame-range A-B   render frames A..B only (same bits as in a whole run)\n"

@@ -213,7 +213,7 @@ typedef struct spn_anim_def {
     double duration;           ///< seconds, default 5
     double fps;                ///< frames per second, default 25
     int substeps;              ///< steps per frame; 0 (default): chosen for stability
-    spn_integrator solver;     ///< default symplectic
+    spn_integrator solver;     ///< SPN_INTEGRATOR_COUNT (default): keep the world's
     int first_frame;           ///< frames handed to the callback: first..last, default 0
     int last_frame;            ///< -1 (default): to the end
     spn_wind_kind wind;

@@ -29,7 +29,7 @@ spn_anim_def spn_anim_def_default(void)
     d.duration = 5;
     d.fps = 25;
     d.substeps = 0;
-    d.solver = SPN_INTEGRATOR_SYMPLECTIC;
+    d.solver = SPN_INTEGRATOR_COUNT;
     d.first_frame = 0;
     d.last_frame = -1;
     d.wind = SPN_WIND_NONE;
@@ -147,7 +147,7 @@ static spn_status make_air(runner *r, spn_world *w)
 static spn_status setup(runner *r, spn_world **w)
 {
     spn_status st = SPN_OK;
-    spn_world_set_integrator(*w, r->def.solver);
+    if (r->def.solver != SPN_INTEGRATOR_COUNT) spn_world_set_integrator(*w, r->def.solver);
     if (r->def.nprey > 0) st = spn_impact_create(w, r->def.prey, r->def.nprey, &r->def.impact, &r->impact);
     if (st == SPN_OK && r->def.wind == SPN_WIND_THESIS) {
         spn_thesis_wind_def td = r->def.thesis;
@@ -200,7 +200,8 @@ spn_status spn_animate(spn_world **w, const spn_anim_def *def, spn_anim_frame_fn
     st = setup(&r, w);
     int frames = spn_anim_frame_count(def), last = def->last_frame < 0 ? frames - 1 : def->last_frame;
     double kc = r.impact ? spn_impact_contact_stiffness(r.impact) : 0;
-    rep.substeps = def->substeps > 0 ? def->substeps : spn_anim_stable_substeps(*w, def->fps, def->solver, kc);
+    spn_integrator solver = spn_world_get_def(*w)->integrator;
+    rep.substeps = def->substeps > 0 ? def->substeps : spn_anim_stable_substeps(*w, def->fps, solver, kc);
     rep.dt = 1 / (def->fps * rep.substeps);
     double t0 = spn_world_time(*w);
     for (int f = 0; f <= last && st == SPN_OK; f++) {
