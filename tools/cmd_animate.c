@@ -28,7 +28,9 @@ static void usage(FILE *out)
             "(frame_00000.png, ...). Frame 0 is the web as loaded.\n\n"
             "  -o, --output OUT        the video, GIF or frame folder (required)\n"
             "      --duration S        seconds, in [0, 3600]; default 5\n"
-            "      --fps N             frames per second, in [1, 240]; default 25\n"
+            "      --fps N             frames per simulated second, in [1, 10000]; default 25\n"
+            "      --playback-fps N    frames per second of the video, in [1, 240]; default --fps\n"
+            "                          (--fps 400 --playback-fps 25: 16 times slow motion)\n"
             "      --solver NAME       euler, symplectic, rk4, adaptive or implicit; default: WEB's\n"
             "      --substeps N        steps per frame, in [1, 1e7]; default: stable for the solver\n"
             "      --seed N            seeds the wind; default 1\n"
@@ -63,6 +65,7 @@ static void usage(FILE *out)
 typedef struct animate_options {
     const char *input, *output, *report, *states;
     bool quiet;
+    double playback_fps;
     spn_anim_def anim;
     spn_render_def render;
     spn_prey_def prey[MAX_IMPACTS];
@@ -96,7 +99,7 @@ static bool wind_model(const char *arg, spn_wind_kind *out)
 enum {
     OPT_DURATION = 256, OPT_FPS, OPT_SOLVER, OPT_SUBSTEPS, OPT_SEED, OPT_RANGE, OPT_STATES, OPT_QUIET, OPT_WIND,
     OPT_TMASS, OPT_TGAIN, OPT_TRANDOM, OPT_TPERIOD, OPT_TTICK, OPT_TRAD, OPT_TFALL, OPT_SPEED, OPT_DIR, OPT_GUST,
-    OPT_TURB, OPT_STOP, OPT_IMPACT, OPT_REPORT, OPT_NOBREAK, OPT_GLUE, OPT_PGRAV
+    OPT_TURB, OPT_STOP, OPT_IMPACT, OPT_REPORT, OPT_NOBREAK, OPT_GLUE, OPT_PGRAV, OPT_PLAYBACK
 };
 
 static bool sim_option(int c, const char *arg, animate_options *o)
@@ -105,7 +108,8 @@ static bool sim_option(int c, const char *arg, animate_options *o)
     long n;
     switch (c) {
     case OPT_DURATION: return cli_double(CMD, "--duration", arg, 0, 3600, &d->duration);
-    case OPT_FPS: return cli_double(CMD, "--fps", arg, 1, 240, &d->fps);
+    case OPT_FPS: return cli_double(CMD, "--fps", arg, 1, 10000, &d->fps);
+    case OPT_PLAYBACK: return cli_double(CMD, "--playback-fps", arg, 1, 240, &o->playback_fps);
     case OPT_SOLVER:
         if (spn_integrator_parse(arg, &d->solver) == SPN_OK) return true;
         cli_usage(CMD, "--solver: %s", spn_last_error());
@@ -164,6 +168,7 @@ static bool air_prey_option(int c, const char *arg, animate_options *o)
 
 static const struct option long_options[] = {
     {"output", required_argument, NULL, 'o'},    {"duration", required_argument, NULL, OPT_DURATION},
+    {"playback-fps", required_argument, NULL, OPT_PLAYBACK},
     {"fps", required_argument, NULL, OPT_FPS},   {"solver", required_argument, NULL, OPT_SOLVER},
     {"substeps", required_argument, NULL, OPT_SUBSTEPS}, {"seed", required_argument, NULL, OPT_SEED},
     {"frame-range", required_argument, NULL, OPT_RANGE}, {"save-states", required_argument, NULL, OPT_STATES},
@@ -352,7 +357,8 @@ static spn_status prepare(animate_options *o, spn_world **w, frame_ctx *c)
         return spn_error(SPN_ERR_IO, "%s: cannot create the folder: %s", o->states, strerror(errno));
     c->rgba = malloc((size_t)o->render.width * o->render.height * 4);
     if (!c->rgba) return spn_error(SPN_ERR_NOMEM, "out of memory for %dx%d frames", o->render.width, o->render.height);
-    st = spn_frames_open(o->output, o->render.width, o->render.height, o->anim.fps, &c->frames);
+    double rate = o->playback_fps > 0 ? o->playback_fps : fmin(o->anim.fps, 240);
+    st = spn_frames_open(o->output, o->render.width, o->render.height, rate, &c->frames);
     if (st == SPN_OK) spn_frames_set_first_index(c->frames, o->anim.first_frame);
     return st;
 }
