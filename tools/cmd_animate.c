@@ -5,8 +5,8 @@
  * frames of --frame-range are the same bits as those of a whole run.
  * SIGINT/SIGTERM stop after the current step: finished PNG frames and state
  * files stay, a video or report being written is abandoned. */
-#include "animate_render.h"
 #include "cli.h"
+#include "render_options.h"
 
 #include <errno.h>
 #include <getopt.h>
@@ -24,7 +24,8 @@ static void usage(FILE *out)
 {
     fprintf(out,
             "usage: spinneret animate WEB -o OUT [options]\n"
-            "Animate the web file WEB and write OUT: a .mp4, a .gif, or a folder of PNG frames\n"
+            "Animate WEB (a web file, or scene:orb[:RINGSxRADIALS]) and write OUT: a .mp4, a .gif,\n"
+            "or a folder of PNG frames "
             "(frame_00000.png, ...). Frame 0 is the web as loaded.\n\n"
             "  -o, --output OUT        the video, GIF or frame folder (required)\n"
             "      --duration S        seconds, in [0, 3600]; default 5\n"
@@ -58,7 +59,7 @@ static void usage(FILE *out)
             "      --glue N            capture glue strength per droplet [N], in [0, 1]; default 4e-5\n"
             "      --prey-gravity      prey fall like pellets (default: they fly)\n\n",
             MAX_IMPACTS);
-    render_usage(out);
+    render_options_help(out);
     fprintf(out, "  -h, --help              this text\n");
 }
 
@@ -67,7 +68,8 @@ typedef struct animate_options {
     bool quiet;
     double playback_fps;
     spn_anim_def anim;
-    spn_render_def render;
+    render_options ro;
+    spn_render_def render; /* ro.def once finished for the loaded web */
     spn_prey_def prey[MAX_IMPACTS];
 } animate_options;
 
@@ -199,9 +201,11 @@ static int parse_options(int argc, char **argv, animate_options *o)
         case OPT_REPORT: o->report = optarg; break;
         case ':': return cli_usage(CMD, "%s: missing value", argv[optind - 1]);
         case '?': return cli_usage(CMD, "unknown option '%s'", argv[optind - 1]);
-        default:
-            if (c >= RENDER_OPT_BASE) ok = render_option(CMD, c, optarg, &o->render);
-            else ok = sim_option(c, optarg, o) || (c >= OPT_SPEED && air_prey_option(c, optarg, o));
+        default: {
+            int r = render_options_parse(CMD, c, optarg, &o->ro);
+            if (r < 0) ok = false;
+            else if (r == 0) ok = sim_option(c, optarg, o) || (c >= OPT_SPEED && air_prey_option(c, optarg, o));
+        }
         }
         if (!ok) return CLI_EXIT_USAGE;
     }
@@ -343,10 +347,10 @@ static spn_status write_report(const char *path, const spn_impact_report *r)
 
 static spn_status prepare(animate_options *o, spn_world **w, frame_ctx *c)
 {
-    spn_status st = spn_web_load(o->input, w);
-    if (st != SPN_OK) return st;
+    render_options_finish(&o->ro, *w);
+    o->render = o->ro.def;
     fix_camera(&o->render, *w);
-    o->render.dew.seed = o->anim.seed;
+    spn_status st;
     st = spn_render_def_check(&o->render);
     if (st != SPN_OK) return st;
     int frames = spn_anim_frame_count(&o->anim);
@@ -366,6 +370,8 @@ static spn_status prepare(animate_options *o, spn_world **w, frame_ctx *c)
 static int animate_run(animate_options *o)
 {
     spn_world *w = NULL;
+    int code = load_world(CMD, o->input, &w);
+    if (code) return code;
     frame_ctx c = {o, NULL, NULL, NULL};
     spn_status st = prepare(o, &w, &c);
     spn_anim_report rep;
@@ -410,7 +416,7 @@ int cmd_animate(int argc, char **argv)
     animate_options o;
     memset(&o, 0, sizeof o);
     o.anim = spn_anim_def_default();
-    o.render = spn_render_def_default();
+    render_options_init(&o.ro);
     int code = parse_options(argc, argv, &o);
     if (code >= 0) return code;
     return animate_run(&o);

@@ -10,5 +10,6 @@
 #include "scenes.h"
 #include "render.h"
 #include "anim.h"
+#include "export.h"
 
 #endif

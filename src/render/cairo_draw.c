@@ -111,6 +111,31 @@ static void draw_segments(canvas *c, const spn_strand *s, double width)
     cairo_new_path(c->cr);
 }
 
+/* Glints over the strand: each lit segment again, brighter and wider, with a
+ * bloom; butt caps, so overlaps at joints stay under the base stroke's width. */
+static void draw_glints(canvas *c, const spn_strand *s, double width)
+{
+    uint32_t segs = s->closed ? s->count : s->count - 1;
+    double u = c->view.px_per_ref, hot[3];
+    for (int j = 0; j < 3; j++) hot[j] = 0.2 * s->rgb[j] + 0.8;
+    cairo_set_line_cap(c->cr, CAIRO_LINE_CAP_BUTT);
+    for (uint32_t k = 0; k < segs; k++) {
+        double g = s->segment_glint[k], x0, y0, x1, y1;
+        if (g < 0.02 || !spn__view_project(&c->view, s->points[k], &x0, &y0, NULL) ||
+            !spn__view_project(&c->view, s->points[(k + 1) % s->count], &x1, &y1, NULL))
+            continue;
+        cairo_new_path(c->cr);
+        cairo_move_to(c->cr, x0, y0);
+        cairo_line_to(c->cr, x1, y1);
+        double a = fmin(1, s->alpha * 2 * g);
+        stroke_rgb(c, hot, a * 0.10, width + 8 * u);
+        stroke_rgb(c, hot, a * 0.25, width + 2.5 * u);
+        stroke_rgb(c, hot, a, width * 1.2);
+    }
+    cairo_new_path(c->cr);
+    cairo_set_line_cap(c->cr, CAIRO_LINE_CAP_ROUND);
+}
+
 static spn_status draw_strand(void *user, const spn_strand *s)
 {
     canvas *c = user;
@@ -129,6 +154,7 @@ static spn_status draw_strand(void *user, const spn_strand *s)
     }
     stroke_rgb(c, s->rgb, s->alpha, width);
     cairo_new_path(c->cr);
+    if (s->segment_glint) draw_glints(c, s, width);
     return SPN_OK;
 }
 

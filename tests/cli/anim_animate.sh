@@ -10,7 +10,7 @@ T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 
-common=(--wind thesis --thesis-gain 300 --duration 1 --fps 10 --size 160x160 --quiet --eye 0.3,0.15,0.35)
+common=(--wind thesis --thesis-gain 300 --duration 1 --fps 10 --size 160x160 --quiet --camera persp --eye 0.3,0.15,0.35)
 "$SPN" animate "$WEB" -o "$T/whole" "${common[@]}" || fail "whole run"
 [ "$(ls "$T/whole" | wc -l)" -eq 11 ] || fail "whole run should have 11 frames, has $(ls "$T/whole" | wc -l)"
 "$SPN" animate "$WEB" -o "$T/part" "${common[@]}" --frame-range 6-8 || fail "frame range run"
