@@ -34,6 +34,14 @@ BG=(--background "$P-backdrop.png")
 "$SPN" render "$WEB" -o "$P-kinds-persp.png" --colour-by kind --camera persp --yaw 35 --pitch 20 --width-scale 1.4
 "$SPN" render "$WEB" -o "$P-dew.svg" --dew --background-color 0.05,0.07,0.1
 
+# A turntable: the frame sequence writer, through ffmpeg when it is installed.
+if command -v ffmpeg >/dev/null 2>&1; then
+    "$SPN" render "$WEB" -o "$P-turntable.gif" --turntable 48 --fps 16 --size 480x480 "${BG[@]}" \
+        --shade 0.86,0.88,0.87 --alpha 0.75 --sheen 1 --glow 0.4 --quiet
+else
+    echo "ffmpeg not installed: skipped the turntable"
+fi
+
 # Exports: polylines for Blender/Houdini, tubes for Maya, a POV-Ray scene.
 "$SPN" export "$WEB" -o "$P.obj"
 "$SPN" export "$WEB" -o "$P-tubes.ply" --tubes 0.0004 --sides 6

@@ -17,6 +17,14 @@
 #include <unistd.h>
 #include <spinneret/spinneret.h>
 
+#if defined(__has_include)
+#if __has_include(<assimp/cimport.h>)
+#include <assimp/cimport.h>
+#include <assimp/scene.h>
+#define HAVE_ASSIMP 1
+#endif
+#endif
+
 /* ---- a small OBJ reader ---------------------------------------------- */
 
 typedef struct obj_data {
@@ -213,6 +221,42 @@ static void test_tubes(void **state)
     spn_world_destroy(w);
 }
 
+/* An importer we did not write (assimp, as used by many DCC tools) reads the
+ * OBJ: one mesh per thread kind, named after it, of line primitives, one line
+ * per spring; with --tubes, polygon meshes. */
+static void test_obj_in_assimp(void **state)
+{
+    (void)state;
+#ifndef HAVE_ASSIMP
+    printf("skipped: assimp headers are not installed (libassimp-dev)\n");
+    skip();
+#else
+    spn_world *w = small_web();
+    spn_export_def d = spn_export_def_default();
+    char path[512];
+    snprintf(path, sizeof path, "%s/export_assimp_%ld.obj", SPN_BUILD_DIR, (long)getpid());
+    for (int tubes = 0; tubes < 2; tubes++) {
+        d.tube_radius = tubes ? 0.001 : 0;
+        assert_int_equal(spn_export_file(w, &d, path), SPN_OK);
+        const struct aiScene *sc = aiImportFile(path, 0);
+        assert_non_null(sc);
+        assert_int_equal(sc->mNumMeshes, 3);
+        unsigned faces = 0;
+        for (unsigned i = 0; i < sc->mNumMeshes; i++) {
+            const struct aiMesh *m = sc->mMeshes[i];
+            const char *name = m->mName.data;
+            assert_true(strcmp(name, "frame") == 0 || strcmp(name, "radius") == 0 || strcmp(name, "capture") == 0);
+            assert_int_equal(m->mPrimitiveTypes, tubes ? aiPrimitiveType_POLYGON : aiPrimitiveType_LINE);
+            faces += m->mNumFaces;
+        }
+        if (!tubes) assert_int_equal(faces, spn_world_spring_count(w));
+        aiReleaseImport(sc);
+    }
+    remove(path);
+    spn_world_destroy(w);
+#endif
+}
+
 static int run(const char *cmd) { return system(cmd); }
 
 /* The exported scene renders in povray without a warning, and the web is in
@@ -281,7 +325,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_obj_polylines), cmocka_unit_test(test_ply_polylines), cmocka_unit_test(test_tubes),
-        cmocka_unit_test(test_pov_renders),   cmocka_unit_test(test_bad_exports),
+        cmocka_unit_test(test_obj_in_assimp), cmocka_unit_test(test_pov_renders),
+        cmocka_unit_test(test_bad_exports),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

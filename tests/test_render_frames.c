@@ -66,6 +66,30 @@ static void test_png_folder(void **state)
     assert_int_equal(access(path, F_OK), -1);
 }
 
+/* A world straight into a sequence; a picture of the wrong size is refused. */
+static void test_add_world(void **state)
+{
+    (void)state;
+    char dir[600], path[700];
+    snprintf(dir, sizeof dir, "%s/world", folder);
+    spn_world *w;
+    assert_int_equal(spn_scene_orb(NULL, NULL, &w), SPN_OK);
+    spn_render_def d = spn_render_def_default();
+    d.width = 40;
+    d.height = 30;
+    spn_frames *f;
+    assert_int_equal(spn_frames_open(dir, 40, 30, 25, &f), SPN_OK);
+    assert_int_equal(spn_frames_add_world(f, w, &d), SPN_OK);
+    d.width = 41;
+    assert_int_equal(spn_frames_add_world(f, w, &d), SPN_ERR_INVALID);
+    assert_int_equal(spn_frames_close(f, true), SPN_OK);
+    snprintf(path, sizeof path, "%s/frame_00000.png", dir);
+    assert_int_equal(access(path, F_OK), 0);
+    snprintf(path, sizeof path, "%s/frame_00001.png", dir);
+    assert_int_equal(access(path, F_OK), -1);
+    spn_world_destroy(w);
+}
+
 /* Decode the first frame of a video with ffmpeg; its middle pixel. */
 static void first_pixel(const char *video, int w, int h, int rgb[3])
 {
@@ -163,7 +187,7 @@ static void test_bad_arguments(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_png_folder), cmocka_unit_test(test_video), cmocka_unit_test(test_missing_ffmpeg),
+        cmocka_unit_test(test_png_folder), cmocka_unit_test(test_add_world), cmocka_unit_test(test_video), cmocka_unit_test(test_missing_ffmpeg),
         cmocka_unit_test(test_bad_arguments)};
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -99,7 +99,7 @@ static int parse(int argc, char **argv, export_options *o)
 static int export_one(export_options *o, const char *in)
 {
     spn_world *w;
-    int code = load_world(CMD, in, &w);
+    int code = render_load_world(CMD, in, &w);
     if (code) return code;
     render_options_finish(&o->ro, w);
     o->def.render = o->ro.def;
@@ -114,7 +114,7 @@ static int frame_bounds(char **files, int n, spn_vec3 *lo, spn_vec3 *hi)
 {
     for (int i = 0; i < n; i++) {
         spn_world *w;
-        int code = load_world(CMD, files[i], &w);
+        int code = render_load_world(CMD, files[i], &w);
         if (code) return code;
         for (uint32_t p = 0; p < spn_world_particle_count(w); p++) {
             spn_vec3 x = spn_world_position(w, p);
@@ -138,7 +138,7 @@ static int export_frames(export_options *o, char **files, int n)
     spn_progress *bar = spn_progress_begin("export", (uint64_t)n, o->quiet);
     for (int i = 0; i < n; i++) {
         spn_world *w;
-        int code = load_world(CMD, files[i], &w);
+        int code = render_load_world(CMD, files[i], &w);
         if (code) return spn_progress_end(bar), code;
         if (i == 0) render_options_finish(&o->ro, w); /* the first frame fixes a perspective camera */
         o->def.render = o->ro.def;

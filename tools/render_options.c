@@ -57,6 +57,14 @@ static bool background(const char *cmd, const char *arg, spn_render_def *d)
     return true;
 }
 
+static bool light(const char *cmd, const char *arg, spn_vec3 *dir)
+{
+    if (!cli_vec3(cmd, "--light", arg, false, dir)) return false;
+    if (spn_v3_len(*dir) > 0) return true;
+    cli_usage(cmd, "--light: a direction, not 0,0,0");
+    return false;
+}
+
 static bool parse_dew(const char *cmd, int c, const char *arg, spn_dew_def *dew)
 {
     dew->enabled = true;
@@ -90,15 +98,13 @@ int render_options_parse(const char *cmd, int c, const char *arg, render_options
     case RO_WIDTH_SCALE: ok = cli_double(cmd, "--width-scale", arg, 0.01, 100, &d->width_scale); break;
     case RO_GLOW: ok = cli_double(cmd, "--glow", arg, 0, 1, &d->glow); break;
     case RO_SHEEN: ok = cli_double(cmd, "--sheen", arg, 0, 1, &d->sheen); break;
-    case RO_LIGHT:
-        ok = cli_vec3(cmd, "--light", arg, false, &d->light);
-        if (ok && spn_v3_len(d->light) == 0) ok = cli_usage(cmd, "--light: the direction must not be 0,0,0") < 0;
-        break;
+    case RO_LIGHT: ok = light(cmd, arg, &d->light); break;
     case RO_DEW: case RO_DEW_SPACING: case RO_DEW_RADIUS: case RO_DEW_JITTER: case RO_DEW_SEED:
         ok = parse_dew(cmd, c, arg, &d->dew);
         break;
     case RO_COLOUR_BY: ok = colour_by(cmd, arg, &d->colour_by); break;
     case RO_NO_LEGEND: d->legend = false; break;
+    case RO_SMOOTH: d->smooth = true; break;
     default: return 0;
     }
     return ok ? 1 : -1;
@@ -109,7 +115,11 @@ void render_options_finish(render_options *o, const spn_world *w)
     spn_camera *c = &o->def.camera;
     if (c->kind != SPN_CAMERA_PERSPECTIVE || o->eye_set) return;
     spn_camera orbit = spn_camera_orbit(w, o->yaw, o->pitch, c->fov_degrees);
-    if (o->target_set) orbit.eye = spn_v3_add(orbit.eye, spn_v3_sub(c->target, orbit.target)), orbit.target = c->target;
+    if (o->target_set) {
+        /* Keep the orbit's direction and distance, around the given target. */
+        orbit.eye = spn_v3_add(orbit.eye, spn_v3_sub(c->target, orbit.target));
+        orbit.target = c->target;
+    }
     c->eye = orbit.eye;
     c->target = orbit.target;
 }
@@ -138,6 +148,7 @@ void render_options_help(FILE *out)
             "      --sheen S              glints where threads reflect the light, 0..1 (default 0)\n"
             "      --light X,Y,Z          direction towards the light (default -0.4,0.5,-0.75: a low\n"
             "                             sun behind the web)\n"
+            "      --smooth               strands as smooth curves through their particles\n"
             "      --colour-by MODE       tension, strain or kind: colour scale with a legend\n"
             "      --no-legend            no legend for --colour-by\n"
             "dew (droplets on the capture spiral):\n"
@@ -171,7 +182,7 @@ static int load_scene(const char *cmd, const char *spec, spn_world **w)
     return st == SPN_OK ? 0 : cli_fail(cmd, "scene:%s: %s", spec, spn_last_error());
 }
 
-int load_world(const char *cmd, const char *spec, spn_world **w)
+int render_load_world(const char *cmd, const char *spec, spn_world **w)
 {
     *w = NULL;
     if (strncmp(spec, "scene:", 6) == 0) return load_scene(cmd, spec + 6, w);

@@ -11,7 +11,7 @@
 enum {
     RO_SIZE = 300, RO_CAMERA, RO_EYE, RO_TARGET, RO_UP, RO_FOV, RO_MARGIN, RO_BACKGROUND, RO_BACKGROUND_COLOR,
     RO_SHADE, RO_ALPHA, RO_WIDTH_SCALE, RO_GLOW, RO_DEW, RO_DEW_SPACING, RO_DEW_RADIUS, RO_DEW_JITTER, RO_DEW_SEED,
-    RO_COLOUR_BY, RO_NO_LEGEND, RO_YAW, RO_PITCH, RO_SHEEN, RO_LIGHT
+    RO_COLOUR_BY, RO_NO_LEGEND, RO_YAW, RO_PITCH, RO_SHEEN, RO_LIGHT, RO_SMOOTH
 };
 
 /* Entries for a getopt_long table (append {NULL, 0, NULL, 0} after your own). */
@@ -29,7 +29,8 @@ enum {
     {"dew-radius", required_argument, NULL, RO_DEW_RADIUS}, {"dew-jitter", required_argument, NULL, RO_DEW_JITTER}, \
     {"dew-seed", required_argument, NULL, RO_DEW_SEED}, {"colour-by", required_argument, NULL, RO_COLOUR_BY},       \
     {"color-by", required_argument, NULL, RO_COLOUR_BY}, {"no-legend", no_argument, NULL, RO_NO_LEGEND},          \
-    {"sheen", required_argument, NULL, RO_SHEEN}, {"light", required_argument, NULL, RO_LIGHT}
+    {"sheen", required_argument, NULL, RO_SHEEN}, {"light", required_argument, NULL, RO_LIGHT},                     \
+    {"smooth", no_argument, NULL, RO_SMOOTH}
 
 typedef struct render_options {
     spn_render_def def;
@@ -50,6 +51,6 @@ void render_options_help(FILE *out);
 /* Load a world from a web file, or build a shared scene: "scene:orb",
  * "scene:orb:RINGSxRADIALS", "scene:chain", "scene:cloth". Returns 0, or
  * prints the failure (naming the file) and returns the exit code. */
-int load_world(const char *cmd, const char *spec, spn_world **w);
+int render_load_world(const char *cmd, const char *spec, spn_world **w);
 
 #endif

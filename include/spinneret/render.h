@@ -55,6 +55,8 @@ typedef struct spn_render_def {
     double sheen;                  ///< glints where a thread reflects the light 0..1, default 0
     spn_vec3 light;                ///< direction towards the (distant) light, default (-0.4, 0.5, -0.75):
                                    ///< a low sun behind the web, which makes silk glint in arcs
+    bool smooth;                   ///< draw strands as centripetal Catmull-Rom curves through their
+                                   ///< particles instead of straight segments, default false
 } spn_render_def;
 
 SPN_API spn_render_def spn_render_def_default(void);
@@ -150,8 +152,17 @@ SPN_API spn_status spn_png_size(const char *path, int *width, int *height);
 
 /// Is the ffmpeg program on PATH (or $SPN_FFMPEG)? Frame sequences to .mp4/.gif need it.
 SPN_API bool spn_frames_have_ffmpeg(void);
+/// Render `w` with `def` (its size must be the sequence's) and add it as the
+/// next frame: the one call an animation loop needs.
+SPN_API spn_status spn_frames_add_world(spn_frames *frames, const spn_world *w, const spn_render_def *def);
 /// The frame size a sequence was opened with.
 SPN_API void spn_frames_size(const spn_frames *frames, int *width, int *height);
+
+/// Release the font and surface caches cairo and fontconfig keep for the
+/// life of the process (legend text fills them), so leak checkers see a clean
+/// exit. Call once, just before exiting, when nothing else uses cairo; the
+/// commands that draw do.
+SPN_API void spn_render_release_caches(void);
 
 /* ---- progress on stderr ------------------------------------------------ */
 

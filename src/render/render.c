@@ -13,6 +13,7 @@
 #include <string.h>
 
 #define MAX_SIDE 16384
+#define MAX_PIXELS (100.0 * 1000 * 1000) /* 400 MB of ARGB: beyond that, render in tiles */
 
 spn_dew_def spn_dew_def_default(void)
 {
@@ -41,6 +42,7 @@ spn_render_def spn_render_def_default(void)
     d.glow = 0;
     d.sheen = 0;
     d.light = spn_v3(-0.4, 0.5, -0.75);
+    d.smooth = false;
     return d;
 }
 
@@ -88,6 +90,9 @@ spn_status spn_render_def_check(const spn_render_def *d)
     if (d->width < 1 || d->height < 1 || d->width > MAX_SIDE || d->height > MAX_SIDE)
         return spn_error(SPN_ERR_INVALID, "render: size must be between 1x1 and %dx%d, got %dx%d", MAX_SIDE, MAX_SIDE,
                          d->width, d->height);
+    if ((double)d->width * d->height > MAX_PIXELS)
+        return spn_error(SPN_ERR_INVALID, "render: %dx%d is more than %.0f million pixels", d->width, d->height,
+                         MAX_PIXELS / 1e6);
     spn_status st = check_rgb(d->background_rgb, "background_rgb");
     if (st == SPN_OK) st = check_rgb(d->shade_rgb, "shade_rgb");
     if (st != SPN_OK) return st;
@@ -219,4 +224,17 @@ spn_status spn_png_size(const char *path, int *width, int *height)
     *height = cairo_image_surface_get_height(s);
     cairo_surface_destroy(s);
     return SPN_OK;
+}
+
+#if defined(__GNUC__)
+/* fontconfig is cairo's dependency, not ours: resolved at run time if loaded. */
+extern void FcFini(void) __attribute__((weak));
+#endif
+
+void spn_render_release_caches(void)
+{
+    cairo_debug_reset_static_data();
+#if defined(__GNUC__)
+    if (FcFini) FcFini();
+#endif
 }

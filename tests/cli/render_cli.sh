@@ -123,7 +123,23 @@ grep -q '^element vertex 20$' "$T/c.ply" || fail "ply tube vertices"
 [ -s "$T/frames/frame_00000.pov" ] && [ -s "$T/frames/frame_00001.pov" ] || fail "pov frames"
 "$SPN" export "$CROSS" -o "$T/c.json" && "$SPN" info "$T/c.json" | grep -q 'springs: 2' || fail "export json"
 
-# 6. Bad options: one message, exit 2, no file.
+# 6. Turntables: a PNG folder always; a GIF through ffmpeg; without ffmpeg a
+# clear failure that names the PNG-folder fallback, and no file.
+"$SPN" render "$CROSS" -o "$T/spin" --turntable 3 --size 64x48 --quiet || fail "turntable to a folder"
+[ -s "$T/spin/frame_00000.png" ] && [ -s "$T/spin/frame_00002.png" ] && [ ! -e "$T/spin/frame_00003.png" ] ||
+    fail "turntable frames"
+if command -v ffmpeg >/dev/null 2>&1; then
+    "$SPN" render "$CROSS" -o "$T/spin.gif" --turntable 4 --size 64x48 --quiet || fail "turntable gif"
+    [ "$(head -c 6 "$T/spin.gif")" = GIF89a ] || fail "turntable gif header"
+else
+    echo "ffmpeg not installed: skipped the GIF turntable"
+fi
+SPN_FFMPEG=/nonexistent/ffmpeg "$SPN" render "$CROSS" -o "$T/spin.mp4" --turntable 2 --quiet 2>"$T/err"
+[ $? -eq 1 ] || fail "turntable without ffmpeg should exit 1"
+grep -q 'ffmpeg' "$T/err" && grep -q 'PNG' "$T/err" || fail "turntable without ffmpeg: $(cat "$T/err")"
+[ ! -e "$T/spin.mp4" ] || fail "turntable without ffmpeg left a file"
+
+# 7. Bad options: one message, exit 2, no file.
 bad() {
     local out=$1; shift
     "$SPN" "$@" 2>"$T/err"
@@ -142,6 +158,7 @@ bad "$T/x.png" render "$CROSS" -o "$T/x.png" --shade nan,0.5,0.5
 bad "$T/x.png" render "$CROSS" -o "$T/x.png" --background-color 0.5,NaN,0.5
 bad "$T/x.png" render "$CROSS" -o "$T/x.png" --alpha 1.5
 bad "$T/x.png" render "$CROSS" -o "$T/x.png" --colour-by beauty
+bad "$T/x.mov" render "$CROSS" -o "$T/x.mov" --turntable 3
 bad "$T/x.stl" export "$CROSS" -o "$T/x.stl"
 bad "$T/x.obj" export "$CROSS" -o "$T/x.obj" --sides 2
 "$SPN" render "$T/missing.json" -o "$T/x.png" 2>/dev/null; [ $? -eq 1 ] || fail "missing input should exit 1"
