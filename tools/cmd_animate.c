@@ -370,7 +370,7 @@ static spn_status prepare(animate_options *o, spn_world **w, frame_ctx *c)
 static int animate_run(animate_options *o)
 {
     spn_world *w = NULL;
-    int code = load_world(CMD, o->input, &w);
+    int code = render_load_world(CMD, o->input, &w);
     if (code) return code;
     frame_ctx c = {o, NULL, NULL, NULL};
     spn_status st = prepare(o, &w, &c);
