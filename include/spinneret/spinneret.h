@@ -11,5 +11,7 @@
 #include "render.h"
 #include "anim.h"
 #include "export.h"
+#include "mesh.h"
+#include "shoot.h"
 
 #endif
