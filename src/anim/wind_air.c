@@ -164,6 +164,7 @@ void spn_air_destroy(spn_air_field *air)
 
 static double gust_factor(const spn_air_field *air, double t)
 {
+    if (air->def.gust == 0) return 1;
     double g = 0;
     for (int j = 0; j < GUST_SINES; j++) g += air->gust_amp[j] * sin(air->gust_omega[j] * t + air->gust_phase[j]);
     return 1 + air->def.gust * g;
@@ -198,7 +199,9 @@ static spn_vec3 turbulence_at(const spn_air_field *air, double t, double shift, 
 
 spn_vec3 spn_air_velocity(const spn_air_field *air, double t, spn_vec3 p)
 {
-    return spn_v3_add(spn_air_mean(air, t), turbulence_at(air, t, advection(air, t), p));
+    spn_vec3 mean = spn_air_mean(air, t);
+    if (air->def.turbulence == 0 || air->def.speed == 0) return mean;
+    return spn_v3_add(mean, turbulence_at(air, t, advection(air, t), p));
 }
 
 spn_status spn_air_set_grid(spn_air_field *air, spn_vec3 lo, spn_vec3 hi, int nx, int ny, int nz, double slice_dt)
