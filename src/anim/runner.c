@@ -202,6 +202,16 @@ spn_status spn_animate(spn_world **w, const spn_anim_def *def, spn_anim_frame_fn
     double kc = r.impact ? spn_impact_contact_stiffness(r.impact) : 0;
     spn_integrator solver = spn_world_get_def(*w)->integrator;
     rep.substeps = def->substeps > 0 ? def->substeps : spn_anim_stable_substeps(*w, def->fps, solver, kc);
+    /* Any solver: contact forces are explicit (a callback), so they need the
+     * explicit step; and a prey moves at most a tenth of its radius per step. */
+    if (r.impact && def->substeps == 0 && (solver == SPN_INTEGRATOR_IMPLICIT || solver == SPN_INTEGRATOR_ADAPTIVE)) {
+        int n = spn_anim_stable_substeps(*w, def->fps, SPN_INTEGRATOR_SYMPLECTIC, kc);
+        if (n > rep.substeps) rep.substeps = n;
+    }
+    for (int i = 0; i < def->nprey && def->substeps == 0; i++) {
+        double v = spn_v3_len(def->prey[i].velocity), n = ceil(10 * v / (def->fps * def->prey[i].radius));
+        if (n > rep.substeps && n < 1e7) rep.substeps = (int)n;
+    }
     rep.dt = 1 / (def->fps * rep.substeps);
     double t0 = spn_world_time(*w);
     for (int f = 0; f <= last && st == SPN_OK; f++) {
