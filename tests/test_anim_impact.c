@@ -60,11 +60,23 @@ static spn_anim_report strike(double speed, double mass, double duration)
     printf("# speed %g: %s, breaks %u, KE %.3g -> %.3g J, balance error %.3g%%, air %.3g, substeps %d\n", speed,
            spn_prey_outcome_name(r->outcome[0]), r->breaks, r->prey_kinetic_start, r->prey_kinetic_end,
            100 * r->balance_error / r->prey_kinetic_start, -r->air_work, rep.substeps);
+    printf("#   strike over at %.3f s: of %.3g J lost,", r->strike_time, r->strike_prey_kinetic_lost);
+    for (int i = 0; i < r->nkinds; i++)
+        printf(" %s %.0f%%", spn_thread_kind_name(r->kinds[i].tag), 100 * r->strike_absorbed[i] / r->strike_prey_kinetic_lost);
+    printf(", air %.0f%%\n", 100 * r->strike_air / r->strike_prey_kinetic_lost);
     for (int i = 0; i < r->nkinds; i++)
         printf("#   %s: elastic %.3g damping %.3g plastic %.3g broken %.3g (%u)\n", spn_thread_kind_name(r->kinds[i].tag),
                r->kinds[i].elastic, r->kinds[i].damping, r->kinds[i].plastic, r->kinds[i].broken, r->kinds[i].breaks);
     spn_world_destroy(w);
     return rep;
+}
+
+/* Share of the prey's lost energy held by thread kind `tag` when the strike ended. */
+static double strike_share(const spn_impact_report *r, uint32_t tag)
+{
+    for (int i = 0; i < r->nkinds; i++)
+        if (r->kinds[i].tag == tag) return r->strike_absorbed[i] / r->strike_prey_kinetic_lost;
+    return 0;
 }
 
 static void test_slow_strike_is_stopped(void **state)
@@ -77,6 +89,14 @@ static void test_slow_strike_is_stopped(void **state)
     assert_true(rep.impact.outcome[0] == SPN_PREY_STOPPED || rep.impact.outcome[0] == SPN_PREY_BOUNCED);
     assert_int_equal(rep.impact.breaks, 0);
     assert_true(rep.impact.balance_error <= 0.02 * rep.impact.prey_kinetic_start);
+    /* Sensenig et al. 2012: the radii take most of the work of stopping prey,
+     * the capture spiral and the air little. */
+    const spn_impact_report *r = &rep.impact;
+    assert_true(r->strike_time > 0);
+    double radii = strike_share(r, SPN_THREAD_RADIUS), capture = strike_share(r, SPN_THREAD_CAPTURE);
+    assert_true(radii > 0.5);
+    assert_true(radii > 3 * capture);
+    assert_true(radii > 3 * r->strike_air / r->strike_prey_kinetic_lost);
 }
 
 static void test_fast_strike_breaks_through(void **state)

@@ -175,6 +175,11 @@ typedef struct spn_impact_report {
     double break_distance_mean;
     int nkinds;
     spn_kind_energy kinds[SPN_KIND_SLOTS];
+    /* When the strike ended (every prey arrested or through; -1: not yet), and
+     * where the prey's lost energy was then, before the web's ringing is damped. */
+    double strike_time;
+    double strike_prey_kinetic_lost, strike_air, strike_web_kinetic, strike_glue;
+    double strike_absorbed[SPN_KIND_SLOTS]; ///< per kind, in the order of `kinds`
 } spn_impact_report;
 
 typedef struct spn_impact spn_impact;

@@ -28,7 +28,10 @@ struct spn_impact {
     spn_vec3 hit[MAX_PREY];      /* prey centre at the end of its first step in contact */
     const spn_world *world;      /* for the break callback */
     double web_radius;
-    double break_dist_max, break_dist_sum; /* broken springs' distance from the nearest hit */
+    double break_dist_max, break_dist_sum;
+    bool strike_done;             /* every prey arrested or through: snapshot taken */
+    double strike_time;
+    spn_impact_report strike;     /* the ledger at that moment */ /* broken springs' distance from the nearest hit */
     double kc;
     /* springs, cached at creation (the graph does not change) */
     uint32_t ns, np;

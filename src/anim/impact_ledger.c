@@ -106,6 +106,8 @@ void spn__impact_ledger_start(spn_impact *im, const spn_world *w)
     im->air_prev = im->wind_prev = 0;
 }
 
+static void check_strike(spn_impact *im, spn_world *w);
+
 void spn_impact_after_step(spn_impact *im, spn_world *w, double dt)
 {
     spn__impact_yield(im, w);
@@ -127,12 +129,34 @@ void spn_impact_after_step(spn_impact *im, spn_world *w, double dt)
             im->hit_known[p] = true;
             im->hit[p] = x[im->prey[p]];
         }
+    check_strike(im, w);
     im->air_prev = pa;
     im->wind_prev = pw;
 }
 
 /* Stopped, passed through, bounced or missed: compare the prey with the web
  * along its initial direction of flight. */
+static spn_prey_outcome outcome(const spn_impact *im, const spn_world *w, int p);
+
+/* The strike is over when every prey that touched the web has been arrested
+ * (its speed along its flight no longer positive) or has gone through; the
+ * prey that never touched do not hold it up once the others are done. */
+static void check_strike(spn_impact *im, spn_world *w)
+{
+    if (im->strike_done) return;
+    int touched = 0;
+    for (int p = 0; p < im->nprey; p++) {
+        if (!im->touched[p]) continue;
+        touched++;
+        double along = spn_v3_dot(spn_world_velocity(w, im->prey[p]), im->dir0[p]);
+        if (along > 0 && outcome(im, w, p) != SPN_PREY_PASSED) return;
+    }
+    if (!touched) return;
+    im->strike_done = true;
+    im->strike_time = spn_world_time(w);
+    spn_impact_report_get(im, w, &im->strike);
+}
+
 static spn_prey_outcome outcome(const spn_impact *im, const spn_world *w, int p)
 {
     if (!im->touched[p]) return SPN_PREY_MISSED;
@@ -184,6 +208,17 @@ void spn_impact_report_get(spn_impact *im, const spn_world *w, spn_impact_report
         r->kinds[i] = im->kinds[i];
         r->kinds[i].elastic = im->elastic[i] - im->elastic0[i];
         lost += r->kinds[i].damping + r->kinds[i].broken + r->kinds[i].plastic;
+    }
+    r->strike_time = im->strike_done ? im->strike_time : -1;
+    if (im->strike_done) {
+        r->strike_prey_kinetic_lost = im->strike.prey_kinetic_start - im->strike.prey_kinetic_end;
+        r->strike_air = -im->strike.air_work;
+        r->strike_web_kinetic = im->strike.web_kinetic;
+        r->strike_glue = im->strike.glue;
+        for (int i = 0; i < im->strike.nkinds; i++) {
+            const spn_kind_energy *k = &im->strike.kinds[i];
+            r->strike_absorbed[i] = k->elastic + k->damping + k->plastic + k->broken;
+        }
     }
     r->balance_error = fabs(r->total_now + lost - r->air_work - r->wind_work - r->total_start);
 }

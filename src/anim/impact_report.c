@@ -38,6 +38,21 @@ static spn_status write_kinds(const spn_impact_report *r, spn_sink *s, double lo
     return st;
 }
 
+/* The partition when the strike ended: what stopped (or slowed) the prey. */
+static spn_status write_strike(const spn_impact_report *r, spn_sink *s)
+{
+    double lost = r->strike_prey_kinetic_lost;
+    spn_status st = spn_sink_printf(s, "  \"strike\": {\"ended\": %s, \"time\": %.6g, \"prey_kinetic_lost\": %.9g",
+                                    r->strike_time >= 0 ? "true" : "false", r->strike_time, lost);
+    for (int i = 0; i < r->nkinds && st == SPN_OK; i++)
+        st = spn_sink_printf(s, ", \"%s\": %.6f", kind_name(r->kinds[i].tag), lost > 0 ? r->strike_absorbed[i] / lost : 0);
+    if (st == SPN_OK)
+        st = spn_sink_printf(s, ",\n    \"air_drag\": %.6f, \"glue\": %.6f, \"web_kinetic\": %.6f},\n",
+                             lost > 0 ? r->strike_air / lost : 0, lost > 0 ? r->strike_glue / lost : 0,
+                             lost > 0 ? r->strike_web_kinetic / lost : 0);
+    return st;
+}
+
 spn_status spn_impact_report_write(const spn_impact_report *r, spn_sink *s)
 {
     double lost = r->prey_kinetic_start - r->prey_kinetic_end;
@@ -55,6 +70,7 @@ spn_status spn_impact_report_write(const spn_impact_report *r, spn_sink *s)
                              r->web_kinetic, r->viscous, r->glue, r->glue_held, r->wind_work, r->contact_energy, r->total_start, r->total_now,
                              r->balance_error, r->prey_kinetic_start > 0 ? r->balance_error / r->prey_kinetic_start : 0);
     if (st == SPN_OK) st = write_kinds(r, s, lost);
+    if (st == SPN_OK) st = write_strike(r, s);
     if (st == SPN_OK) st = spn_sink_printf(s, "  \"broken\": {");
     int first = 1;
     for (int i = 0; i < r->nkinds && st == SPN_OK; i++) {
