@@ -129,10 +129,17 @@ spn_status spn_prey_parse(const char *text, spn_prey_def *out)
     if (!text || sscanf(text, "%lf,%lf,%lf;%lf,%lf,%lf;%lf;%lf%c", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6],
                         &v[7], &tail) != 8)
         return spn_error(SPN_ERR_INVALID, "impact '%s': expected \"x,y,z;vx,vy,vz;mass;radius\"", text ? text : "");
-    for (int i = 0; i < 8; i++)
-        if (!isfinite(v[i])) return spn_error(SPN_ERR_INVALID, "impact '%s': values must be finite", text);
-    if (!(v[6] > 0)) return spn_error(SPN_ERR_INVALID, "impact '%s': mass must be > 0", text);
-    if (!(v[7] > 0)) return spn_error(SPN_ERR_INVALID, "impact '%s': radius must be > 0", text);
+    /* Ranges wide enough for any prey, narrow enough that the contact's time
+     * step stays usable: a 1e-300 kg speck made the run take forever, and
+     * 1e300 m/s blew it up at the first step. */
+    static const struct { const char *what; double lo, hi; } range[] = {
+        {"position [m]", -1e6, 1e6}, {"velocity [m/s]", -1e3, 1e3}, {"mass [kg]", 1e-9, 100}, {"radius [m]", 1e-6, 10}};
+    for (int i = 0; i < 8; i++) {
+        int r = i < 3 ? 0 : i < 6 ? 1 : i - 4;
+        if (!(v[i] >= range[r].lo && v[i] <= range[r].hi))
+            return spn_error(SPN_ERR_INVALID, "impact '%s': %s must be in [%g, %g], got %g", text, range[r].what,
+                             range[r].lo, range[r].hi, v[i]);
+    }
     out->position = spn_v3(v[0], v[1], v[2]);
     out->velocity = spn_v3(v[3], v[4], v[5]);
     out->mass = v[6];

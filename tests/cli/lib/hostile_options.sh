@@ -37,6 +37,9 @@ values() { # kind lo hi -> one value a line
   anchors) printf '%s\n' '0,0;0,0;0,0' 'nan,0;1,0;0,1' '1e300,0;0,1e300;-1e300,0' '0,0;1,0' '' ';;;' \
              '1e-300,0;0,1e-300;-1e-300,0' '0,0;1,0;2,0' '-1,-1;1,-1;1,1;-1,1' \
              "$(for i in $(seq 0 64); do printf '%s,%s;' "$i" "$((i % 2))"; done)" ;;
+  prey) printf '%s\n' '0,0,-0.1;0,0,1;0;0.004' '0,0,-0.1;0,0,1;-1;0.004' '0,0,-0.1;0,0,1;0.0002;0' \
+          'nan,0,0;0,0,1;0.0002;0.004' '1e300,0,0;0,0,1e300;1e300;1e300' '0,0,-0.1;0,0,1;1e-300;1e-300' \
+          '0,0,-0.1;0,0,1;0.0002' '' ;;
   scene) printf '%s\n' 0x5 -1x5 1e300x5 nanx3 "$((hi + 1))x1" 1x1 2x3 "x" ;;
   esac
 }
@@ -73,7 +76,7 @@ check() { # row-description option value args...
   case $rc in
   0) finite_output "$out" || fail "$what $opt '$value': exit 0 but output missing or not finite" ;;
   2) grep -qF -- "$opt" "$T/err" || fail "$what $opt '$value': refused without naming the option: $(head -c 300 "$T/err")"
-     grep -qE '\[|expected|between|range' "$T/err" || fail "$what $opt '$value': refused without a range: $(head -c 300 "$T/err")"
+     grep -qE '\[|expected|between|range|must' "$T/err" || fail "$what $opt '$value': refused without a range: $(head -c 300 "$T/err")"
      [ -e "$out" ] && fail "$what $opt '$value': refused but left $out" ;;
   124) fail "$what $opt '$value': hung (killed after ${LIMIT}s)" ;;
   *) fail "$what $opt '$value': exit $rc: $(head -c 300 "$T/err")" ;;
