@@ -17,14 +17,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     if (size > 4096 || memchr(data, 0, size)) return -1; /* argv cannot hold a NUL */
-    char *text = malloc(size + 1);
-    memcpy(text, data, size);
-    text[size] = '\0';
-    char *argv[] = {"build", "--method", "geometric", "--anchors", text, NULL};
+    /* "--anchors=TEXT": as a separate argument "-h" would be taken for --help. */
+    char *text = malloc(size + 11);
+    memcpy(text, "--anchors=", 10);
+    memcpy(text + 10, data, size);
+    text[size + 10] = '\0';
+    char *argv[] = {"build", "--method", "geometric", text, NULL};
     int err = dup(2), null = open("/dev/null", O_WRONLY);
     dup2(null, 2);
     optind = 0;
-    int rc = cmd_build(5, argv);
+    int rc = cmd_build(4, argv);
     dup2(err, 2);
     close(err), close(null);
     free(text);

@@ -3,7 +3,8 @@
 # its corpus seeded from the globs in fuzz/seeds/<harness>. Prints one JSON line
 # per harness (executions, corpus size, crashes) and fails if any crashed;
 # crashing inputs are kept in BUILD/fuzz-crashes/ (make each one a test in
-# tests/data/bad/ before fixing it). FUZZ_ONLY=fuzz_cli runs one harness.
+# tests/data/bad/ before fixing it). FUZZ_ONLY=fuzz_cli runs one harness;
+# FUZZ_TIMEOUT (default 25 s) is the slowest input allowed.
 set -u
 seconds=${FUZZ_SECONDS:-60}
 # Absolute: a harness may work in a folder of its own (fuzz_cli does).
@@ -41,7 +42,7 @@ for h in "$build"/fuzz/${FUZZ_ONLY:-fuzz_*}; do
   dictarg=()
   [ -s "$dict" ] && dictarg=(-dict="$dict")
   log="$build/fuzz-$name.log"
-  "$h" "${dictarg[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=1024 \
+  "$h" "${dictarg[@]}" -max_total_time="$seconds" -timeout="${FUZZ_TIMEOUT:-25}" -rss_limit_mb=2048 -malloc_limit_mb=1024 \
        -print_final_stats=1 -artifact_prefix="$crashes/$name-" "$corpus" >"$log" 2>&1
   rc=$?
   runs=$(grep -o 'Done [0-9]* runs' "$log" | tail -1 | grep -o '[0-9]*')
