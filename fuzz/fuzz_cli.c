@@ -54,7 +54,7 @@ static const command commands[] = {
 typedef struct limits {
     const char *name;
     double cap;
-    const char *extra[6];
+    const char *extra[8]; /* NULL-terminated: at most 7 */
 } limits;
 
 static const limits table[] = {
@@ -250,7 +250,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     const limits *lim = limits_for(c->name);
     for (int i = 1; i < n; i++)
         if (!numbers_within(words[i], lim->cap) || strcmp(words[i], "--") == 0) return free(text), -1;
-    for (int i = 0; lim->extra[i]; i++) words[n++] = (char *)lim->extra[i];
+    for (int i = 0; i < 8 && lim->extra[i]; i++) words[n++] = (char *)lim->extra[i];
     words[n] = NULL;
     int rc = run(c, n, words);
     if (rc < 0 || rc > 2) {
