@@ -8,5 +8,6 @@
 #include "web.h"
 #include "io.h"
 #include "scenes.h"
+#include "inscribe.h"
 
 #endif
