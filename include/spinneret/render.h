@@ -51,6 +51,7 @@ typedef struct spn_render_def {
     spn_colour_by colour_by;
     spn_dew_def dew;
     bool legend;                   ///< draw the legend for colour_by modes, default true
+    double glow;                   ///< soft halo around threads 0..1, default 0 (the thesis look)
 } spn_render_def;
 
 SPN_API spn_render_def spn_render_def_default(void);
@@ -70,6 +71,84 @@ SPN_API spn_status spn_frames_open(const char *out, int width, int height, doubl
 SPN_API void spn_frames_set_first_index(spn_frames *frames, int index);
 SPN_API spn_status spn_frames_add(spn_frames *frames, const uint8_t *rgba);
 SPN_API spn_status spn_frames_close(spn_frames *frames, bool commit);
+
+
+/* ---- additions (render helper) ----------------------------------------- */
+
+/// Line width [px on a 1200 px canvas] and grey factor of a thread kind; unknown
+/// tags get the generic style. The shade drawn is shade_rgb * factor.
+SPN_API double spn_thread_kind_width(uint32_t tag);
+SPN_API double spn_thread_kind_shade(uint32_t tag);
+
+/* ---- drawing callbacks ------------------------------------------------- *
+ * The web is emitted as strands (one smooth path each: consecutive springs of
+ * one kind chained through particles of degree 2 for that kind), beads (dew
+ * droplets) and labels (the legend). Cairo, the viewer and the exporters
+ * implement the table; all coordinates are world coordinates. */
+
+/// A chain of springs of one kind, drawn as one path.
+typedef struct spn_strand {
+    uint32_t kind;               ///< thread tag of every spring in the strand
+    uint32_t count;              ///< points (springs + 1, or springs when closed)
+    const spn_vec3 *points;      ///< world positions
+    const uint32_t *particles;   ///< particle id of each point
+    const uint32_t *springs;     ///< spring id of each segment (count - 1, or count when closed)
+    bool closed;                 ///< the last point joins the first
+    double width;                ///< line width [px on a 1200 px canvas], width_scale applied
+    double rgb[3];               ///< colour of the whole strand (shade or kind colour)
+    const double *segment_rgb;   ///< colour_by tension/strain: 3 values per segment, else NULL
+    double alpha;                ///< opacity 0..1
+} spn_strand;
+
+/// A dew droplet: a small water sphere.
+typedef struct spn_bead {
+    spn_vec3 centre;
+    double radius;               ///< [m]
+    uint32_t strand_kind;        ///< the kind of thread it sits on
+} spn_bead;
+
+/// One row of the legend: a colour swatch and its text. Row 0 is the title
+/// (its swatch unused).
+typedef struct spn_label {
+    const char *text;
+    double rgb[3];
+    int row;
+    int rows;                    ///< rows in this legend
+} spn_label;
+
+typedef struct spn_draw_fns {
+    spn_status (*strand)(void *user, const spn_strand *strand);  ///< may be NULL
+    spn_status (*bead)(void *user, const spn_bead *bead);        ///< may be NULL
+    spn_status (*label)(void *user, const spn_label *label);     ///< may be NULL
+} spn_draw_fns;
+
+/// Emit the world through `fns`: strands first (heavier kinds first, so fine
+/// threads lie on top), then dew beads when def->dew.enabled, then the legend
+/// when def->legend and a colour_by mode asks for one. Stops at the first
+/// callback that fails and returns its status.
+SPN_API spn_status spn_draw_world(const spn_world *w, const spn_render_def *def, const spn_draw_fns *fns, void *user);
+
+/// Defaults for dew: spacing 4 mm, radius 0.7 mm, jitter 0.35, seed 1, disabled.
+SPN_API spn_dew_def spn_dew_def_default(void);
+
+/// Check a render definition; SPN_ERR_INVALID naming the first bad field.
+SPN_API spn_status spn_render_def_check(const spn_render_def *def);
+
+/// Is the ffmpeg program on PATH (or $SPN_FFMPEG)? Frame sequences to .mp4/.gif need it.
+SPN_API bool spn_frames_have_ffmpeg(void);
+/// The frame size a sequence was opened with.
+SPN_API void spn_frames_size(const spn_frames *frames, int *width, int *height);
+
+/* ---- progress on stderr ------------------------------------------------ */
+
+/// A one-line progress bar on stderr, shown only when stderr is a terminal
+/// and `quiet` is false (animating commands pass their --quiet). NULL-safe:
+/// every function accepts the NULL that begin returns when it shows nothing.
+typedef struct spn_progress spn_progress;
+SPN_API spn_progress *spn_progress_begin(const char *label, uint64_t total, bool quiet);
+SPN_API void spn_progress_update(spn_progress *progress, uint64_t done);
+/// Finish the line and free the bar.
+SPN_API void spn_progress_end(spn_progress *progress);
 
 #ifdef __cplusplus
 }

@@ -8,6 +8,7 @@
 #include "web.h"
 #include "io.h"
 #include "scenes.h"
+#include "render.h"
 #include "inscribe.h"
 
 #endif

@@ -1,0 +1,177 @@
+// Peer benchmark: the standard orb web (spn_scene_orb) stepped by Bullet's
+// btSoftBody and by Spinneret's symplectic Euler in one run: same nodes,
+// masses, fixed flags, springs, rest lengths, dt and step count. Prints one
+// JSON line per size with both costs in ns per spring per step and the ratio.
+//
+// Bullet recomputes rest lengths from the current positions on its first
+// step; the web is pre-strained, so after updateConstants() we clear
+// m_bUpdateRtCst and write the rest lengths (m_rl, m_c1 = rl^2, m_c0) ourselves.
+// Bullet's links are position-based (stiffness kLST in [0, 1], one iteration;
+// we give each link the kLST that matches our spring's stiffness at this dt):
+// the figure compares the cost of a step, and the strain error after the run
+// (against a reference run at a tenth of the step) says what each step buys.
+// This is the one place C++ is allowed (Bullet is C++).
+#include <BulletSoftBody/btSoftBody.h>
+#include <BulletSoftBody/btSoftBodyHelpers.h>
+#include <BulletCollision/BroadphaseCollision/btDbvtBroadphase.h>
+#include <BulletCollision/CollisionDispatch/btCollisionDispatcher.h>
+#include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
+
+extern "C" {
+#include <spinneret/spinneret.h>
+}
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+static double seconds_now()
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+static spn_world *make_web(int rings, int radials)
+{
+    spn_world_def def = spn_world_def_default();
+    def.threads = 1;
+    spn_orb_scene_def d = spn_orb_scene_def_default();
+    d.rings = rings;
+    d.radials = radials;
+    d.damping_ratio = 0; // Bullet's links have no axial damping: compare like with like
+    d.tension_only = false;
+    spn_world *w = nullptr;
+    if (spn_scene_orb(&def, &d, &w) != SPN_OK) {
+        std::fprintf(stderr, "bullet_orb: %s\n", spn_last_error());
+        std::exit(1);
+    }
+    return w;
+}
+
+// Largest |strain - reference strain| over the springs of w.
+static double strain_error(const spn_world *w, const std::vector<double> &ref)
+{
+    double e = 0;
+    for (uint32_t s = 0; s < spn_world_spring_count(w); s++) {
+        spn_spring_info si = spn_world_spring(w, s);
+        e = std::fmax(e, std::fabs((si.length - si.rest) / si.rest - ref[s]));
+    }
+    return e;
+}
+
+static std::vector<double> strains(const spn_world *w)
+{
+    std::vector<double> out(spn_world_spring_count(w));
+    for (uint32_t s = 0; s < out.size(); s++) {
+        spn_spring_info si = spn_world_spring(w, s);
+        out[s] = (si.length - si.rest) / si.rest;
+    }
+    return out;
+}
+
+struct bullet_run {
+    double ns_per_spring_step;
+    double strain_error;
+};
+
+static bullet_run run_bullet(const spn_world *w, double dt, int steps, const std::vector<double> &ref)
+{
+    uint32_t np = spn_world_particle_count(w), ns = spn_world_spring_count(w);
+    btSoftBodyWorldInfo info;
+    btDefaultCollisionConfiguration config;
+    btCollisionDispatcher dispatcher(&config);
+    btDbvtBroadphase broadphase;
+    info.m_dispatcher = &dispatcher;
+    info.m_broadphase = &broadphase;
+    spn_vec3 g = spn_world_get_def(w)->gravity;
+    info.m_gravity.setValue(g.x, g.y, g.z);
+    info.m_sparsesdf.Initialize();
+
+    std::vector<btVector3> x(np);
+    std::vector<btScalar> m(np);
+    for (uint32_t i = 0; i < np; i++) {
+        spn_vec3 p = spn_world_position(w, i);
+        x[i].setValue(p.x, p.y, p.z);
+        m[i] = spn_world_is_fixed(w, i) ? 0 : spn_world_mass(w, i);
+    }
+    btSoftBody *sb = new btSoftBody(&info, (int)np, x.data(), m.data());
+    // A link's kLST is the fraction of its constraint error removed per step;
+    // k dt^2 (1/m_a + 1/m_b) gives the same impulse per step as our spring of
+    // stiffness k, so both engines step the same physical web.
+    for (uint32_t s = 0; s < ns; s++) {
+        spn_spring_info si = spn_world_spring(w, s);
+        btSoftBody::Material *mat = sb->appendMaterial();
+        double im = (m[si.a] > 0 ? 1 / m[si.a] : 0) + (m[si.b] > 0 ? 1 / m[si.b] : 0);
+        mat->m_kLST = (btScalar)std::fmin(1.0, si.k * dt * dt * im);
+        sb->appendLink((int)si.a, (int)si.b, mat);
+    }
+    sb->m_cfg.piterations = 1;
+    sb->m_cfg.kDP = 0;
+    sb->m_cfg.collisions = 0;
+    sb->updateConstants();
+    sb->m_bUpdateRtCst = false;
+    for (uint32_t s = 0; s < ns; s++) {
+        btSoftBody::Link &l = sb->m_links[(int)s];
+        l.m_rl = spn_world_spring(w, s).rest;
+        l.m_c1 = l.m_rl * l.m_rl;
+        l.m_c0 = (l.m_n[0]->m_im + l.m_n[1]->m_im) / l.m_material->m_kLST;
+    }
+    double t0 = seconds_now();
+    for (int k = 0; k < steps; k++) {
+        sb->predictMotion(dt);
+        sb->solveConstraints();
+        sb->integrateMotion();
+    }
+    double t1 = seconds_now();
+    // Strain error of Bullet's end state, measured with our springs' rest lengths.
+    spn_world *copy = spn_world_clone(w);
+    for (uint32_t i = 0; i < np; i++) {
+        const btVector3 &p = sb->m_nodes[(int)i].m_x;
+        spn_world_set_position(copy, i, spn_v3(p.x(), p.y(), p.z()));
+    }
+    bullet_run r = {(t1 - t0) * 1e9 / ((double)ns * steps), strain_error(copy, ref)};
+    spn_world_destroy(copy);
+    delete sb;
+    return r;
+}
+
+static double run_spinneret(spn_world *w, double dt, int steps)
+{
+    spn_world_set_integrator(w, SPN_INTEGRATOR_SYMPLECTIC);
+    spn_world_compile(w);
+    double t0 = seconds_now();
+    for (int k = 0; k < steps; k++)
+        if (spn_world_step(w, dt) != SPN_OK) {
+            std::fprintf(stderr, "bullet_orb: %s\n", spn_last_error());
+            std::exit(1);
+        }
+    return (seconds_now() - t0) * 1e9 / ((double)spn_world_spring_count(w) * steps);
+}
+
+int main(int argc, char **argv)
+{
+    struct size { int rings, radials, steps; } sizes[] = {{40, 125, 2000}, {250, 400, 100}, {1000, 1000, 10}};
+    int nsizes = argc > 1 && std::strcmp(argv[1], "--small") == 0 ? 1 : 3;
+    const double dt = 1e-6; // explicit stability at the stiff inner rings of the standard web
+    for (int k = 0; k < nsizes; k++) {
+        const size &sz = sizes[k];
+        spn_world *reference = make_web(sz.rings, sz.radials);
+        for (int i = 0; i < sz.steps * 10; i++) spn_world_step(reference, dt / 10);
+        std::vector<double> ref = strains(reference);
+        spn_world_destroy(reference);
+
+        spn_world *w = make_web(sz.rings, sz.radials);
+        bullet_run b = run_bullet(w, dt, sz.steps, ref);
+        double ours = run_spinneret(w, dt, sz.steps);
+        std::printf("{\"bench\":\"peer_bullet_softbody\",\"particles\":%u,\"springs\":%u,\"dt\":%g,\"steps\":%d,"
+                    "\"threads\":1,\"bullet_ns_per_spring_step\":%.3f,\"spinneret_ns_per_spring_step\":%.3f,"
+                    "\"ratio\":%.2f,\"bullet_strain_error\":%.3g,\"spinneret_strain_error\":%.3g}\n",
+                    spn_world_particle_count(w), spn_world_spring_count(w), dt, sz.steps, b.ns_per_spring_step, ours,
+                    b.ns_per_spring_step / ours, b.strain_error, strain_error(w, ref));
+        std::fflush(stdout);
+        spn_world_destroy(w);
+    }
+    return 0;
+}

@@ -1,0 +1,370 @@
+/* Rendering measured, never compared with golden pictures: ink lies where the
+ * springs are and nowhere else (coverage against the analytic stroke area),
+ * alpha 0.7 over white gives the expected blend, joints of a strand are not
+ * darker than its middle, a background image shows through where no thread
+ * is, strands and dew come out in the numbers the geometry predicts, and bad
+ * definitions are refused with no file left behind. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <cairo.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include <spinneret/spinneret.h>
+
+#define SIDE 200
+
+/* A world of straight springs between the given points (x0, y0, x1, y1). */
+static spn_world *segments_world(const double (*seg)[4], int n, uint32_t tag)
+{
+    spn_world *w = spn_world_create(NULL);
+    for (int i = 0; i < n; i++) {
+        spn_particle_def p = spn_particle_def_default();
+        uint32_t a, b;
+        p.fixed = true;
+        p.position = spn_v3(seg[i][0], seg[i][1], 0);
+        assert_int_equal(spn_world_add_particle(w, &p, &a), SPN_OK);
+        p.position = spn_v3(seg[i][2], seg[i][3], 0);
+        assert_int_equal(spn_world_add_particle(w, &p, &b), SPN_OK);
+        spn_spring_def s = spn_spring_def_default();
+        s.a = a;
+        s.b = b;
+        s.k = 1;
+        s.rest = -1;
+        s.tag = tag;
+        assert_int_equal(spn_world_add_spring(w, &s, NULL), SPN_OK);
+    }
+    return w;
+}
+
+/* A known mapping: world [-0.5, 0.5]^2 onto SIDE x SIDE pixels, 200 px/m,
+ * lines `px` pixels wide (generic kind), white threads, black background. */
+static spn_render_def known_def(double px)
+{
+    spn_render_def d = spn_render_def_default();
+    d.width = d.height = SIDE;
+    d.camera.fixed_bounds = true;
+    d.camera.bounds_min = spn_v3(-0.5, -0.5, 0);
+    d.camera.bounds_max = spn_v3(0.5, 0.5, 0);
+    d.camera.margin = 0;
+    d.shade_rgb[0] = d.shade_rgb[1] = d.shade_rgb[2] = 1;
+    d.width_scale = px / (spn_thread_kind_width(SPN_THREAD_GENERIC) * SIDE / 1200.0);
+    return d;
+}
+
+/* Distance from pixel centre (x, y) to the segment (a, b) in pixels. */
+static double seg_dist(double x, double y, const double *s)
+{
+    double ax = 100 + 200 * s[0], ay = 100 - 200 * s[1], bx = 100 + 200 * s[2], by = 100 - 200 * s[3];
+    double dx = bx - ax, dy = by - ay, t = ((x - ax) * dx + (y - ay) * dy) / (dx * dx + dy * dy);
+    t = t < 0 ? 0 : t > 1 ? 1 : t;
+    return hypot(x - ax - t * dx, y - ay - t * dy);
+}
+
+static void test_ink_where_expected(void **state)
+{
+    (void)state;
+    const double seg[2][4] = {{-0.4, 0.2, 0.4, 0.2}, {-0.2, -0.4, -0.2, -0.1}};
+    spn_world *w = segments_world(seg, 2, SPN_THREAD_GENERIC);
+    const double width = 4;
+    spn_render_def d = known_def(width);
+    uint8_t *px = malloc(SIDE * SIDE * 4);
+    assert_int_equal(spn_render_rgba(w, &d, px), SPN_OK);
+    double ink = 0, stray = 0, inside_min = 255;
+    for (int y = 0; y < SIDE; y++)
+        for (int x = 0; x < SIDE; x++) {
+            double v = px[(y * SIDE + x) * 4], dist = fmin(seg_dist(x + 0.5, y + 0.5, seg[0]), seg_dist(x + 0.5, y + 0.5, seg[1]));
+            ink += v / 255;
+            if (dist > width / 2 + 1) stray += v;
+            if (dist < width / 2 - 1) inside_min = fmin(inside_min, v);
+        }
+    /* Two strokes with round caps: length * width + a disc each. */
+    double expected = (160 + 60) * width + 2 * SPN_PI * width * width / 4;
+    assert_true(stray == 0);
+    assert_true(inside_min >= 254);
+    assert_true(fabs(ink - expected) < 0.03 * expected);
+    free(px);
+    spn_world_destroy(w);
+}
+
+/* A bent chain of three springs: one strand, so its joints blend like its middle. */
+static void test_alpha_blend_and_joints(void **state)
+{
+    (void)state;
+    spn_world *w = spn_world_create(NULL);
+    const double pts[4][2] = {{-0.4, -0.3}, {-0.1, 0.3}, {0.2, -0.3}, {0.4, 0.3}};
+    for (int i = 0; i < 4; i++) {
+        spn_particle_def p = spn_particle_def_default();
+        p.position = spn_v3(pts[i][0], pts[i][1], 0);
+        assert_int_equal(spn_world_add_particle(w, &p, NULL), SPN_OK);
+    }
+    for (uint32_t i = 0; i < 3; i++) {
+        spn_spring_def s = spn_spring_def_default();
+        s.a = i;
+        s.b = i + 1;
+        s.k = 1;
+        s.rest = -1;
+        assert_int_equal(spn_world_add_spring(w, &s, NULL), SPN_OK);
+    }
+    spn_render_def d = known_def(8);
+    const double shade[3] = {0.2, 0.4, 0.6};
+    for (int c = 0; c < 3; c++) d.shade_rgb[c] = shade[c], d.background_rgb[c] = 1;
+    d.alpha = 0.7;
+    uint8_t *px = malloc(SIDE * SIDE * 4);
+    assert_int_equal(spn_render_rgba(w, &d, px), SPN_OK);
+    /* Middle of the first segment, and the two joints. */
+    const double probe[3][2] = {{-0.25, 0.0}, {-0.1, 0.3}, {0.2, -0.3}};
+    for (int k = 0; k < 3; k++) {
+        int x = (int)(100 + 200 * probe[k][0]), y = (int)(100 - 200 * probe[k][1]);
+        for (int c = 0; c < 3; c++) {
+            double expected = 255 * (0.7 * shade[c] + 0.3);
+            assert_true(fabs(px[(y * SIDE + x) * 4 + c] - expected) <= 2);
+        }
+    }
+    free(px);
+    spn_world_destroy(w);
+}
+
+/* A 4 x 2 test image of four coloured quadrants, stretched over a square
+ * canvas by cover scaling: the middle half of the image width shows. */
+static const char *write_test_background(char *path, size_t n)
+{
+    snprintf(path, n, "%s/render_bg_%ld.png", SPN_BUILD_DIR, (long)getpid());
+    cairo_surface_t *s = cairo_image_surface_create(CAIRO_FORMAT_RGB24, 400, 200);
+    cairo_t *cr = cairo_create(s);
+    const double q[4][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}};
+    for (int i = 0; i < 4; i++) {
+        cairo_rectangle(cr, (i % 2) * 200, (i / 2) * 100, 200, 100);
+        cairo_set_source_rgb(cr, q[i][0], q[i][1], q[i][2]);
+        cairo_fill(cr);
+    }
+    cairo_destroy(cr);
+    assert_int_equal(cairo_surface_write_to_png(s, path), CAIRO_STATUS_SUCCESS);
+    cairo_surface_destroy(s);
+    return path;
+}
+
+static void test_background_shows_where_no_thread(void **state)
+{
+    (void)state;
+    char path[512];
+    const double seg[1][4] = {{-0.5, 0.0, 0.5, 0.0}};
+    spn_world *w = segments_world(seg, 1, SPN_THREAD_GENERIC);
+    spn_render_def d = known_def(4);
+    d.background_png = write_test_background(path, sizeof path);
+    uint8_t *px = malloc(SIDE * SIDE * 4);
+    assert_int_equal(spn_render_rgba(w, &d, px), SPN_OK);
+    /* Canvas quadrants show image quadrants: the image is 2:1, scaled by 1
+     * to 200 px high and cropped to its middle 200 px. */
+    const int probe[4][2] = {{50, 40}, {150, 40}, {50, 160}, {150, 160}};
+    const uint8_t want[4][3] = {{255, 0, 0}, {0, 255, 0}, {0, 0, 255}, {255, 255, 0}};
+    for (int k = 0; k < 4; k++)
+        for (int c = 0; c < 3; c++) assert_int_equal(px[(probe[k][1] * SIDE + probe[k][0]) * 4 + c], want[k][c]);
+    /* The thread covers the image on its line. */
+    assert_int_equal(px[(100 * SIDE + 30) * 4 + 2], 255);
+    assert_int_equal(px[(100 * SIDE + 30) * 4 + 1], 255);
+    remove(path);
+    d.background_png = "/nonexistent/sky.png";
+    assert_int_equal(spn_render_rgba(w, &d, px), SPN_ERR_IO);
+    assert_non_null(strstr(spn_last_error(), "/nonexistent/sky.png"));
+    free(px);
+    spn_world_destroy(w);
+}
+
+typedef struct counts {
+    int strands, closed, segments, beads, labels;
+    uint32_t kinds_seen[8];
+    double bead_radius_sum;
+    int main_beads;
+    double main_radius_sum, dew_radius;
+} counts;
+
+static spn_status count_strand(void *user, const spn_strand *s)
+{
+    counts *c = user;
+    c->strands++;
+    c->closed += s->closed;
+    c->segments += (int)(s->closed ? s->count : s->count - 1);
+    return SPN_OK;
+}
+
+static spn_status count_bead(void *user, const spn_bead *b)
+{
+    counts *c = user;
+    c->beads++;
+    if (b->radius > 0.5 * c->dew_radius) {
+        c->main_beads++;
+        c->main_radius_sum += b->radius;
+    }
+    return SPN_OK;
+}
+
+static spn_status count_label(void *user, const spn_label *l)
+{
+    (void)l;
+    ((counts *)user)->labels++;
+    return SPN_OK;
+}
+
+/* The standard web: each radius is one strand from the hub to the rim, each
+ * ring one closed strand; every spring is drawn once. */
+static void test_orb_web_strands(void **state)
+{
+    (void)state;
+    spn_orb_scene_def od = spn_orb_scene_def_default();
+    od.rings = 7;
+    od.radials = 11;
+    spn_world *w;
+    assert_int_equal(spn_scene_orb(NULL, &od, &w), SPN_OK);
+    spn_render_def d = spn_render_def_default();
+    d.colour_by = SPN_COLOUR_KIND;
+    counts c = {0};
+    spn_draw_fns fns = {count_strand, count_bead, count_label};
+    assert_int_equal(spn_draw_world(w, &d, &fns, &c), SPN_OK);
+    assert_int_equal(c.strands, 11 + 7);
+    assert_int_equal(c.closed, 7);
+    assert_int_equal(c.segments, (int)spn_world_spring_count(w));
+    assert_int_equal(c.labels, 1 + 3); /* title, frame, radius, capture */
+    spn_world_destroy(w);
+}
+
+/* Dew along the capture rings: main drops every `spacing` on average, of
+ * mean radius `radius`, the same drops for the same seed. */
+static void test_dew_spacing_and_radius(void **state)
+{
+    (void)state;
+    spn_orb_scene_def od = spn_orb_scene_def_default();
+    spn_world *w;
+    assert_int_equal(spn_scene_orb(NULL, &od, &w), SPN_OK);
+    double capture = 0;
+    for (uint32_t s = 0; s < spn_world_spring_count(w); s++) {
+        spn_spring_info info = spn_world_spring(w, s);
+        if (info.tag == SPN_THREAD_CAPTURE) capture += info.length;
+    }
+    spn_render_def d = spn_render_def_default();
+    d.dew.enabled = true;
+    d.dew.spacing = 3e-3;
+    d.dew.radius = 0.5e-3;
+    counts a = {0}, b = {0};
+    a.dew_radius = b.dew_radius = d.dew.radius;
+    spn_draw_fns fns = {NULL, count_bead, NULL};
+    assert_int_equal(spn_draw_world(w, &d, &fns, &a), SPN_OK);
+    assert_int_equal(spn_draw_world(w, &d, &fns, &b), SPN_OK);
+    assert_int_equal(a.beads, b.beads);
+    assert_true(a.main_radius_sum == b.main_radius_sum);
+    double expected = capture / d.dew.spacing;
+    assert_true(fabs(a.main_beads - expected) < 0.05 * expected);
+    assert_true(fabs(a.main_radius_sum / a.main_beads - d.dew.radius) < 0.05 * d.dew.radius);
+    d.dew.seed = 2;
+    counts e = {0};
+    e.dew_radius = d.dew.radius;
+    assert_int_equal(spn_draw_world(w, &d, &fns, &e), SPN_OK);
+    assert_true(e.main_radius_sum != a.main_radius_sum);
+    spn_world_destroy(w);
+}
+
+static void test_deterministic_pixels(void **state)
+{
+    (void)state;
+    spn_world *w;
+    assert_int_equal(spn_scene_orb(NULL, NULL, &w), SPN_OK);
+    spn_render_def d = spn_render_def_default();
+    d.width = d.height = 300;
+    d.dew.enabled = true;
+    d.glow = 0.5;
+    uint8_t *a = malloc(300 * 300 * 4), *b = malloc(300 * 300 * 4);
+    assert_int_equal(spn_render_rgba(w, &d, a), SPN_OK);
+    assert_int_equal(spn_render_rgba(w, &d, b), SPN_OK);
+    assert_memory_equal(a, b, 300 * 300 * 4);
+    free(a);
+    free(b);
+    spn_world_destroy(w);
+}
+
+/* Tension colouring: a stretched spring takes the top of the scale (red), a
+ * spring at rest the bottom (blue). */
+static void test_colour_by_tension(void **state)
+{
+    (void)state;
+    const double seg[2][4] = {{-0.4, 0.2, 0.4, 0.2}, {-0.4, -0.2, 0.4, -0.2}};
+    spn_world *w = segments_world(seg, 2, SPN_THREAD_GENERIC);
+    spn_world_set_spring_rest(w, 0, 0.5); /* 0.8 m long: tension 0.3 N */
+    spn_render_def d = known_def(6);
+    d.colour_by = SPN_COLOUR_TENSION;
+    d.legend = false;
+    uint8_t *px = malloc(SIDE * SIDE * 4);
+    assert_int_equal(spn_render_rgba(w, &d, px), SPN_OK);
+    const uint8_t *hot = px + (60 * SIDE + 100) * 4, *cold = px + (140 * SIDE + 100) * 4;
+    assert_true(hot[0] > 200 && hot[2] < 80);
+    assert_true(cold[2] > 180 && cold[0] < 80);
+    free(px);
+    spn_world_destroy(w);
+}
+
+static void test_bad_definitions(void **state)
+{
+    (void)state;
+    spn_world *w;
+    assert_int_equal(spn_scene_orb(NULL, NULL, &w), SPN_OK);
+    char path[512];
+    snprintf(path, sizeof path, "%s/render_bad_%ld.png", SPN_BUILD_DIR, (long)getpid());
+    spn_render_def d = spn_render_def_default();
+    d.width = 0;
+    assert_int_equal(spn_render_file(w, &d, path), SPN_ERR_INVALID);
+    d = spn_render_def_default();
+    d.width = d.height = 100000;
+    assert_int_equal(spn_render_file(w, &d, path), SPN_ERR_INVALID);
+    d = spn_render_def_default();
+    d.shade_rgb[1] = NAN;
+    assert_int_equal(spn_render_file(w, &d, path), SPN_ERR_INVALID);
+    assert_non_null(strstr(spn_last_error(), "shade_rgb[1]"));
+    d = spn_render_def_default();
+    d.background_png = "/nonexistent/x.png";
+    assert_int_equal(spn_render_file(w, &d, path), SPN_ERR_IO);
+    assert_int_equal(access(path, F_OK), -1);
+    snprintf(path, sizeof path, "%s/render_bad_%ld.bmp", SPN_BUILD_DIR, (long)getpid());
+    d = spn_render_def_default();
+    assert_int_equal(spn_render_file(w, &d, path), SPN_ERR_INVALID);
+    assert_int_equal(access(path, F_OK), -1);
+    spn_world_destroy(w);
+}
+
+/* SVG and PDF come out as files of their type. */
+static void test_vector_outputs(void **state)
+{
+    (void)state;
+    spn_world *w;
+    assert_int_equal(spn_scene_orb(NULL, NULL, &w), SPN_OK);
+    spn_render_def d = spn_render_def_default();
+    const char *ext[2] = {"svg", "pdf"}, *magic[2] = {"<?xml", "%PDF"};
+    for (int i = 0; i < 2; i++) {
+        char path[512], head[8] = {0};
+        snprintf(path, sizeof path, "%s/render_vec_%ld.%s", SPN_BUILD_DIR, (long)getpid(), ext[i]);
+        assert_int_equal(spn_render_file(w, &d, path), SPN_OK);
+        FILE *fp = fopen(path, "rb");
+        assert_non_null(fp);
+        assert_true(fread(head, 1, 5, fp) > 0);
+        fclose(fp);
+        assert_memory_equal(head, magic[i], strlen(magic[i]));
+        remove(path);
+    }
+    spn_world_destroy(w);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_ink_where_expected),      cmocka_unit_test(test_alpha_blend_and_joints),
+        cmocka_unit_test(test_background_shows_where_no_thread), cmocka_unit_test(test_orb_web_strands),
+        cmocka_unit_test(test_dew_spacing_and_radius),  cmocka_unit_test(test_deterministic_pixels),
+        cmocka_unit_test(test_colour_by_tension),       cmocka_unit_test(test_bad_definitions),
+        cmocka_unit_test(test_vector_outputs),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

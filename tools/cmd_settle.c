@@ -1,0 +1,113 @@
+/* spinneret settle FILE -o OUT: step a web until it is at rest (or out of
+ * time) with spn_world_settle and write the result as a web file. The report
+ * goes to stderr; a run that blows up writes nothing and exits 1. */
+#include "cli.h"
+
+#include <getopt.h>
+#include <stdio.h>
+#include <string.h>
+
+static const char *const CMD = "settle";
+
+static void usage(FILE *out)
+{
+    spn_settle_def d = spn_settle_def_default();
+    fprintf(out,
+            "usage: spinneret settle FILE -o OUT [options]\n"
+            "Step the web in FILE until it is at rest, then write it to OUT (a web file).\n"
+            "At rest: kinetic energy <= --max-kinetic and the largest net force on a free\n"
+            "particle <= --tol. Exits 0 when converged or timed out (the report on stderr\n"
+            "says which), 1 when the simulation blew up (nothing written).\n\n"
+            "  -o, --output OUT      the settled web file (required; may be FILE itself)\n"
+            "      --solver NAME     euler, symplectic, rk4, adaptive or implicit\n"
+            "                        (default: the integrator named in FILE)\n"
+            "      --dt S            time step [s], in [1e-9, 1]; default %g\n"
+            "      --tol N           residual force threshold [N], in [0, 1e6]; default %g\n"
+            "      --max-time S      give up after this much simulated time [s], in [1e-9, 1e7]; default %g\n"
+            "      --max-kinetic J   kinetic energy threshold [J], in [0, 1e6]; default %g\n"
+            "  -h, --help            this text\n",
+            d.dt, d.max_residual, d.max_time, d.max_kinetic);
+}
+
+typedef struct settle_options {
+    const char *input, *output, *solver;
+    spn_settle_def def;
+} settle_options;
+
+/* Fills `o` from argv; returns -1 to go on, else the exit code. */
+static int parse_options(int argc, char **argv, settle_options *o)
+{
+    enum { OPT_SOLVER = 256, OPT_DT, OPT_TOL, OPT_MAX_TIME, OPT_MAX_KINETIC };
+    static const struct option options[] = {{"output", required_argument, NULL, 'o'},
+                                            {"solver", required_argument, NULL, OPT_SOLVER},
+                                            {"dt", required_argument, NULL, OPT_DT},
+                                            {"tol", required_argument, NULL, OPT_TOL},
+                                            {"max-time", required_argument, NULL, OPT_MAX_TIME},
+                                            {"max-kinetic", required_argument, NULL, OPT_MAX_KINETIC},
+                                            {"help", no_argument, NULL, 'h'},
+                                            {NULL, 0, NULL, 0}};
+    opterr = 0;
+    for (int c; (c = getopt_long(argc, argv, ":o:h", options, NULL)) != -1;) {
+        bool ok = true;
+        switch (c) {
+        case 'o': o->output = optarg; break;
+        case OPT_SOLVER: o->solver = optarg; break;
+        case OPT_DT: ok = cli_double(CMD, "--dt", optarg, 1e-9, 1, &o->def.dt); break;
+        case OPT_TOL: ok = cli_double(CMD, "--tol", optarg, 0, 1e6, &o->def.max_residual); break;
+        case OPT_MAX_TIME: ok = cli_double(CMD, "--max-time", optarg, 1e-9, 1e7, &o->def.max_time); break;
+        case OPT_MAX_KINETIC: ok = cli_double(CMD, "--max-kinetic", optarg, 0, 1e6, &o->def.max_kinetic); break;
+        case 'h': usage(stdout); return 0;
+        case ':': return cli_usage(CMD, "%s: missing value", argv[optind - 1]);
+        default: return cli_usage(CMD, "unknown option '%s'", argv[optind - 1]);
+        }
+        if (!ok) return CLI_EXIT_USAGE;
+    }
+    if (optind >= argc) return cli_usage(CMD, "missing FILE");
+    if (optind + 1 < argc) return cli_usage(CMD, "unexpected argument '%s'", argv[optind + 1]);
+    o->input = argv[optind];
+    if (!o->output || !*o->output) return cli_usage(CMD, "-o/--output: the output file is required");
+    spn_integrator integ;
+    if (o->solver && spn_integrator_parse(o->solver, &integ) != SPN_OK)
+        return cli_usage(CMD, "--solver: %s", spn_last_error());
+    return -1;
+}
+
+static void print_report(const spn_settle_report *r, const spn_settle_def *d, const char *solver)
+{
+    if (r->reason == SPN_SETTLE_CONVERGED)
+        fprintf(stderr, "settle: converged after %g s simulated (%llu steps, %s)\n", r->time,
+                (unsigned long long)r->steps, solver);
+    else
+        fprintf(stderr, "settle: timed out after %g s simulated (%llu steps, %s): not at rest\n", r->time,
+                (unsigned long long)r->steps, solver);
+    fprintf(stderr, "  kinetic energy %.6g J (threshold %g)\n", r->kinetic, d->max_kinetic);
+    fprintf(stderr, "  largest residual force %.6g N (threshold %g)\n", r->residual, d->max_residual);
+    fprintf(stderr, "  final energy (kinetic + elastic + gravitational) %.9g J\n", r->total_energy);
+}
+
+int cmd_settle(int argc, char **argv)
+{
+    settle_options o = {NULL, NULL, NULL, spn_settle_def_default()};
+    int code = parse_options(argc, argv, &o);
+    if (code >= 0) return code;
+
+    spn_world *w = NULL;
+    if (spn_web_load(o.input, &w) != SPN_OK) return cli_fail(CMD, "%s", spn_last_error());
+    if (o.solver) {
+        spn_integrator integ = SPN_INTEGRATOR_SYMPLECTIC;
+        spn_integrator_parse(o.solver, &integ);
+        spn_world_set_integrator(w, integ);
+    }
+    spn_settle_report report;
+    spn_status st = spn_world_settle(w, &o.def, &report);
+    if (st != SPN_OK) {
+        spn_world_destroy(w);
+        return cli_fail(CMD, "%s: %s; nothing written", o.input, spn_last_error());
+    }
+    print_report(&report, &o.def, spn_integrator_name(spn_world_get_def(w)->integrator));
+    st = spn_web_save(w, o.output);
+    spn_world_destroy(w);
+    if (st != SPN_OK) return cli_fail(CMD, "%s", spn_last_error());
+    fprintf(stderr, "  wrote %s\n", o.output);
+    return 0;
+}
