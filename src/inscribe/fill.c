@@ -13,6 +13,7 @@
  *     to that node: that is how the fill hangs from the web.
  * Pieces of a split thread keep its material (k scales with 1 / length).
  * Nodes not tied to the web are cleaned away afterwards (spn__clean).
+ * Fill threads are laid at rest length and resist compression (see spn__fill).
  * New threads are SPN_THREAD_INSCRIPTION, which renderers shade apart. */
 #include "inscribe_internal.h"
 
@@ -107,7 +108,8 @@ static spn_status tie_nodes(spn_world *w, const spn_target *t, const grid *g, co
     return st;
 }
 
-/* The node nearest to p within one cell side, or UINT32_MAX. */
+/* The node nearest to p within one cell side, or UINT32_MAX; none when the
+ * nearest is closer than 0.35 of a side (a very short tie would be very stiff). */
 static uint32_t nearest_node(const spn_world *w, const grid *g, spn_vec3 p)
 {
     int ci = (int)floor((p.x - g->x0) / g->h), cj = (int)floor((p.y - g->y0) / g->h);
@@ -121,7 +123,7 @@ static uint32_t nearest_node(const spn_world *w, const grid *g, spn_vec3 p)
             double dist = hypot(d.x, d.y);
             if (dist < bd) bd = dist, best = n;
         }
-    return best;
+    return bd < 0.35 * g->h ? UINT32_MAX : best;
 }
 
 /* Split spring s at the parameters u[0..n) (increasing) and tie each new mass to node[k]. */
@@ -209,6 +211,14 @@ spn_status spn__fill(spn_world *w, const spn_target *t, const spn__material *m, 
     if (!(spacing > 0)) return spn_error(SPN_ERR_INVALID, "fill spacing: need > 0 m");
     spn_rng rng;
     spn_rng_seed(&rng, seed);
+    /* Laid at rest and resisting compression, like the matted silk of a
+     * stabilimentum: a net of tension-only threads with a free edge has no
+     * stiffness and folds up under the slightest load (we watched the
+     * letters crumple), and pre-strained it pulls the radii together. */
+    spn__material fm = *m;
+    fm.prestrain = 0;
+    fm.tension_only = false;
+    m = &fm;
     uint32_t ns0 = spn_world_spring_count(w);
     grid g = {0, 0, spacing, 0, 0, NULL};
     spn_status st = place_nodes(w, t, &g, &rng);

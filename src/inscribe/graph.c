@@ -73,7 +73,7 @@ static double median(double *v, size_t n, double fallback)
 
 spn__material spn__capture_material(const spn_world *w)
 {
-    spn__material m = {0.07, 1e-6, 0.02, 0.02};
+    spn__material m = {0.07, 1e-6, 0.02, 0.02, true};
     uint32_t ns = spn_world_spring_count(w), np = spn_world_particle_count(w), n = 0;
     double *ea = malloc(((size_t)ns + 1) * sizeof *ea), *pre = malloc(((size_t)ns + 1) * sizeof *pre);
     double *zeta = malloc(((size_t)ns + 1) * sizeof *zeta);
@@ -113,7 +113,7 @@ spn_status spn__add_thread(spn_world *w, const spn__material *m, uint32_t a, uin
     d.k = m->ea / d.rest;
     double mseg = m->density * d.rest;
     d.kd = m->damping * 2 * sqrt(d.k * mseg);
-    d.tension_only = true;
+    d.tension_only = m->tension_only;
     d.tag = tag;
     d.stage = tag;
     d.order = spn_world_spring_count(w);

@@ -46,6 +46,7 @@ typedef struct spn__material {
     double density;   /* kg/m */
     double prestrain; /* length / rest - 1 */
     double damping;   /* kd / (2 sqrt(k m_seg)) */
+    bool tension_only;
 } spn__material;
 spn__material spn__capture_material(const spn_world *w);
 /* Add a thread of `tag` from a to b laid at its current length with the material's prestrain. */
