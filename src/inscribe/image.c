@@ -25,7 +25,8 @@ void spn_grey_image_free(spn_grey_image *img)
 typedef struct pnm_reader {
     FILE *fp;
     const char *path;
-    int line;
+    int line;       /* line of the next character */
+    int token_line; /* line where the last number started */
 } pnm_reader;
 
 static int next_char(pnm_reader *r)
@@ -45,15 +46,16 @@ static spn_status read_number(pnm_reader *r, const char *what, long max, long *o
         while (c != EOF && c != '\n') c = next_char(r);
     }
     if (c == EOF) return spn_error(SPN_ERR_FORMAT, "%s:%d: file ends before the %s", r->path, r->line, what);
+    r->token_line = r->line;
     if (!isdigit(c)) return spn_error(SPN_ERR_FORMAT, "%s:%d: %s: expected a number, found '%c'", r->path, r->line, what, c);
     long v = 0;
     while (c != EOF && isdigit(c)) {
         v = v * 10 + (c - '0');
-        if (v > max) return spn_error(SPN_ERR_FORMAT, "%s:%d: %s is above %ld", r->path, r->line, what, max);
+        if (v > max) return spn_error(SPN_ERR_FORMAT, "%s:%d: %s is above %ld", r->path, r->token_line, what, max);
         c = next_char(r);
     }
     if (c != EOF && !isspace(c) && c != '#')
-        return spn_error(SPN_ERR_FORMAT, "%s:%d: %s: unexpected '%c' after the number", r->path, r->line, what, c);
+        return spn_error(SPN_ERR_FORMAT, "%s:%d: %s: unexpected '%c' after the number", r->path, r->token_line, what, c);
     if (c == '#') ungetc(c, r->fp);
     *out = v;
     return SPN_OK;
@@ -123,12 +125,13 @@ static spn_status read_pnm_header(pnm_reader *r, int *type, long *w, long *h, lo
     spn_status st = read_number(r, "width", PNM_MAX_SIDE, w);
     if (st == SPN_OK) st = read_number(r, "height", PNM_MAX_SIDE, h);
     if (st == SPN_OK && (*w == 0 || *h == 0))
-        st = spn_error(SPN_ERR_FORMAT, "%s:%d: image is %ldx%ld; need a positive width and height", r->path, r->line,
+        st = spn_error(SPN_ERR_FORMAT, "%s:%d: image is %ldx%ld; need a positive width and height", r->path, r->token_line,
                        *w, *h);
     *maxval = 1;
     if (st == SPN_OK && (*type == 2 || *type == 5)) {
         st = read_number(r, "maxval", 65535, maxval);
-        if (st == SPN_OK && *maxval == 0) st = spn_error(SPN_ERR_FORMAT, "%s:%d: maxval must be positive", r->path, r->line);
+        if (st == SPN_OK && *maxval == 0)
+            st = spn_error(SPN_ERR_FORMAT, "%s:%d: maxval must be positive", r->path, r->token_line);
     }
     return st;
 }
@@ -136,7 +139,7 @@ static spn_status read_pnm_header(pnm_reader *r, int *type, long *w, long *h, lo
 spn_status spn_pnm_read(const char *path, spn_grey_image *out)
 {
     memset(out, 0, sizeof *out);
-    pnm_reader r = {fopen(path, "rb"), path, 1};
+    pnm_reader r = {fopen(path, "rb"), path, 1, 1};
     if (!r.fp) return spn_error(SPN_ERR_IO, "%s: cannot read: %s", path, strerror(errno));
     int type = 0;
     long w = 0, h = 0, maxval = 1;
