@@ -5,6 +5,7 @@
 #   make test     build, run the suite, then run it again under ASan+UBSan (build-asan/)
 #   make demo     build and write the showcase into out/
 #   make bench    run the benchmarks, write bench/results/<machine>.json
+#   make fuzz     run every libFuzzer harness FUZZ_SECONDS each (default 60; build-fuzz/)
 #   make install  install into PREFIX (default /usr/local)
 
 PREFIX ?= /usr/local
@@ -14,10 +15,12 @@ CMAKE_FLAGS ?=
 WERROR ?= ON
 
 DEPS := cmake pkg-config gcc make libcmocka-dev libcairo2-dev libcjson-dev fonts-dejavu-core \
-        libassimp-dev libglfw3-dev libgl-dev libgl1-mesa-dri xvfb xauth ffmpeg povray clang
+        libassimp-dev libglfw3-dev libgl-dev libgl1-mesa-dri xvfb xauth ffmpeg povray clang libclang-rt-14-dev
 BENCH_DEPS := libbullet-dev g++ libsuitesparse-dev
 
-.PHONY: all deps deps-bench build test test-fast test-asan demo bench install clean
+.PHONY: all deps deps-bench build test test-fast test-asan fuzz fuzz-build demo bench install clean
+
+FUZZ_SECONDS ?= 60
 
 all: build
 
@@ -44,7 +47,17 @@ test-asan: deps build-asan/CMakeCache.txt
 	cd build-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  ctest --output-on-failure -j $(JOBS)
 
+fuzz-build: deps
+	CC=clang cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSPN_FUZZ=ON -DSPN_TESTS=OFF \
+	  -DSPN_VIEWER=OFF -DSPN_OPENMP=OFF $(CMAKE_FLAGS)
+	cmake --build build-fuzz -j $(JOBS)
+
+fuzz: fuzz-build
+	FUZZ_SECONDS=$(FUZZ_SECONDS) scripts/fuzz.sh build-fuzz
+
+# The suite, the sanitizer run, and a short fuzzing pass so regressions surface.
 test: test-fast test-asan
+	$(MAKE) fuzz FUZZ_SECONDS=$(if $(CI),5,3)
 
 demo: build
 	@scripts/demo.sh build/spinneret out

@@ -19,7 +19,7 @@ static void usage(FILE *out)
             "particle <= --tol. Exits 0 when converged or timed out (the report on stderr\n"
             "says which), 1 when the simulation blew up (nothing written).\n\n"
             "  -o, --output OUT      the settled web file (required; may be FILE itself)\n"
-            "      --solver NAME     euler, symplectic, rk4, adaptive or implicit\n"
+            "      --solver NAME     euler, symplectic, rk4, adaptive or implicit (kept in OUT)\n"
             "                        (default: the integrator named in FILE)\n"
             "      --dt S            time step [s], in [1e-9, 1]; default %g\n"
             "      --tol N           residual force threshold [N], in [0, 1e6]; default %g\n"

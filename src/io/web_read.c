@@ -43,13 +43,17 @@ static const char *type_name(const cJSON *j)
     return "an invalid value";
 }
 
-/* Every key of `obj` must be one of `allowed` (NULL-terminated). */
+/* Every key of `obj` must be one of `allowed` (NULL-terminated), once: cJSON
+ * would quietly take the first of two equal keys. */
 static spn_status check_keys(const reader *r, const cJSON *obj, const char *path, const char *const *allowed)
 {
     for (const cJSON *c = obj->child; c; c = c->next) {
         bool known = false;
         for (const char *const *k = allowed; *k && !known; k++) known = strcmp(*k, c->string) == 0;
         if (!known) return bad(r, "%s%s%s: unknown field", path, *path ? "." : "", c->string);
+        for (const cJSON *d = obj->child; d != c; d = d->next)
+            if (strcmp(d->string, c->string) == 0)
+                return bad(r, "%s%s%s: field appears twice", path, *path ? "." : "", c->string);
     }
     return SPN_OK;
 }
@@ -70,12 +74,17 @@ static spn_status finite_number(const reader *r, const cJSON *j, const char *fie
     return SPN_OK;
 }
 
+/* On failure *out is 0, so callers may convert it to an integer type
+ * unconditionally (a refused value can be outside that type's range). */
 static spn_status whole_number(const reader *r, const cJSON *j, const char *field, double max, double *out)
 {
-    spn_status st = finite_number(r, j, field, out);
+    double v = 0;
+    *out = 0;
+    spn_status st = finite_number(r, j, field, &v);
     if (st != SPN_OK) return st;
-    if (*out < 0 || *out > max || floor(*out) != *out)
-        return bad(r, "%s: expected a whole number in [0, %.0f], got %.17g", field, max, *out);
+    if (v < 0 || v > max || floor(v) != v)
+        return bad(r, "%s: expected a whole number in [0, %.0f], got %.17g", field, max, v);
+    *out = v;
     return SPN_OK;
 }
 
@@ -87,6 +96,7 @@ typedef struct column {
     const cJSON *next; /* entry to read next; NULL for a missing optional column */
     char path[64];     /* "particles.mass" */
     uint32_t index;    /* entry index of `next` */
+    int width;         /* entries per item: 3 for vectors */
 } column;
 
 static spn_status column_open(const reader *r, const cJSON *section, const char *sect, const char *key,
@@ -95,6 +105,7 @@ static spn_status column_open(const reader *r, const cJSON *section, const char 
     snprintf(col->path, sizeof col->path, "%s.%s", sect, key);
     col->next = NULL;
     col->index = 0;
+    col->width = width;
     const cJSON *arr = cJSON_GetObjectItemCaseSensitive(section, key);
     if (!arr) return required ? bad(r, "missing field '%s'", col->path) : SPN_OK;
     if (!cJSON_IsArray(arr)) return bad(r, "%s: expected an array, got %s", col->path, type_name(arr));
@@ -115,7 +126,10 @@ static spn_status col_number(const reader *r, column *col, double dflt, double *
         return SPN_OK;
     }
     char field[96];
-    snprintf(field, sizeof field, "%s[%u]", col->path, col->index);
+    if (col->width == 3)
+        snprintf(field, sizeof field, "%s[%u] (particle %u, %c)", col->path, col->index, col->index / 3,
+                 "xyz"[col->index % 3]);
+    else snprintf(field, sizeof field, "%s[%u]", col->path, col->index);
     spn_status st = finite_number(r, col->next, field, out);
     col->next = col->next->next;
     col->index++;

@@ -32,6 +32,7 @@ write("empty.json", "")
 write("blank.json", "  \n\t\n")
 write("truncated.json", good_text[: len(good_text) // 2])
 write("nan_literal.json", sub('"drag": 2', '"drag": NaN'))
+write("duplicate_field.json", sub('"mass": [0, 0.001, 0.001, 0],', '"mass": [0, 0.001, 0.001, 0],\n    "mass": [1, 1, 1, 1],'))
 write("trailing_text.json", good_text + "{}\n")
 write("top_array.json", "[1, 2, 3]\n")
 with open(os.path.join(here, "nul_byte.json"), "wb") as f:
