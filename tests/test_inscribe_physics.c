@@ -62,6 +62,7 @@ static void test_inscribed_web_is_settled_and_whole(void **state)
         spn_inscribe_def d = spn_inscribe_def_default();
         d.emphasis = modes[m];
         d.gaps = 5;
+        d.fill_spacing = 0.0024; /* coarse: explicit settling of a fine fill is slow */
         d.settle_def.dt = 2e-6;
         d.settle_def.max_time = 0.5;
         d.settle_def.check_interval = 1e-3;

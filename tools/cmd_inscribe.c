@@ -29,7 +29,7 @@ static void usage(FILE *out)
             "method\n"
             "      --threshold N      remove segments scoring above N, [0, 10]; default 8\n"
             "      --emphasis MODE    none, crosshatch, fill or outline; default none\n"
-            "      --fill-spacing M   fill: distance between attachments [m]; default capture radius / 60\n"
+            "      --fill-spacing M   fill: distance between attachments [m]; default capture radius / 80\n"
             "      --gaps N           also take out N random capture segments (fig. 6.18)\n"
             "      --seed N           for fill and gaps; default 1\n"
             "settling (before scoring and after editing)\n"

@@ -95,7 +95,7 @@ typedef struct spn_inscribe_def {
     int threshold;         ///< remove segments whose score (1..10) is above this, default 8
     spn_emphasis emphasis; ///< default SPN_EMPHASIS_NONE
     int gaps;              ///< random capture segments taken out anywhere (fig 6.18), default 0
-    double fill_spacing;   ///< fill: distance between attachments [m]; 0 = capture radius / 60
+    double fill_spacing;   ///< fill: distance between attachments [m]; 0 = capture radius / 80
     uint64_t seed;         ///< for fill and gaps, default 1
     bool settle;           ///< settle before scoring and after editing, default true
     spn_settle_def settle_def; ///< default spn_settle_def_default()

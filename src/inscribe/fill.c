@@ -211,12 +211,14 @@ spn_status spn__fill(spn_world *w, const spn_target *t, const spn__material *m, 
     if (!(spacing > 0)) return spn_error(SPN_ERR_INVALID, "fill spacing: need > 0 m");
     spn_rng rng;
     spn_rng_seed(&rng, seed);
-    /* Laid at rest and resisting compression, like the matted silk of a
-     * stabilimentum: a net of tension-only threads with a free edge has no
-     * stiffness and folds up under the slightest load (we watched the
-     * letters crumple), and pre-strained it pulls the radii together. */
+    /* Resisting compression, like the matted silk of a stabilimentum: a net
+     * of tension-only threads with a free edge has no stiffness and folds up
+     * under the slightest load (we watched the letters crumple). A fifth of
+     * the web's pre-strain keeps every fill thread in tension, so a node on
+     * two nearly straight threads still has a sideways stiffness (at zero
+     * tension it has none, and settling crawls). */
     spn__material fm = *m;
-    fm.prestrain = 0;
+    fm.prestrain = 0.2 * m->prestrain;
     fm.tension_only = false;
     m = &fm;
     uint32_t ns0 = spn_world_spring_count(w);

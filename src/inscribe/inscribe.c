@@ -324,7 +324,7 @@ static double default_fill_spacing(const spn_world *w)
 {
     spn_capture_area area;
     if (spn_capture_area_of(w, &area) != SPN_OK) return 0.0025;
-    return area.radius / 60;
+    return area.radius / 80;
 }
 
 spn_status spn_inscribe(spn_world **wp, const spn_target *t, const spn_inscribe_def *def, spn_inscribe_report *report)
