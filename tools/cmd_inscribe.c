@@ -41,7 +41,7 @@ static void usage(FILE *out)
             "output\n"
             "  -o, --output OUT       the inscribed web file (required)\n"
             "      --render PNG       also render the result (default render settings)\n"
-            "      --overlay PNG      the dilated target over the web (figs. 6.3, 6.10)\n"
+            "      --overlay PNG      the dilated target over the web before inscription (figs. 6.3, 6.10)\n"
             "  -h, --help             this text\n");
 }
 
@@ -168,10 +168,13 @@ static void print_report(const spn_inscribe_report *r, const spn_inscribe_def *d
                 d->settle_def.max_residual);
 }
 
-static spn_status write_outputs(const inscribe_options *o, const spn_world *w, const spn_target *t)
+/* The overlay shows the target over the web as it was (the thesis' source
+ * image, figs. 6.3 and 6.10), so one sees which segments it covers. */
+static spn_status write_outputs(const inscribe_options *o, const spn_world *w, const spn_world *source,
+                                const spn_target *t)
 {
     spn_status st = spn_web_save(w, o->output);
-    if (st == SPN_OK && o->overlay) st = spn_inscribe_overlay(w, t, o->overlay);
+    if (st == SPN_OK && o->overlay) st = spn_inscribe_overlay(source, t, o->overlay);
     if (st == SPN_OK && o->render) {
         spn_render_def rd = spn_render_def_default();
         st = spn_render_file(w, &rd, o->render);
@@ -188,7 +191,7 @@ int cmd_inscribe(int argc, char **argv)
     int code = parse_options(argc, argv, &o);
     if (code >= 0) return free(o.text), code;
 
-    spn_world *w = NULL;
+    spn_world *w = NULL, *source = NULL;
     spn_target *t = NULL;
     spn_inscribe_report report;
     spn_status st = spn_web_load(o.input, &w);
@@ -198,10 +201,12 @@ int cmd_inscribe(int argc, char **argv)
         spn_world_set_integrator(w, integ);
     }
     if (st == SPN_OK) st = make_target(&o, w, &t);
+    if (st == SPN_OK && o.overlay && !(source = spn_world_clone(w))) st = spn_error(SPN_ERR_NOMEM, "out of memory");
     if (st == SPN_OK) st = spn_inscribe(&w, t, &o.def, &report);
     if (st == SPN_OK) print_report(&report, &o.def);
-    if (st == SPN_OK) st = write_outputs(&o, w, t);
+    if (st == SPN_OK) st = write_outputs(&o, w, source, t);
     spn_target_destroy(t);
+    spn_world_destroy(source);
     spn_world_destroy(w);
     free(o.text);
     if (st != SPN_OK) return cli_fail(CMD, "%s", spn_last_error());
