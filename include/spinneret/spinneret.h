@@ -9,6 +9,7 @@
 #include "io.h"
 #include "scenes.h"
 #include "render.h"
+#include "export.h"
 #include "inscribe.h"
 
 #endif
