@@ -232,5 +232,7 @@ int main(void)
         cmocka_unit_test(test_full_target_removes_all_above_threshold),
         cmocka_unit_test(test_emphasis_changes_only_the_message),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    int failed = cmocka_run_group_tests(tests, NULL, NULL);
+    spn_render_release_caches(); /* cairo's and fontconfig's font caches */
+    return failed;
 }

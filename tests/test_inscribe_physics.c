@@ -155,5 +155,7 @@ int main(void)
         cmocka_unit_test(test_subdivided_segments_go_whole),
         cmocka_unit_test(test_failure_leaves_the_web_alone),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    int failed = cmocka_run_group_tests(tests, NULL, NULL);
+    spn_render_release_caches(); /* cairo's and fontconfig's font caches */
+    return failed;
 }

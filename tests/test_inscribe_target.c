@@ -175,5 +175,7 @@ int main(void)
         cmocka_unit_test(test_bad_text_refused),             cmocka_unit_test(test_pnm_reader),
         cmocka_unit_test(test_image_target),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    int failed = cmocka_run_group_tests(tests, NULL, NULL);
+    spn_render_release_caches(); /* cairo's and fontconfig's font caches */
+    return failed;
 }
