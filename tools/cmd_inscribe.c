@@ -21,7 +21,7 @@ static void usage(FILE *out)
             "target\n"
             "      --text TEXT        a line of text (repeat for more lines; \"\\n\" also breaks)\n"
             "      --font NAME        font, default \"DejaVu Sans Bold\" (must be installed)\n"
-            "      --fit F            the text or image spans F of the capture circle, (0, 1]; default 0.9\n"
+            "      --fit F            F of the largest size that fits in the capture spiral, (0, 1]; default 0.9\n"
             "      --text-height M    capital height [m] instead of --fit (must still fit)\n"
             "      --line-spacing F   baseline distance in capital heights, [1, 4]; default 1.45\n"
             "      --image FILE       PNG, PBM or PGM; dark pixels are the message\n"

@@ -56,19 +56,21 @@ SPN_API void spn_target_paint(spn_target *t, spn_ink_fn fn, void *user);
 typedef struct spn_text_def {
     const char *text;      ///< lines separated by '\n'; not empty
     const char *font;      ///< "Family [Bold] [Italic|Oblique]", default "DejaVu Sans Bold"
-    double fit;            ///< fraction of the capture circle the block may span, default 0.9
+    double fit;            ///< fraction of the largest size that fits in the capture spiral, default 0.9
     double height;         ///< > 0: capital height [m] instead of fitting; must still fit
     double line_spacing;   ///< baseline distance in capital heights, default 1.45
 } spn_text_def;
 
 SPN_API spn_text_def spn_text_def_default(void);
-/// Set the text, centred in the capture area. Errors: empty text, a font that
+/// Set the text where the largest block of its shape fits in the capture
+/// spiral, at `fit` of that size. Errors: empty text, a font that
 /// fontconfig does not have (no silent substitution), text that cannot fit.
 SPN_API spn_status spn_target_text(spn_target *t, const spn_world *w, const spn_text_def *def);
 
 /// Place an image file (PNG through cairo; PBM/PGM P1/P2/P4/P5), dark = ink,
-/// transparent = no ink, centred in the capture area and scaled to span `fit`
-/// of its circle (0 < fit <= 1). Errors name the file (and line for PNM).
+/// transparent = no ink, placed like text: where the largest image of its
+/// aspect fits in the capture spiral, at `fit` (0 < fit <= 1) of that size.
+/// Errors name the file (and line for PNM).
 SPN_API spn_status spn_target_image(spn_target *t, const spn_world *w, const char *path, double fit);
 
 /// A grey image: 0 black .. 255 white.

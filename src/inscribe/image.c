@@ -2,8 +2,8 @@
  * mainly low frequency content", such as a logo). PNG is read by cairo;
  * PBM and PGM (P1, P2, P4, P5) by the small reader below, which names the
  * line of the first bad token. Dark pixels are ink; transparent pixels none.
- * The image is centred in the capture area and scaled, keeping its aspect,
- * so that its diagonal spans `fit` of the capture circle's diameter. */
+ * The image keeps its aspect and is `fit` of the largest size that fits in
+ * the capture spiral, where it fits best (spn__fit_box). */
 #include "inscribe_internal.h"
 
 #include <cairo.h>
@@ -228,16 +228,18 @@ spn_status spn_target_image(spn_target *t, const spn_world *w, const char *path,
 {
     if (!(fit > 0 && fit <= 1)) return spn_error(SPN_ERR_INVALID, "fit %g: need 0 < fit <= 1", fit);
     if (!path || !*path) return spn_error(SPN_ERR_INVALID, "image: no file given");
-    spn_capture_area area;
-    spn_status st = spn_capture_area_of(w, &area);
     spn_grey_image img;
-    if (st == SPN_OK) st = read_image(path, &img);
-    if (st != SPN_OK) return st;
-    /* Image pixels per target pixel, so the image diagonal spans fit * 2R. */
-    double diag_px = fit * 2 * area.radius * t->scale;
-    double k = hypot(img.width, img.height) / diag_px;
+    spn_status st = read_image(path, &img);
+    spn_vec3 centre;
+    double most; /* metres per image pixel at the largest fitting size */
+    if (st == SPN_OK) st = spn__fit_box(w, 0.5 * img.width, 0.5 * img.height, &centre, &most);
+    if (st != SPN_OK) {
+        spn_grey_image_free(&img);
+        return st;
+    }
+    double k = 1 / (fit * most * t->scale); /* image pixels per target pixel */
     double cx, cy;
-    spn_target_to_pixel(t, area.centre, &cx, &cy);
+    spn_target_to_pixel(t, centre, &cx, &cy);
     for (int j = 0; j < t->height; j++)
         for (int i = 0; i < t->width; i++) {
             double u = (i + 0.5 - cx) * k + 0.5 * img.width, v = (j + 0.5 - cy) * k + 0.5 * img.height;

@@ -19,6 +19,9 @@ struct spn_target {
 /* The thesis' 7x7 structuring element: radius 3. */
 #define SPN__DILATE_RADIUS 3
 
+/* Where a box of half-size (aw, ah) [any unit] fits best in the capture
+ * spiral: its centre and the largest scale [m per unit] that keeps it inside. */
+spn_status spn__fit_box(const spn_world *w, double aw, double ah, spn_vec3 *centre, double *scale);
 /* A raster of the same frame as `t`, zero ink. */
 float *spn__raster_alloc(const spn_target *t);
 /* The web drawn as 1-pixel threads, ink 1 on 0 (the source image). */

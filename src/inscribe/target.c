@@ -102,46 +102,137 @@ void spn_target_paint(spn_target *t, spn_ink_fn fn, void *user)
         }
 }
 
+/* Capture radius and free-zone radius about `c`: each of AREA_SECTORS
+ * directions is bounded by the farthest capture point in it. */
+static double area_about(const spn_vec3 *pt, size_t n, spn_vec3 c, double *inner)
+{
+    double far[AREA_SECTORS], near[AREA_SECTORS];
+    for (int k = 0; k < AREA_SECTORS; k++) far[k] = 0, near[k] = INFINITY;
+    for (size_t i = 0; i < n; i++) {
+        double dx = pt[i].x - c.x, dy = pt[i].y - c.y, r = hypot(dx, dy);
+        int k = (int)((atan2(dy, dx) + SPN_PI) / (2 * SPN_PI) * AREA_SECTORS) % AREA_SECTORS;
+        far[k] = fmax(far[k], r);
+        near[k] = fmin(near[k], r);
+    }
+    double radius = INFINITY, in = 0;
+    for (int k = 0; k < AREA_SECTORS; k++) {
+        radius = fmin(radius, far[k]); /* an empty direction has no spiral: radius 0 */
+        if (isfinite(near[k])) in = fmax(in, near[k]);
+    }
+    *inner = in < radius ? in : 0;
+    return radius;
+}
+
+/* Points every `step` metres along every capture thread (NULL on no memory). */
+static spn_vec3 *capture_points(const spn_world *w, double step, size_t *count)
+{
+    uint32_t ns = spn_world_spring_count(w);
+    size_t n = 0, cap = 1024;
+    spn_vec3 *pt = malloc(cap * sizeof *pt);
+    for (uint32_t s = 0; s < ns && pt; s++) {
+        spn_spring_info si = spn_world_spring(w, s);
+        if (si.tag != SPN_THREAD_CAPTURE || si.broken) continue;
+        spn_vec3 a = spn_world_position(w, si.a), b = spn_world_position(w, si.b);
+        int m = 1 + (int)fmin(1000, hypot(b.x - a.x, b.y - a.y) / step);
+        for (int e = 0; e <= m && pt; e++) {
+            if (n == cap) {
+                spn_vec3 *grown = realloc(pt, 2 * cap * sizeof *pt);
+                if (!grown) free(pt);
+                pt = grown, cap *= 2;
+                if (!pt) break;
+            }
+            pt[n++] = spn_v3_add(a, spn_v3_scale(spn_v3_sub(b, a), (double)e / m));
+        }
+    }
+    *count = n;
+    return pt;
+}
+
 spn_status spn_capture_area_of(const spn_world *w, spn_capture_area *out)
 {
     memset(out, 0, sizeof *out);
     uint32_t ns = spn_world_spring_count(w), n = 0;
-    spn_vec3 c = spn_v3(0, 0, 0);
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
     for (uint32_t s = 0; s < ns; s++) {
         spn_spring_info si = spn_world_spring(w, s);
         if (si.tag != SPN_THREAD_CAPTURE || si.broken) continue;
-        c = spn_v3_add(c, spn_v3_add(spn_world_position(w, si.a), spn_world_position(w, si.b)));
+        for (int e = 0; e < 2; e++) {
+            spn_vec3 p = spn_world_position(w, e ? si.b : si.a);
+            lo[0] = fmin(lo[0], p.x), hi[0] = fmax(hi[0], p.x), lo[1] = fmin(lo[1], p.y), hi[1] = fmax(hi[1], p.y);
+        }
         n++;
     }
     if (n == 0) return spn_error(SPN_ERR_INVALID, "inscribe: the web has no capture-spiral threads (tag capture)");
-    c = spn_v3_scale(c, 0.5 / n);
-    double far[AREA_SECTORS], near[AREA_SECTORS];
-    for (int k = 0; k < AREA_SECTORS; k++) far[k] = 0, near[k] = INFINITY;
-    /* Points along every capture thread, binned by direction: each sector's
-     * farthest point bounds the spiral there. */
-    for (uint32_t s = 0; s < ns; s++) {
-        spn_spring_info si = spn_world_spring(w, s);
-        if (si.tag != SPN_THREAD_CAPTURE || si.broken) continue;
-        spn_vec3 a = spn_world_position(w, si.a), b = spn_world_position(w, si.b);
-        double reach = fmax(hypot(a.x - c.x, a.y - c.y), 1e-12);
-        int samples = 2 + (int)(hypot(b.x - a.x, b.y - a.y) / (2 * SPN_PI * reach / AREA_SECTORS) * 3);
-        samples = samples > 1000 ? 1000 : samples;
-        for (int e = 0; e <= samples; e++) {
-            spn_vec3 d = spn_v3_sub(spn_v3_add(a, spn_v3_scale(spn_v3_sub(b, a), (double)e / samples)), c);
-            double r = hypot(d.x, d.y), ang = atan2(d.y, d.x) + SPN_PI;
-            int k = (int)(ang / (2 * SPN_PI) * AREA_SECTORS) % AREA_SECTORS;
-            far[k] = fmax(far[k], r);
-            near[k] = fmin(near[k], r);
-        }
+    double size = fmax(hi[0] - lo[0], hi[1] - lo[1]);
+    size_t np;
+    spn_vec3 *pt = capture_points(w, size / 2000, &np);
+    if (!pt) return spn_error(SPN_ERR_NOMEM, "out of memory");
+    /* The centre with the largest circle inside the spiral: a coarse grid over
+     * the middle of the capture box, then a finer one about the best point. */
+    spn_vec3 best = spn_v3(0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0);
+    double inner, best_r = area_about(pt, np, best, &inner), half = 0.25 * size;
+    for (int pass = 0; pass < 3; pass++, half /= 4) {
+        spn_vec3 around = best;
+        for (int j = -4; j <= 4; j++)
+            for (int i = -4; i <= 4; i++) {
+                spn_vec3 c = spn_v3(around.x + half * i / 4, around.y + half * j / 4, 0);
+                double in, r = area_about(pt, np, c, &in);
+                if (r > best_r) best_r = r, best = c;
+            }
     }
-    double radius = INFINITY, inner = 0;
-    for (int k = 0; k < AREA_SECTORS; k++) {
-        if (far[k] > 0) radius = fmin(radius, far[k]);
-        if (isfinite(near[k])) inner = fmax(inner, near[k]);
-    }
-    out->centre = c;
-    out->radius = radius;
-    out->inner = inner < radius ? inner : 0;
+    out->centre = best;
+    out->radius = area_about(pt, np, best, &inner);
+    out->inner = inner;
     out->segments = n;
+    free(pt);
+    if (!(out->radius > 0)) return spn_error(SPN_ERR_INVALID, "inscribe: the capture spiral encloses no area");
+    return SPN_OK;
+}
+
+/* Largest s such that the box of half-size (aw s, ah s) centred at c lies in
+ * the spiral: in each direction the box's edge must stay inside the farthest
+ * capture point of that direction (checked at both edges of every sector). */
+static double box_scale_about(const spn_vec3 *pt, size_t n, spn_vec3 c, double aw, double ah)
+{
+    double far[AREA_SECTORS];
+    for (int k = 0; k < AREA_SECTORS; k++) far[k] = 0;
+    for (size_t i = 0; i < n; i++) {
+        double dx = pt[i].x - c.x, dy = pt[i].y - c.y;
+        int k = (int)((atan2(dy, dx) + SPN_PI) / (2 * SPN_PI) * AREA_SECTORS) % AREA_SECTORS;
+        far[k] = fmax(far[k], hypot(dx, dy));
+    }
+    double s = INFINITY;
+    for (int k = 0; k < AREA_SECTORS; k++)
+        for (int e = 0; e < 2; e++) {
+            double ang = (k + e) * 2 * SPN_PI / AREA_SECTORS - SPN_PI;
+            double cx = fabs(cos(ang)), cy = fabs(sin(ang));
+            double edge = fmin(cx > 1e-12 ? aw / cx : INFINITY, cy > 1e-12 ? ah / cy : INFINITY);
+            s = fmin(s, far[k] / edge);
+        }
+    return s;
+}
+
+spn_status spn__fit_box(const spn_world *w, double aw, double ah, spn_vec3 *centre, double *scale)
+{
+    spn_capture_area area;
+    spn_status st = spn_capture_area_of(w, &area);
+    if (st != SPN_OK) return st;
+    size_t np;
+    spn_vec3 *pt = capture_points(w, area.radius / 1000, &np);
+    if (!pt) return spn_error(SPN_ERR_NOMEM, "out of memory");
+    spn_vec3 best = area.centre;
+    double best_s = box_scale_about(pt, np, best, aw, ah), half = 0.5 * area.radius;
+    for (int pass = 0; pass < 3; pass++, half /= 4) {
+        spn_vec3 around = best;
+        for (int j = -4; j <= 4; j++)
+            for (int i = -4; i <= 4; i++) {
+                spn_vec3 c = spn_v3(around.x + half * i / 4, around.y + half * j / 4, 0);
+                double sc = box_scale_about(pt, np, c, aw, ah);
+                if (sc > best_s) best_s = sc, best = c;
+            }
+    }
+    free(pt);
+    *centre = best;
+    *scale = best_s;
     return SPN_OK;
 }

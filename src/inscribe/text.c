@@ -5,7 +5,8 @@
  *
  * A font fontconfig does not have is an error, not a silent substitution:
  * the family FreeType actually opened is compared with the one asked for.
- * Layout: lines centred on the capture area's centre, baselines
+ * Layout: the block centred where the largest block of its shape fits in
+ * the capture spiral (spn__fit_box), baselines
  * `line_spacing` capital heights apart, each line centred on its ink. */
 #include "inscribe_internal.h"
 
@@ -151,21 +152,23 @@ static spn_status check_def(const spn_text_def *d)
     return SPN_OK;
 }
 
-/* Scale from reference pixels to target pixels: fitted, or the asked height checked. */
-static spn_status text_scale(const layout *L, const spn_text_def *d, const spn_capture_area *area,
-                             const spn_target *t, double *k)
+/* Scale from reference pixels to target pixels, and the block's centre:
+ * `fit` of the largest block that fits in the spiral, or the asked height checked. */
+static spn_status text_scale(const layout *L, const spn_text_def *d, const spn_world *w, const spn_target *t,
+                             double *k, spn_vec3 *centre)
 {
-    double half_diag = 0.5 * hypot(L->width, L->height); /* reference px */
-    double room = area->radius * t->scale;                 /* target px */
+    double most; /* metres per reference pixel at the largest fitting size */
+    spn_status st = spn__fit_box(w, 0.5 * L->width, 0.5 * L->height, centre, &most);
+    if (st != SPN_OK) return st;
     if (d->height > 0) {
         *k = d->height * t->scale / L->cap;
-        if (half_diag * *k > room * 1.0000001)
+        if (*k > most * t->scale * 1.0000001)
             return spn_error(SPN_ERR_INVALID,
-                             "text height %g m: the text (%.3f x %.3f m) does not fit in the capture area "
-                             "(radius %.3f m); try --fit",
-                             d->height, L->width * *k / t->scale, L->height * *k / t->scale, area->radius);
+                             "text height %g m: the text (%.3f x %.3f m) does not fit in the capture spiral "
+                             "(at most %.3f m capitals); try --fit",
+                             d->height, L->width * *k / t->scale, L->height * *k / t->scale, most * L->cap);
     } else {
-        *k = d->fit * room / half_diag;
+        *k = d->fit * most * t->scale;
     }
     if (L->cap * *k < 4)
         return spn_error(SPN_ERR_INVALID, "text: letters would be %.1f pixels tall, too small to inscribe; "
@@ -179,8 +182,6 @@ spn_status spn_target_text(spn_target *t, const spn_world *w, const spn_text_def
     spn_status st = check_def(&d);
     layout L;
     if (st == SPN_OK) st = split_lines(d.text, &L);
-    spn_capture_area area;
-    if (st == SPN_OK) st = spn_capture_area_of(w, &area);
     if (st != SPN_OK) return st;
     L.spacing = d.line_spacing;
     cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_A8, t->width, t->height);
@@ -192,13 +193,14 @@ spn_status spn_target_text(spn_target *t, const spn_world *w, const spn_text_def
     }
     st = select_font(cr, d.font);
     double k = 1;
+    spn_vec3 centre = spn_v3(0, 0, 0);
     if (st == SPN_OK) {
         measure(cr, &L);
-        st = text_scale(&L, &d, &area, t, &k);
+        st = text_scale(&L, &d, w, t, &k, &centre);
     }
     if (st == SPN_OK) {
         double cx, cy;
-        spn_target_to_pixel(t, area.centre, &cx, &cy);
+        spn_target_to_pixel(t, centre, &cx, &cy);
         draw_lines(cr, &L, k, cx, cy);
         cairo_surface_flush(surf);
         const unsigned char *px = cairo_image_surface_get_data(surf);
