@@ -228,7 +228,7 @@ spn_status spn_target_image(spn_target *t, const spn_world *w, const char *path,
 {
     if (!(fit > 0 && fit <= 1)) return spn_error(SPN_ERR_INVALID, "fit %g: need 0 < fit <= 1", fit);
     if (!path || !*path) return spn_error(SPN_ERR_INVALID, "image: no file given");
-    spn_grey_image img;
+    spn_grey_image img = {0, 0, NULL};
     spn_status st = read_image(path, &img);
     spn_vec3 centre;
     double most; /* metres per image pixel at the largest fitting size */
