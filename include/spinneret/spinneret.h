@@ -10,6 +10,8 @@
 #include "scenes.h"
 #include "render.h"
 #include "export.h"
+#include "mesh.h"
+#include "shoot.h"
 #include "inscribe.h"
 
 #endif
