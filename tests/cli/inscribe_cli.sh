@@ -10,7 +10,7 @@ WEB=$DATA/inscribe/orb.json
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
-SETTLE=(--solver symplectic --dt 2e-6 --max-time 0.5)
+SETTLE=(--solver implicit --dt 1e-3 --max-time 5)
 
 count_kind() { # file kind-number: springs carrying that tag
     python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(sum(1 for t in d['springs']['tag'] if t==int(sys.argv[2])))" "$1" "$2"
@@ -18,7 +18,7 @@ count_kind() { # file kind-number: springs carrying that tag
 
 "$SPN" inscribe --help | grep -q 'usage: spinneret inscribe' || fail "--help"
 
-"$SPN" inscribe "$WEB" --text "PIG" --emphasis fill --fill-spacing 0.0024 "${SETTLE[@]}" -o "$T/pig.json" \
+"$SPN" inscribe "$WEB" --text "PIG" --emphasis fill "${SETTLE[@]}" -o "$T/pig.json" \
     --render "$T/pig.png" --overlay "$T/pig_overlay.png" 2>"$T/log" || { cat "$T/log"; fail "fill run"; }
 for f in pig.json pig.png pig_overlay.png; do [ -s "$T/$f" ] || fail "$f not written"; done
 grep -q 'settled: converged' "$T/log" || fail "not settled: $(cat "$T/log")"
