@@ -38,6 +38,8 @@ inscribe terrific-crosshatch --text "TERRIFIC" --emphasis crosshatch
 inscribe radiant-fill      --text "RADIANT" --emphasis fill
 inscribe humble-outline    --text "HUMBLE" --emphasis outline
 inscribe some-pig-fill     --text "SOME" --text "PIG" --emphasis fill
+inscribe terrific-fill     --text "TERRIFIC" --emphasis fill
+inscribe humble-fill       --text "HUMBLE" --emphasis fill
 inscribe gaps              --gaps 40 --seed 3
 
 # A logo-like target (three interlocking ellipse rings, mainly low-frequency
