@@ -221,7 +221,7 @@ spn_status spn__clean(spn_world **wp, const bool *remove, uint32_t *pruned, uint
     spn_world *w = *wp;
     uint32_t np = spn_world_particle_count(w), ns = spn_world_spring_count(w), dropped = 0;
     bool *dead = calloc((size_t)ns + 1, sizeof *dead), *reach = calloc((size_t)np + 1, sizeof *reach);
-    spn__graph g;
+    spn__graph g = {0, 0, NULL, NULL};
     spn_status st = dead && reach ? spn__graph_build(w, NULL, &g) : spn_error(SPN_ERR_NOMEM, "out of memory");
     if (st == SPN_OK) {
         for (uint32_t s = 0; s < ns; s++) dead[s] = remove && remove[s];
@@ -243,8 +243,8 @@ spn_status spn__clean(spn_world **wp, const bool *remove, uint32_t *pruned, uint
             st = compact(w, dead, reach, &c);
             if (st == SPN_OK) spn_world_destroy(w), *wp = c;
         }
-        spn__graph_free(&g);
     }
+    spn__graph_free(&g);
     if (st == SPN_OK) *particles_removed += dropped;
     free(dead);
     free(reach);

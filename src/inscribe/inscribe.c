@@ -90,7 +90,7 @@ static spn_status build_chains(const spn_world *w, scoring *sc)
         sc->chain[s] = id[r];
     }
     free(parent), free(id);
-    if (st == SPN_OK) spn__graph_free(&g);
+    spn__graph_free(&g); /* safe after a failed build: it leaves g empty */
     return st;
 }
 
@@ -300,7 +300,7 @@ static spn_status edit_segments(spn_world *w, const spn_target *t, const spn_ins
         spn__graph g;
         st = spn__graph_build(w, NULL, &g);
         if (st == SPN_OK) st = crosshatch(w, t, &sc, &g, m, keep_ratio, &rep->added);
-        if (st == SPN_OK) spn__graph_free(&g);
+        spn__graph_free(&g);
     }
     if (st == SPN_OK && d->emphasis == SPN_EMPHASIS_OUTLINE) st = outline(w, t, &sc, remove, m, keep_ratio, &rep->added);
     uint32_t ns0 = sc.ns;
