@@ -203,9 +203,10 @@ static void test_emphasis_changes_only_the_message(void **state)
     for (int e = 0; e < 4; e++) {
         spn_world *w = orb();
         spn_target *t = NULL;
-        assert_int_equal(spn_target_create(w, 1200, &t), SPN_OK);
+        assert_int_equal(spn_target_create(w, 600, &t), SPN_OK);
         spn_text_def td = spn_text_def_default();
         td.text = "PIG";
+        td.fit = 0.5; /* a quarter of the area: fewer fill threads, a quicker test */
         assert_int_equal(spn_target_text(t, w, &td), SPN_OK);
         uint32_t na, nb, changes = 0;
         thread_key *before = keys_of(w, &na);

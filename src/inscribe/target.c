@@ -165,7 +165,7 @@ spn_status spn_capture_area_of(const spn_world *w, spn_capture_area *out)
     if (n == 0) return spn_error(SPN_ERR_INVALID, "inscribe: the web has no capture-spiral threads (tag capture)");
     double size = fmax(hi[0] - lo[0], hi[1] - lo[1]);
     size_t np;
-    spn_vec3 *pt = capture_points(w, size / 2000, &np);
+    spn_vec3 *pt = capture_points(w, size / 500, &np);
     if (!pt) return spn_error(SPN_ERR_NOMEM, "out of memory");
     /* The centre with the largest circle inside the spiral: a coarse grid over
      * the middle of the capture box, then a finer one about the best point. */
@@ -218,7 +218,7 @@ spn_status spn__fit_box(const spn_world *w, double aw, double ah, spn_vec3 *cent
     spn_status st = spn_capture_area_of(w, &area);
     if (st != SPN_OK) return st;
     size_t np;
-    spn_vec3 *pt = capture_points(w, area.radius / 1000, &np);
+    spn_vec3 *pt = capture_points(w, area.radius / 250, &np);
     if (!pt) return spn_error(SPN_ERR_NOMEM, "out of memory");
     spn_vec3 best = area.centre;
     double best_s = box_scale_about(pt, np, best, aw, ah), half = 0.5 * area.radius;
