@@ -71,6 +71,32 @@ static void test_bit_identical(void **state)
     }
 }
 
+/* A clone of a world mid-run (compiled, with solver scratch) continues
+ * exactly as the original. */
+static void test_clone_continues(void **state)
+{
+    (void)state;
+    for (int integ = 0; integ < SPN_INTEGRATOR_COUNT; integ++) {
+        spn_world_def def = spn_world_def_default();
+        def.integrator = (spn_integrator)integ;
+        spn_world *w;
+        assert_int_equal(spn_scene_chain(&def, spn_v3(0, 0, 0), spn_v3(1, 0, 0), 20, 1.1, 0.1, 1e3, 0.1, &w), SPN_OK);
+        assert_int_equal(spn_world_add_plane(w, spn_v3(0, 1, 0), -0.1, 0.5, 0.1), SPN_OK);
+        for (int i = 0; i < 50; i++) assert_int_equal(spn_world_step(w, 1e-3), SPN_OK);
+        spn_world *c = spn_world_clone(w);
+        assert_non_null(c);
+        for (int i = 0; i < 50; i++) {
+            assert_int_equal(spn_world_step(w, 1e-3), SPN_OK);
+            assert_int_equal(spn_world_step(c, 1e-3), SPN_OK);
+        }
+        uint32_t n = spn_world_particle_count(w);
+        assert_memory_equal(spn_world_positions(w), spn_world_positions(c), n * sizeof(spn_vec3));
+        assert_memory_equal(spn_world_velocities(w), spn_world_velocities(c), n * sizeof(spn_vec3));
+        spn_world_destroy(w);
+        spn_world_destroy(c);
+    }
+}
+
 int main(int argc, char **argv)
 {
     (void)argc;
@@ -83,6 +109,7 @@ int main(int argc, char **argv)
     }
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bit_identical),
+        cmocka_unit_test(test_clone_continues),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -157,7 +157,7 @@ SPN_API void spn_world_set_force_callback(spn_world *w, spn_force_fn fn, void *u
 
 /// Air velocity at a point and time [m/s], for aerodynamic drag on threads.
 /// Called from one thread, once per tagged segment (at its midpoint) per
-/// force evaluation, in spring order, so it may keep state.
+/// force evaluation, in a fixed order, so it may keep state.
 typedef spn_vec3 (*spn_air_fn)(void *user, double t, spn_vec3 position);
 /// Air and its properties: segments whose tag has a diameter (below) feel drag
 /// from the air velocity relative to them, normal component only, with a drag

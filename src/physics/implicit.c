@@ -16,13 +16,15 @@
  * gives df_a/dv_a = -kd u u^T; viscous drag -drag m I; air drag on a segment
  * -(c / 4) (I - u u^T) on each end and between them (c from the drag law at
  * the current relative air speed, the derivative of |u_n| frozen). The
- * damping force's dependence on x is left out, as Baraff & Witkin do.
+ * damping force's dependence on x is left out (it is not symmetric and would
+ * break CG; Baraff & Witkin drop that part too).
  *
  * Matrix-free: per spring we keep u and three coefficients (48 bytes) and
  * apply A as one spring pass plus one gather, the same fixed-order pattern
  * as the forces, so results do not depend on the thread count. An assembled
- * block-sparse matrix would hold 3x3 blocks (72 bytes per spring per
- * off-diagonal, plus diagonals) and is rebuilt every step anyway.
+ * block-sparse matrix (symmetric 3x3 blocks, 104 bytes per spring) measured
+ * slower per product at every web size and costs 60-108 ns per spring to
+ * assemble each step (bench/bench_matvec.c, docs/physics.md).
  *
  * The fixed points of the step are exactly f(x) = 0 at v = 0, so a run
  * settles to the true equilibrium whatever the step. */
