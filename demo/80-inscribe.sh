@@ -11,20 +11,23 @@ mkdir -p "$D"
 
 # The web: the builder's default orb web when `build` exists, else the standard web.
 WEB=$D/web.json
-if "$SPN" build --help >/dev/null 2>&1 && "$SPN" build -o "$WEB" >/dev/null 2>&1; then
+if "$SPN" build -o "$WEB" >/dev/null 2>&1; then
     echo "web: spinneret build (default orb web)"
+elif "$SPN" build --species generic -o "$WEB" >/dev/null 2>&1; then
+    echo "web: spinneret build --species generic"
 else
     cp tests/data/inscribe/orb.json "$WEB"
     echo "web: the standard orb web (tests/data/inscribe/orb.json)"
 fi
 
-# Settling: the implicit solver when the program has it, else small explicit steps.
-if "$SPN" settle "$WEB" --solver implicit --max-time 1e-3 -o "$D/probe.json" >/dev/null 2>&1; then
+# Settling: the implicit solver when the program has it, else small explicit
+# steps. The web is brought to rest once here, so each inscription's first
+# settle has nothing left to do.
+if "$SPN" settle "$WEB" --solver implicit --max-time 5 -o "$WEB" >/dev/null 2>&1; then
     SETTLE=(--solver implicit --dt 1e-3 --max-time 5)
 else
     SETTLE=(--solver symplectic --dt 2e-6 --max-time 0.2)
 fi
-rm -f "$D/probe.json"
 
 inscribe() { # name, then inscribe options
     local name=$1; shift
