@@ -9,6 +9,7 @@
 #include "io.h"
 #include "scenes.h"
 #include "render.h"
+#include "anim.h"
 #include "export.h"
 #include "mesh.h"
 #include "shoot.h"
