@@ -68,8 +68,8 @@ inscribe logo-fill --image "$D/logo.pgm" --fit 0.95 --emphasis fill
 # The inscribed web in wind, so the message sways with the web.
 if "$SPN" animate --help >/dev/null 2>&1; then
     # Wind blows along z, so a camera from the side shows the sway; 20 ms
-    # implicit steps keep the 9000-thread fill affordable in a demo.
-    if "$SPN" animate "$D/some-pig-fill.json" -o "$D/some-pig-wind.mp4" --duration 2 --fps 20 --substeps 2 \
+    # implicit steps keep the 10 000-thread fill affordable in a demo.
+    if "$SPN" animate "$D/some-pig-fill.json" -o "$D/some-pig-wind.mp4" --duration 2 --fps 15 --substeps 3 \
         --wind air --wind-speed 3 --gust 0.5 --solver implicit --camera persp --yaw 35 --pitch 10 \
         --size 600x600 --quiet >"$D/wind.log" 2>&1; then
         echo "wind: $D/some-pig-wind.mp4"
