@@ -18,7 +18,7 @@ count_kind() { # file kind-number: springs carrying that tag
 
 "$SPN" inscribe --help | grep -q 'usage: spinneret inscribe' || fail "--help"
 
-"$SPN" inscribe "$WEB" --text "PIG" --emphasis fill "${SETTLE[@]}" -o "$T/pig.json" \
+"$SPN" inscribe "$WEB" --text "PIG" --fit 0.5 --emphasis fill "${SETTLE[@]}" -o "$T/pig.json" \
     --render "$T/pig.png" --overlay "$T/pig_overlay.png" 2>"$T/log" || { cat "$T/log"; fail "fill run"; }
 for f in pig.json pig.png pig_overlay.png; do [ -s "$T/$f" ] || fail "$f not written"; done
 grep -q 'settled: converged' "$T/log" || fail "not settled: $(cat "$T/log")"
