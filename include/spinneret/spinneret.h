@@ -13,5 +13,6 @@
 #include "export.h"
 #include "mesh.h"
 #include "shoot.h"
+#include "inscribe.h"
 
 #endif
