@@ -70,9 +70,9 @@ void view_key(view_state *v, int key)
     case GLFW_KEY_S: stop_motion(v); break;
     case GLFW_KEY_SPACE: v->paused = !v->paused; break;
     case GLFW_KEY_PERIOD: v->paused = true; v->single_step = true; break;
-    case GLFW_KEY_W: v->wind_on = !v->wind_on; break;
-    case GLFW_KEY_LEFT_BRACKET: v->wind_strength = fmax(0.0, v->wind_strength / 1.25); break;
-    case GLFW_KEY_RIGHT_BRACKET: v->wind_strength = fmin(50.0, v->wind_strength * 1.25 + 0.01); break;
+    case GLFW_KEY_W: v->wind_on = !v->wind_on; view_wind_update(v); break;
+    case GLFW_KEY_LEFT_BRACKET: v->wind_strength = fmax(0.0, v->wind_strength / 1.25); view_wind_update(v); break;
+    case GLFW_KEY_RIGHT_BRACKET: v->wind_strength = fmin(50.0, v->wind_strength * 1.25 + 0.01); view_wind_update(v); break;
     case GLFW_KEY_D: v->show_dew = !v->show_dew; break;
     case GLFW_KEY_H: v->show_help = !v->show_help; break;
     case GLFW_KEY_P: take_screenshot(v); break;

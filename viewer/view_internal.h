@@ -56,7 +56,8 @@ struct view_state {
     bool show_vertices, show_edges, show_energy, show_faces, show_background, show_dew, show_help;
     /* simulation switches */
     bool paused, single_step, gravity_on, gravity_reversed, wind_on;
-    double wind_strength;     /* m/s */
+    double wind_strength;     /* mean wind speed [m/s] */
+    spn_air_field *air;       /* while the wind blows */
     spn_vec3 base_gravity;
 
     /* camera: orbit around `centre` */
@@ -119,6 +120,11 @@ void view_mouse_move(view_state *v, double x, double y);
 spn_status view_load_script(view_state *v, const char *path);
 void view_run_script(view_state *v);
 int view_key_from_name(const char *name);
+
+/* view_wind.c */
+void view_wind_update(view_state *v);            /* after toggling, a new strength or a new world */
+void view_wind_prepare(view_state *v, double t0, double t1);
+void view_wind_release(view_state *v);
 
 /* view_main.c */
 spn_status view_build_web(view_state *v);

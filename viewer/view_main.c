@@ -22,6 +22,7 @@ static double now_seconds(void)
 
 void view_set_world(view_state *v, spn_world *w)
 {
+    view_wind_release(v);
     spn_world_destroy(v->world);
     v->world = w;
     if (!w) return;
@@ -30,6 +31,7 @@ void view_set_world(view_state *v, spn_world *w)
     spn_world_set_integrator(w, v->opt.solver);
     v->grabbed = -1;
     if (!v->opt.build_mode) view_frame_camera(v); /* a built web stays where it was clicked */
+    view_wind_update(v);
 }
 
 void view_step(view_state *v, double frame_dt)
@@ -39,6 +41,7 @@ void view_step(view_state *v, double frame_dt)
     int n = (int)ceil(frame_dt / v->opt.dt - 1e-9);
     if (n < 1) n = 1;
     double t0 = now_seconds();
+    view_wind_prepare(v, spn_world_time(v->world), spn_world_time(v->world) + frame_dt);
     for (int i = 0; i < n; i++) {
         spn_status st = spn_world_step(v->world, frame_dt / n);
         if (st != SPN_OK) {

@@ -15,5 +15,6 @@
 #include "interrupt.h"
 #include "mesh.h"
 #include "shoot.h"
+#include "inscribe.h"
 
 #endif
