@@ -30,6 +30,8 @@ writers=(
   "export $T/web.json -o OUT.json"
   "settle $T/web.json -o OUT.json --max-time 0.001"
   "shoot --from 0,1.5,0 --to 3,3,0 -o OUT.json"
+  "build --species araneus -o OUT.json"
+  "inscribe $DATA/inscribe/orb.json --image $DATA/inscribe/plus.pbm --raster 64 --no-settle -o OUT.json"
 )
 
 run_to() { # writer-line output-base -> runs it, sets rc, err in $T/err
