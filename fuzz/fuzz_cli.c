@@ -13,6 +13,9 @@
  * next. PATH is emptied: no ffmpeg or povray is started (their absence is an
  * error path worth fuzzing; the programs themselves are not ours).
  *
+ * A crash input is replayed by tests/cli/hostile_found.sh once written to
+ * tests/data/bad/hostile_cli/ with its row's appended arguments.
+ *
  * Hangs are kept out by the table below, one row per subcommand: every
  * number in the arguments must lie in [-cap, cap] and, unless zero, be at
  * least 1e-3 in size (a 1e-9 s time step over 60 s is a legitimate command
@@ -224,22 +227,24 @@ static int split(const uint8_t *data, size_t size, char *text, char **words)
     return n;
 }
 
-/* Runs one command with stdout and stderr silenced; returns its exit code. */
+/* Runs one command with stdout and stderr silenced; returns its exit code.
+ * stdout is silenced at its descriptor, stderr by swapping the FILE: the
+ * sanitizers write their reports to descriptor 2, which must stay open. */
 static int run(const command *c, int argc, char **argv)
 {
     fflush(stdout);
-    fflush(stderr);
-    int out = dup(1), err = dup(2), null = open("/dev/null", O_WRONLY);
+    int out = dup(1), null = open("/dev/null", O_WRONLY);
     dup2(null, 1);
-    dup2(null, 2);
+    FILE *saved = stderr;
+    stderr = fopen("/dev/null", "w");
     optind = 0; /* glibc: 0 re-initialises getopt completely */
     int rc = c->fn(argc, argv);
     spn_render_release_caches();
     fflush(stdout);
-    fflush(stderr);
+    fclose(stderr);
+    stderr = saved;
     dup2(out, 1);
-    dup2(err, 2);
-    close(out), close(err), close(null);
+    close(out), close(null);
     return rc;
 }
 

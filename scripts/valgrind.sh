@@ -25,6 +25,9 @@ report() { printf '{"test":"%s","seconds":%s,"ok":%s}\n' "$1" "$2" "$3"; }
 for t in "$build"/tests/test_*; do
   [ -x "$t" ] || continue
   name=$(basename "$t"); [[ $name =~ $only ]] || continue
+  # It re-executes itself through /proc/self/exe, which under valgrind is
+  # valgrind's own tool binary: nothing to learn there about our memory.
+  [ "$name" = test_physics_determinism ] && continue
   s=$(date +%s)
   (cd "$build" && SPN_TEST_DATA=$src/tests/data "${vg[@]}" "$t" >"$T/out" 2>&1); rc=$?
   report "$name" $(($(date +%s) - s)) "$([ $rc -eq 0 ] && echo true || echo false)"

@@ -85,10 +85,12 @@ double spn__band_sum(const spn_target *t, const float *ink, spn_vec3 a, spn_vec3
     spn_target_to_pixel(t, b, &bx, &by);
     double dx = bx - ax, dy = by - ay, len = hypot(dx, dy);
     double h = SPN__BAND_HALF;
-    int i0 = (int)floor(fmin(ax, bx) - h), i1 = (int)ceil(fmax(ax, bx) + h);
-    int j0 = (int)floor(fmin(ay, by) - h), j1 = (int)ceil(fmax(ay, by) + h);
-    i0 = i0 < 0 ? 0 : i0, j0 = j0 < 0 ? 0 : j0;
-    i1 = i1 > t->width ? t->width : i1, j1 = j1 > t->height ? t->height : j1;
+    /* Clamp in doubles, then convert: a segment far off the raster (a web
+     * that blew up reached 1e84 px) must not pass through int (undefined). */
+    int i0 = (int)fmax(0, fmin(t->width, floor(fmin(ax, bx) - h)));
+    int i1 = (int)fmax(0, fmin(t->width, ceil(fmax(ax, bx) + h)));
+    int j0 = (int)fmax(0, fmin(t->height, floor(fmin(ay, by) - h)));
+    int j1 = (int)fmax(0, fmin(t->height, ceil(fmax(ay, by) + h)));
     double ux = len > 0 ? dx / len : 1, uy = len > 0 ? dy / len : 0, sum = 0, n = 0;
     for (int j = j0; j < j1; j++)
         for (int i = i0; i < i1; i++) {
