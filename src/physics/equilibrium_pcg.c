@@ -1,0 +1,170 @@
+/* Preconditioned conjugate gradients for one Newton step of the equilibrium
+ * solver (A p = f, A the projected Hessian over free particles), and the
+ * simple preconditioners: Jacobi (the diagonal) and block Jacobi (each
+ * particle's 3x3 diagonal block inverted, which undoes the local anisotropy
+ * of silk: a thread is ~50x stiffer along itself than across). The multigrid
+ * preconditioner lives in equilibrium_mg.c.
+ *
+ * Every sum is a fixed-order block reduction (spn__eq_dot), so the iterates
+ * are the same bits for any thread count. */
+#include "equilibrium_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define PAR_MIN 4096u
+
+static int team(const spn__eq *e) { return e->n < PAR_MIN ? 1 : e->threads; }
+
+spn_status spn__precond_setup(spn__precond *pc, const spn__eq *e)
+{
+    const uint32_t n = e->n;
+    if (!pc->inv) {
+        pc->inv = malloc(6 * (size_t)(n ? n : 1) * sizeof *pc->inv);
+        if (!pc->inv) return spn_error(SPN_ERR_NOMEM, "equilibrium: out of memory");
+    }
+    int bad = 0;
+    bool block = pc->kind != SPN_PRECOND_JACOBI;
+#pragma omp parallel for schedule(static) num_threads(team(e)) reduction(+ : bad)
+    for (uint32_t i = 0; i < n; i++) {
+        const double *d = e->diag + 6 * (size_t)i;
+        double *inv = pc->inv + 6 * (size_t)i;
+        if (block) {
+            if (!spn__sym_inverse(d, inv)) bad++;
+        } else if (d[0] > 0 && d[1] > 0 && d[2] > 0) {
+            inv[0] = 1 / d[0];
+            inv[1] = 1 / d[1];
+            inv[2] = 1 / d[2];
+            inv[3] = inv[4] = inv[5] = 0;
+        } else {
+            bad++;
+        }
+    }
+    if (bad) return SPN_ERR_UNSTABLE; /* a particle without stiffness: the caller shifts the diagonal */
+    if (pc->kind == SPN_PRECOND_MULTIGRID) return spn__mg_setup(&pc->mg, e, pc->inv);
+    return SPN_OK;
+}
+
+/* Symmetric block Gauss-Seidel, M = (D + L) D^-1 (D + U) in particle order:
+ * a forward sweep solves (D + L) y = r, a backward one (D + U) z = D y.
+ * Sequential by nature (so it runs on one thread and gives the same bits). */
+void spn__sgs_apply(const spn__eq *e, const double *inv, const double *r, double *z)
+{
+    const uint32_t n = e->n;
+    const uint32_t *start = e->adj_start;
+    const int32_t *col = e->adj_col;
+    const double *offd = e->offd;
+    for (uint32_t i = 0; i < n; i++) {
+        double acc[3] = {r[3 * i], r[3 * i + 1], r[3 * i + 2]};
+        for (uint32_t j = start[i]; j < start[i + 1]; j++) {
+            uint32_t c = (uint32_t)col[j];
+            if (c >= i) continue;
+            double t[3];
+            spn__sym_mul(offd + 6 * (size_t)j, z + 3 * (size_t)c, t);
+            acc[0] -= t[0], acc[1] -= t[1], acc[2] -= t[2];
+        }
+        spn__sym_mul(inv + 6 * (size_t)i, acc, z + 3 * (size_t)i);
+    }
+    /* z now holds y; (D + U) z = D y  <=>  z_i = y_i - D_i^-1 sum_{j > i} A_ij z_j */
+    for (uint32_t i = n; i-- > 0;) {
+        double acc[3] = {0, 0, 0};
+        for (uint32_t j = start[i]; j < start[i + 1]; j++) {
+            uint32_t c = (uint32_t)col[j];
+            if (c <= i) continue;
+            double t[3];
+            spn__sym_mul(offd + 6 * (size_t)j, z + 3 * (size_t)c, t);
+            acc[0] += t[0], acc[1] += t[1], acc[2] += t[2];
+        }
+        double d[3];
+        spn__sym_mul(inv + 6 * (size_t)i, acc, d);
+        z[3 * i] -= d[0], z[3 * i + 1] -= d[1], z[3 * i + 2] -= d[2];
+    }
+}
+
+void spn__precond_apply(const spn__precond *pc, const spn__eq *e, const double *r, double *z)
+{
+    if (pc->kind == SPN_PRECOND_SGS) {
+        spn__sgs_apply(e, pc->inv, r, z);
+        return;
+    }
+    if (pc->kind == SPN_PRECOND_MULTIGRID && pc->mg) {
+        spn__mg_apply(pc->mg, e, r, z);
+        return;
+    }
+    const uint32_t n = e->n;
+#pragma omp parallel for schedule(static) num_threads(team(e))
+    for (uint32_t i = 0; i < n; i++) spn__sym_mul(pc->inv + 6 * (size_t)i, r + 3 * (size_t)i, z + 3 * (size_t)i);
+}
+
+void spn__precond_free(spn__precond *pc)
+{
+    free(pc->inv);
+    spn__mg_free(pc->mg);
+    pc->inv = NULL;
+    pc->mg = NULL;
+}
+
+/* z = M^-1 r; returns r . z (block preconditioners fused in one pass). */
+static double precond_dot(const spn__precond *pc, const spn__eq *e, const double *r, double *z)
+{
+    if ((pc->kind == SPN_PRECOND_MULTIGRID && pc->mg) || pc->kind == SPN_PRECOND_SGS) {
+        spn__precond_apply(pc, e, r, z);
+        return spn__eq_dot(e, r, z);
+    }
+    const uint32_t n = e->n, nchunks = e->nchunks;
+#pragma omp parallel for schedule(static) num_threads(team(e))
+    for (uint32_t c = 0; c < nchunks; c++) {
+        uint32_t end = (c + 1) * SPN__EQ_CHUNK < n ? (c + 1) * SPN__EQ_CHUNK : n;
+        double s0 = 0, s1 = 0, s2 = 0;
+        for (uint32_t i = c * SPN__EQ_CHUNK; i < end; i++) {
+            const double *ri = r + 3 * (size_t)i;
+            double *zi = z + 3 * (size_t)i;
+            spn__sym_mul(pc->inv + 6 * (size_t)i, ri, zi);
+            s0 += ri[0] * zi[0];
+            s1 += ri[1] * zi[1];
+            s2 += ri[2] * zi[2];
+        }
+        e->partial[c] = s0 + s1 + s2;
+    }
+    double sum = 0;
+    for (uint32_t c = 0; c < nchunks; c++) sum += e->partial[c];
+    return sum;
+}
+
+/* y = x + b y */
+static void xpby(const spn__eq *e, const double *x, double b, double *y)
+{
+    const uint32_t n3 = 3 * e->n;
+#pragma omp parallel for schedule(static) num_threads(team(e))
+    for (uint32_t i = 0; i < n3; i++) y[i] = x[i] + b * y[i];
+}
+
+int spn__eq_pcg(const spn__eq *e, const spn__precond *pc, double *p, double eta, int max_iter, double *work)
+{
+    const size_t n3 = 3 * (size_t)e->n;
+    double *r = work, *z = work + n3, *d = work + 2 * n3, *q = work + 3 * n3;
+    double bnorm = sqrt(spn__eq_dot(e, e->f, e->f));
+    if (!(bnorm > 0)) {
+        memset(p, 0, n3 * sizeof *p);
+        return 0;
+    }
+    /* warm start: r = f - A p */
+    spn__eq_matvec(e, p, r);
+    for (size_t i = 0; i < n3; i++) r[i] = e->f[i] - r[i];
+    if (sqrt(spn__eq_dot(e, r, r)) <= eta * bnorm) return 0;
+    double rz = precond_dot(pc, e, r, z);
+    memcpy(d, z, n3 * sizeof *d);
+    for (int it = 0; it < max_iter; it++) {
+        double dq = spn__eq_matvec_dot(e, d, q);
+        if (!(dq > 0)) return -1;
+        double alpha = rz / dq;
+        double rr = spn__eq_update(e, alpha, d, q, p, r);
+        if (sqrt(rr) <= eta * bnorm) return it + 1;
+        double rz_new = precond_dot(pc, e, r, z);
+        if (!(rz_new > 0)) return it + 1;
+        xpby(e, z, rz_new / rz, d);
+        rz = rz_new;
+    }
+    return max_iter;
+}
