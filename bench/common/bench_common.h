@@ -34,4 +34,10 @@ double bench_cpu_now(void);
 /// gravity and a uniform `load` per free particle. Not the solver's code.
 double bench_residual(const spn_world *w, spn_vec3 load);
 
+/// Move `w` to equilibrium (springs, gravity, uniform `load`) by Newton with
+/// the exact Hessian and a banded Cholesky solve, until the largest net force
+/// is <= tol [N]. Returns the Newton iterations, or -1 on failure. The
+/// reference for the sag check: independent of the library's solver.
+int bench_reference_newton(spn_world *w, spn_vec3 load, double tol, int max_iter);
+
 #endif

@@ -27,10 +27,11 @@ typedef enum spn_precond {
     SPN_PRECOND_BLOCK_JACOBI, ///< each particle's 3x3 diagonal block, inverted
     SPN_PRECOND_MULTIGRID,   ///< aggregation multigrid V-cycle over the spring graph
     SPN_PRECOND_SGS,         ///< symmetric block Gauss-Seidel (sequential)
+    SPN_PRECOND_AUTO,        ///< block Jacobi below 50,000 free particles, multigrid above (measured)
     SPN_PRECOND_COUNT
 } spn_precond;
 
-/// "jacobi", "block-jacobi", "multigrid", "sgs".
+/// "jacobi", "block-jacobi", "multigrid", "sgs", "auto".
 SPN_API const char *spn_precond_name(spn_precond p);
 /// Parse a name as above; SPN_ERR_INVALID naming the choices otherwise.
 SPN_API spn_status spn_precond_parse(const char *name, spn_precond *out);
@@ -42,7 +43,7 @@ typedef struct spn_equilibrium_def {
                           ///< slack world, the largest external force on a particle. Default 0
     int max_iterations;   ///< Newton iterations, default 200
     int max_cg_iterations; ///< per linear solve, default 5000
-    spn_precond preconditioner; ///< default SPN_PRECOND_MULTIGRID
+    spn_precond preconditioner; ///< default SPN_PRECOND_AUTO
     bool gravity;         ///< include the world's gravity; default true
     spn_vec3 load;        ///< constant force on every free particle [N]; default 0
     const spn_vec3 *loads; ///< NULL or particle_count forces [N] added per particle
@@ -71,6 +72,7 @@ typedef struct spn_equilibrium_report {
     double energy_change;  ///< potential energy end - start [J] (<= 0)
     double max_displacement; ///< largest distance a particle moved [m]
     uint32_t worst;        ///< the particle with the largest residual at the end
+    spn_precond preconditioner; ///< the one used (auto resolved)
 } spn_equilibrium_report;
 
 /// Move the free particles of `w` to a static equilibrium (velocities set to

@@ -81,9 +81,10 @@ void spn__precond_free(spn__precond *pc);
 /* Symmetric block Gauss-Seidel with the inverted diagonal blocks inv. */
 void spn__sgs_apply(const spn__eq *e, const double *inv, const double *r, double *z);
 
-/* Solve A p = f to a relative residual eta with p as the first guess.
+/* Solve A p = f until |A p - f|_2 <= max(eta |f|_2, floor), p the first guess.
  * Returns the iterations used, or -1 when A showed non-positive curvature. */
-int spn__eq_pcg(const spn__eq *e, const spn__precond *pc, double *p, double eta, int max_iter, double *work);
+int spn__eq_pcg(const spn__eq *e, const spn__precond *pc, double *p, double eta, double floor, int max_iter,
+                double *work);
 
 /* Symmetric 3x3 block helpers (6-double layout). */
 static inline void spn__sym_mul(const double *h, const double *v, double *out)

@@ -21,7 +21,6 @@
 #include "equilibrium_internal.h"
 
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -29,18 +28,15 @@
 #define COARSEST 96u
 #define MAX_LEVELS 24
 #ifndef SWEEPS
-#define SWEEPS 2
+#define SWEEPS 1
 #endif
 #ifndef OMEGA
 #define OMEGA 0.6
 #endif
-#ifndef OVER
-#define OVER 1.0
+#ifndef FINE_GS
+#define FINE_GS 1
 #endif
-#ifndef CYCLES
-#define CYCLES 1
-#endif
-#define PAR_MIN 4096u
+#define PAR_MIN 32768u
 
 typedef struct mg_level {
     uint32_t n;                 /* rows (particles or aggregates) */
@@ -361,10 +357,6 @@ spn_status spn__mg_setup(spn__mg **out, const spn__eq *e, const double *inv0)
             l++;
         }
         if (mg->nlevels == 0) mg->nlevels = 1;
-        if (getenv("SPN_EQ_DEBUG"))
-            for (int k = 0; k < mg->nlevels; k++)
-                fprintf(stderr, "level %d: %u rows, %u blocks\n", k, mg->lv[k].n,
-                        k ? mg->lv[k].row_start[mg->lv[k].n] : e->adj_start[e->n]);
         size_t N = 3 * (size_t)mg->lv[mg->nlevels - 1].n;
         mg->dense = malloc((N ? N * N : 1) * sizeof *mg->dense);
         if (!mg->dense) return spn_error(SPN_ERR_NOMEM, "equilibrium: out of memory (multigrid)");
@@ -411,6 +403,24 @@ static void jacobi(const spn__mg *mg, const mg_level *L, const double *r, double
     }
 }
 
+/* One block Gauss-Seidel sweep on level 0 (forward or backward), in place. */
+static void gauss_seidel(const spn__eq *e, const double *inv, const double *b, double *x, bool forward)
+{
+    const uint32_t n = e->n;
+    for (uint32_t k = 0; k < n; k++) {
+        uint32_t i = forward ? k : n - 1 - k;
+        double acc[3] = {b[3 * i], b[3 * i + 1], b[3 * i + 2]};
+        for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++) {
+            uint32_t c = (uint32_t)e->adj_col[j];
+            if (c == i) continue;
+            double t[3];
+            spn__sym_mul(e->offd + 6 * (size_t)j, x + 3 * (size_t)c, t);
+            acc[0] -= t[0], acc[1] -= t[1], acc[2] -= t[2];
+        }
+        spn__sym_mul(inv + 6 * (size_t)i, acc, x + 3 * (size_t)i);
+    }
+}
+
 static void vcycle(const spn__mg *mg, const spn__eq *e, int l, const double *b, double *x)
 {
     const mg_level *L = &mg->lv[l];
@@ -418,10 +428,15 @@ static void vcycle(const spn__mg *mg, const spn__eq *e, int l, const double *b, 
         dense_solve(mg, L, b, x);
         return;
     }
-    jacobi(mg, L, b, x, true);
-    for (int s = 1; s < SWEEPS; s++) {
-        residual(mg, e, l, b, x, L->r);
-        jacobi(mg, L, L->r, x, false);
+    if (l == 0 && FINE_GS) {
+        memset(x, 0, 3 * (size_t)L->n * sizeof *x);
+        for (int s = 0; s < SWEEPS; s++) gauss_seidel(e, L->inv, b, x, true);
+    } else {
+        jacobi(mg, L, b, x, true);
+        for (int s = 1; s < SWEEPS; s++) {
+            residual(mg, e, l, b, x, L->r);
+            jacobi(mg, L, L->r, x, false);
+        }
     }
     residual(mg, e, l, b, x, L->r);
     const mg_level *C = &mg->lv[l + 1];
@@ -433,18 +448,13 @@ static void vcycle(const spn__mg *mg, const spn__eq *e, int l, const double *b, 
         memcpy(C->b + 3 * (size_t)I, s, sizeof s);
     }
     vcycle(mg, e, l + 1, C->b, C->x);
-    if (CYCLES > 1 && l + 2 < mg->nlevels) { /* W-cycle: a second coarse pass on the new residual */
-        double *xs = C->r;
-        memcpy(xs, C->x, 3 * (size_t)C->n * sizeof *xs);
-        residual(mg, e, l + 1, C->b, xs, C->x); /* C->x = b - A xs */
-        memcpy(C->b, C->x, 3 * (size_t)C->n * sizeof *xs);
-        vcycle(mg, e, l + 1, C->b, C->x);
-        for (size_t k = 0; k < 3 * (size_t)C->n; k++) C->x[k] += xs[k];
-    }
-    const double over = OVER;
 #pragma omp parallel for schedule(static) num_threads(team(mg, L->n))
     for (uint32_t i = 0; i < L->n; i++)
-        for (int c = 0; c < 3; c++) x[3 * i + c] += over * C->x[3 * (size_t)L->agg[i] + c];
+        for (int c = 0; c < 3; c++) x[3 * i + c] += C->x[3 * (size_t)L->agg[i] + c];
+    if (l == 0 && FINE_GS) {
+        for (int s = 0; s < SWEEPS; s++) gauss_seidel(e, L->inv, b, x, false);
+        return;
+    }
     for (int s = 0; s < SWEEPS; s++) {
         residual(mg, e, l, b, x, L->r);
         jacobi(mg, L, L->r, x, false);

@@ -13,7 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define PAR_MIN 4096u
+#define PAR_MIN 32768u
 
 static int team(const spn__eq *e) { return e->n < PAR_MIN ? 1 : e->threads; }
 
@@ -140,7 +140,8 @@ static void xpby(const spn__eq *e, const double *x, double b, double *y)
     for (uint32_t i = 0; i < n3; i++) y[i] = x[i] + b * y[i];
 }
 
-int spn__eq_pcg(const spn__eq *e, const spn__precond *pc, double *p, double eta, int max_iter, double *work)
+int spn__eq_pcg(const spn__eq *e, const spn__precond *pc, double *p, double eta, double floor, int max_iter,
+                double *work)
 {
     const size_t n3 = 3 * (size_t)e->n;
     double *r = work, *z = work + n3, *d = work + 2 * n3, *q = work + 3 * n3;
@@ -149,10 +150,11 @@ int spn__eq_pcg(const spn__eq *e, const spn__precond *pc, double *p, double eta,
         memset(p, 0, n3 * sizeof *p);
         return 0;
     }
+    double stop = fmax(eta * bnorm, floor);
     /* warm start: r = f - A p */
     spn__eq_matvec(e, p, r);
     for (size_t i = 0; i < n3; i++) r[i] = e->f[i] - r[i];
-    if (sqrt(spn__eq_dot(e, r, r)) <= eta * bnorm) return 0;
+    if (sqrt(spn__eq_dot(e, r, r)) <= stop) return 0;
     double rz = precond_dot(pc, e, r, z);
     memcpy(d, z, n3 * sizeof *d);
     for (int it = 0; it < max_iter; it++) {
@@ -160,7 +162,7 @@ int spn__eq_pcg(const spn__eq *e, const spn__precond *pc, double *p, double eta,
         if (!(dq > 0)) return -1;
         double alpha = rz / dq;
         double rr = spn__eq_update(e, alpha, d, q, p, r);
-        if (sqrt(rr) <= eta * bnorm) return it + 1;
+        if (sqrt(rr) <= stop) return it + 1;
         double rz_new = precond_dot(pc, e, r, z);
         if (!(rz_new > 0)) return it + 1;
         xpby(e, z, rz_new / rz, d);

@@ -32,7 +32,7 @@
 #include <omp.h>
 #endif
 
-#define PAR_MIN 4096u /* below this many items a loop runs on one thread */
+#define PAR_MIN 32768u /* below this many items a loop runs on one thread: smaller loops lose more to the fork than they gain */
 
 static int team(const spn__eq *e, uint32_t items) { return items < PAR_MIN ? 1 : e->threads; }
 
@@ -369,15 +369,22 @@ double spn__eq_energy_delta(spn__eq *e, const double *p, double alpha)
  * the row itself, so the loop has no branch). */
 static inline void matvec_row(const double *restrict diag, const uint32_t *restrict start,
                               const int32_t *restrict col, const double *restrict offd, uint32_t i,
-                              const double *restrict p, double *restrict acc)
+                              const double *restrict p, double *restrict y)
 {
-    spn__sym_mul(diag + 6 * (size_t)i, p + 3 * (size_t)i, acc);
+    const double *d = diag + 6 * (size_t)i, *pi = p + 3 * (size_t)i;
+    /* scalars, not an array: a copy out of a stack array stalls on store forwarding */
+    double a0 = d[0] * pi[0] + d[3] * pi[1] + d[4] * pi[2];
+    double a1 = d[3] * pi[0] + d[1] * pi[1] + d[5] * pi[2];
+    double a2 = d[4] * pi[0] + d[5] * pi[1] + d[2] * pi[2];
     for (uint32_t j = start[i]; j < start[i + 1]; j++) {
         const double *h = offd + 6 * (size_t)j, *v = p + 3 * (size_t)col[j];
-        acc[0] += h[0] * v[0] + h[3] * v[1] + h[4] * v[2];
-        acc[1] += h[3] * v[0] + h[1] * v[1] + h[5] * v[2];
-        acc[2] += h[4] * v[0] + h[5] * v[1] + h[2] * v[2];
+        a0 += h[0] * v[0] + h[3] * v[1] + h[4] * v[2];
+        a1 += h[3] * v[0] + h[1] * v[1] + h[5] * v[2];
+        a2 += h[4] * v[0] + h[5] * v[1] + h[2] * v[2];
     }
+    y[3 * (size_t)i] = a0;
+    y[3 * (size_t)i + 1] = a1;
+    y[3 * (size_t)i + 2] = a2;
 }
 
 double spn__eq_matvec_dot(const spn__eq *e, const double *p, double *y)
@@ -388,13 +395,11 @@ double spn__eq_matvec_dot(const spn__eq *e, const double *p, double *y)
         uint32_t end = (c + 1) * SPN__EQ_CHUNK < n ? (c + 1) * SPN__EQ_CHUNK : n;
         double s0 = 0, s1 = 0, s2 = 0;
         for (uint32_t i = c * SPN__EQ_CHUNK; i < end; i++) {
-            double acc[3];
-            matvec_row(e->diag, e->adj_start, e->adj_col, e->offd, i, p, acc);
-            const double *pi = p + 3 * (size_t)i;
-            s0 += acc[0] * pi[0];
-            s1 += acc[1] * pi[1];
-            s2 += acc[2] * pi[2];
-            memcpy(y + 3 * (size_t)i, acc, sizeof acc);
+            matvec_row(e->diag, e->adj_start, e->adj_col, e->offd, i, p, y);
+            const double *pi = p + 3 * (size_t)i, *yi = y + 3 * (size_t)i;
+            s0 += yi[0] * pi[0];
+            s1 += yi[1] * pi[1];
+            s2 += yi[2] * pi[2];
         }
         e->partial[c] = s0 + s1 + s2;
     }
