@@ -24,6 +24,7 @@ typedef struct spn__eq {
     double *xtrial;    /* 3 n: line-search positions */
 
     uint32_t m;        /* springs with a free end, not broken */
+    uint32_t m_free;   /* the first m_free join two free particles; the rest have a (free) and b fixed */
     uint32_t *sa, *sb; /* local ids */
     double *k, *rest;
     uint8_t *tonly;
@@ -39,6 +40,7 @@ typedef struct spn__eq {
     double *diag; /* 6 n: diagonal blocks (springs + shift) */
     double *offd; /* 6 per adjacency entry: -H_s of the row's spring (0 to a fixed end) */
     double *kscale; /* n: sum of incident k, the scale of the Levenberg shift */
+    double lambda;  /* the shift of the last assembly */
     double *f;    /* 3 n: net force = -gradient */
     double noise; /* rounding scale of an energy difference [J] */
     double xmax;  /* largest |coordinate| at the start [m] */

@@ -118,12 +118,15 @@ static double precond_dot(const spn__precond *pc, const spn__eq *e, const double
         uint32_t end = (c + 1) * SPN__EQ_CHUNK < n ? (c + 1) * SPN__EQ_CHUNK : n;
         double s0 = 0, s1 = 0, s2 = 0;
         for (uint32_t i = c * SPN__EQ_CHUNK; i < end; i++) {
-            const double *ri = r + 3 * (size_t)i;
-            double *zi = z + 3 * (size_t)i;
-            spn__sym_mul(pc->inv + 6 * (size_t)i, ri, zi);
-            s0 += ri[0] * zi[0];
-            s1 += ri[1] * zi[1];
-            s2 += ri[2] * zi[2];
+            const double *ri = r + 3 * (size_t)i, *h = pc->inv + 6 * (size_t)i;
+            /* scalars: writing z and reading it back would stall on store forwarding */
+            double z0 = h[0] * ri[0] + h[3] * ri[1] + h[4] * ri[2];
+            double z1 = h[3] * ri[0] + h[1] * ri[1] + h[5] * ri[2];
+            double z2 = h[4] * ri[0] + h[5] * ri[1] + h[2] * ri[2];
+            z[3 * (size_t)i] = z0, z[3 * (size_t)i + 1] = z1, z[3 * (size_t)i + 2] = z2;
+            s0 += ri[0] * z0;
+            s1 += ri[1] * z1;
+            s2 += ri[2] * z2;
         }
         e->partial[c] = s0 + s1 + s2;
     }
