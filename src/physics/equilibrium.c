@@ -124,6 +124,7 @@ typedef struct newton {
     double lambda, target, residual, eta, energy_change;
     uint32_t worst;
     int max_cg, stalls;
+    spn_status status; /* SPN_OK, or the failure that ended the run */
     spn_equilibrium_report rep;
 } newton;
 
@@ -139,12 +140,26 @@ static double forcing(const newton *nt, double previous_residual)
     return fmin(0.5, eta);
 }
 
+/* Take the line-search positions as the current ones (or back): the fixed
+ * particles sit in both arrays, and only free ones are ever written. */
+static void swap_positions(spn__eq *e)
+{
+    double *t = e->x;
+    e->x = e->xtrial;
+    e->xtrial = t;
+}
+
 /* One Newton iteration. Returns 1 to go on, 0 when stalled. */
 static int newton_iteration(newton *nt)
 {
     spn__eq *e = &nt->e;
     size_t n3 = 3 * (size_t)e->n;
-    if (spn__precond_setup(&nt->pc, e) != SPN_OK) {
+    spn_status st = spn__precond_setup(&nt->pc, e);
+    if (st == SPN_ERR_NOMEM) {
+        nt->status = st;
+        return 0;
+    }
+    if (st != SPN_OK) { /* a particle without stiffness, or a coarse level not positive definite */
         nt->lambda = grow_lambda(nt->lambda);
         nt->residual = spn__eq_assemble(e, nt->lambda, &nt->worst);
         return nt->lambda < LAMBDA_MAX;
@@ -161,21 +176,29 @@ static int newton_iteration(newton *nt)
     }
     /* CG from zero keeps p^T A p = f^T p, so the quadratic model predicts a drop of slope / 2 */
     double de = spn__eq_energy_delta(e, nt->p, 1), rho = isfinite(de) ? -de / (0.5 * slope) : -1;
-    if (!(de <= -ARMIJO * slope) && !(fabs(de) <= e->noise)) { /* the model was wrong: shift and retry */
+    bool armijo = de <= -ARMIJO * slope, rounding = fabs(de) <= e->noise;
+    if (!armijo && !rounding) { /* the model was wrong: shift and retry */
         nt->rep.backtracks++;
         nt->lambda = fmax(LAMBDA_FIRST, 4 * nt->lambda);
         nt->residual = spn__eq_assemble(e, nt->lambda, &nt->worst);
         return nt->lambda < LAMBDA_MAX;
     }
-    memcpy(e->x, e->xtrial, n3 * sizeof *e->x);
-    nt->energy_change += de;
+    if (!armijo) rho = 1; /* the energy cannot tell: the residual decides below */
+    double previous = nt->residual, lambda = nt->lambda;
     if (rho > 0.75) nt->lambda = nt->lambda > 1e-9 ? nt->lambda / 3 : 0;
     else if (rho < 0.25) nt->lambda = fmax(LAMBDA_FIRST, 2 * nt->lambda);
-    double previous = nt->residual;
+    swap_positions(e);
     nt->residual = spn__eq_assemble(e, nt->lambda, &nt->worst);
-    nt->stalls = (de < -e->noise || nt->residual < previous) ? 0 : nt->stalls + 1;
+    if (!armijo && !(nt->residual < previous)) { /* a step lost in rounding that did not help: undo */
+        swap_positions(e);
+        nt->lambda = lambda;
+        nt->residual = spn__eq_assemble(e, nt->lambda, &nt->worst);
+        return ++nt->stalls < STALL_LIMIT;
+    }
+    nt->energy_change += de;
+    nt->stalls = 0;
     nt->eta = forcing(nt, previous);
-    return nt->stalls < STALL_LIMIT;
+    return 1;
 }
 
 static void run(newton *nt, const spn_equilibrium_def *d)
@@ -204,6 +227,7 @@ static void run(newton *nt, const spn_equilibrium_def *d)
             nt->rep.reason = SPN_EQUILIBRIUM_STALLED;
             break;
         }
+        if (nt->status != SPN_OK) break;
     }
     if (e->iso_force > nt->residual || e->n == 0) {
         nt->residual = fmax(nt->residual, e->iso_force);
@@ -260,7 +284,7 @@ spn_status spn_world_equilibrium(spn_world *w, const spn_equilibrium_def *def, s
         st = spn_error(SPN_ERR_NOMEM, "equilibrium: out of memory");
     } else {
         run(&nt, &d);
-        st = write_back(&nt, w, report);
+        st = nt.status != SPN_OK ? nt.status : write_back(&nt, w, report);
     }
     free(nt.p);
     free(nt.work);
