@@ -34,7 +34,7 @@ spn_world *bench_cloth(int threads)
     spn_world_def wd = spn_world_def_default();
     wd.threads = threads;
     spn_world *w = NULL;
-    spn_status st = spn_scene_cloth(&wd, 64, 64, 1.0, 0.0, 0.1, 500, 0.01, 1u | 2u, &w);
+    spn_status st = spn_scene_cloth(&wd, 64, 64, 1.0, 0.0, 0.1, 500, 0.01, 15u, &w);
     return or_die(st, w);
 }
 
