@@ -304,28 +304,45 @@ static void test_slack_and_compressed_stay_stable(void **state)
     spn_world_destroy(s);
 }
 
+/* Solve the standard web (rings x radials) with `threads` and precond; a copy of the positions. */
+static spn_vec3 *solve_copy(int rings, int radials, int threads, spn_precond pc, int max_iterations)
+{
+    spn_world *w = small_orb(rings, radials, 0.02, threads);
+    spn_equilibrium_def d = spn_equilibrium_def_default();
+    d.load = spn_v3(0, 0, 3e-7);
+    d.max_iterations = max_iterations;
+    d.preconditioner = pc;
+    spn_equilibrium_report r;
+    assert_int_equal(spn_world_equilibrium(w, &d, &r), SPN_OK);
+    assert_int_equal(r.iterations, r.reason == SPN_EQUILIBRIUM_CONVERGED ? r.iterations : max_iterations);
+    uint32_t np = spn_world_particle_count(w);
+    spn_vec3 *x = malloc(np * sizeof *x);
+    assert_non_null(x);
+    memcpy(x, spn_world_positions(w), np * sizeof *x);
+    spn_world_destroy(w);
+    return x;
+}
+
 static void test_same_bits_twice_and_with_two_threads(void **state)
 {
     (void)state;
-    /* big enough (5k particles) for the parallel loops to split */
-    spn_vec3 *first = NULL;
-    for (int run = 0; run < 3; run++) {
-        spn_world *w = small_orb(40, 125, 0.02, run == 2 ? 2 : 1);
-        spn_equilibrium_def d = spn_equilibrium_def_default();
-        d.load = spn_v3(0, 0, 3e-7);
-        spn_equilibrium_report r;
-        assert_int_equal(spn_world_equilibrium(w, &d, &r), SPN_OK);
-        assert_int_equal(r.reason, SPN_EQUILIBRIUM_CONVERGED);
-        uint32_t np = spn_world_particle_count(w);
-        if (!first) {
-            first = malloc(np * sizeof *first);
-            memcpy(first, spn_world_positions(w), np * sizeof *first);
-        } else {
-            assert_memory_equal(first, spn_world_positions(w), np * sizeof *first);
+    /* 5k particles: the spring-wise product; 33k: past the size where the
+     * loops split across threads (32,768 free particles) */
+    const int sizes[2][2] = {{40, 125}, {150, 220}};
+    for (int k = 0; k < 2; k++) {
+        int rings = sizes[k][0], radials = sizes[k][1];
+        uint32_t np = spn_orb_scene_particles(rings, radials);
+        spn_precond pcs[2] = {SPN_PRECOND_BLOCK_JACOBI, SPN_PRECOND_MULTIGRID};
+        for (int p = 0; p < 2; p++) {
+            int steps = k ? 2 : 200; /* the large one: two Newton steps are enough to compare */
+            spn_vec3 *a = solve_copy(rings, radials, 1, pcs[p], steps);
+            spn_vec3 *b = solve_copy(rings, radials, k ? 2 : 1, pcs[p], steps);
+            spn_vec3 *c = solve_copy(rings, radials, 2, pcs[p], steps);
+            assert_memory_equal(a, b, np * sizeof *a);
+            assert_memory_equal(a, c, np * sizeof *a);
+            free(a), free(b), free(c);
         }
-        spn_world_destroy(w);
     }
-    free(first);
 }
 
 static void test_bad_definitions_are_named(void **state)
