@@ -58,7 +58,7 @@ struct spn__mg {
     int threads;
 };
 
-static int team(const spn__mg *mg, uint32_t n) { return n < PAR_MIN ? 1 : mg->threads; }
+static inline int team(const spn__mg *mg, uint32_t n) { return n < PAR_MIN ? 1 : mg->threads; }
 
 /* ---- graph views: level 0 is the implicit spring system ------------------ */
 
@@ -218,6 +218,7 @@ static void add_sym(double *dst, const double *h, double sign)
 /* C's values from L's (Galerkin sums), one coarse row per aggregate. */
 static void coarse_values(const spn__mg *mg, const spn__eq *e, const mg_level *L, int l, mg_level *C)
 {
+    (void)mg; /* only its thread count, unused without OpenMP */
     const uint32_t nc = C->n;
 #pragma omp parallel for schedule(static) num_threads(team(mg, nc))
     for (uint32_t I = 0; I < nc; I++) {
@@ -244,6 +245,7 @@ static void coarse_values(const spn__mg *mg, const spn__eq *e, const mg_level *L
 /* Inverted diagonal blocks of an explicit level; false if one is singular. */
 static bool level_inverse(const spn__mg *mg, mg_level *C)
 {
+    (void)mg;
     int bad = 0;
 #pragma omp parallel for schedule(static) num_threads(team(mg, C->n)) reduction(+ : bad)
     for (uint32_t I = 0; I < C->n; I++) {
@@ -395,6 +397,7 @@ static void residual(const spn__mg *mg, const spn__eq *e, int l, const double *b
 /* x = omega D^-1 r (first) or x += omega D^-1 r. */
 static void jacobi(const spn__mg *mg, const mg_level *L, const double *r, double *x, bool first)
 {
+    (void)mg;
 #pragma omp parallel for schedule(static) num_threads(team(mg, L->n))
     for (uint32_t i = 0; i < L->n; i++) {
         double t[3];

@@ -15,7 +15,7 @@
 
 #define PAR_MIN 32768u
 
-static int team(const spn__eq *e) { return e->n < PAR_MIN ? 1 : e->threads; }
+static inline int team(const spn__eq *e) { return e->n < PAR_MIN ? 1 : e->threads; }
 
 spn_status spn__precond_setup(spn__precond *pc, const spn__eq *e)
 {
