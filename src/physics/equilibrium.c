@@ -27,6 +27,9 @@
 #define LAMBDA_MAX 1e8
 #define ARMIJO 1e-4
 #define AUTO_MULTIGRID 50000u /* free particles from which multigrid beats block Jacobi */
+#define SLACK_CAP 1.0   /* a step may take a taut silk thread (to first order) at most to slack */
+#define SLACK_FLOOR 0.01 /* ... but is never cut below this fraction */
+#define ETA0 0.1         /* the first solve's CG tolerance: a rough first step went slack wholesale */
 #define STALL_LIMIT 5 /* iterations in a row that lower neither energy nor residual */
 
 static const char *const PRECOND_NAMES[SPN_PRECOND_COUNT] = {"jacobi", "block-jacobi", "multigrid", "sgs", "auto"};
@@ -174,8 +177,16 @@ static int newton_iteration(newton *nt)
         nt->residual = spn__eq_assemble(e, nt->lambda, &nt->worst);
         return nt->lambda < LAMBDA_MAX;
     }
-    /* CG from zero keeps p^T A p = f^T p, so the quadratic model predicts a drop of slope / 2 */
-    double de = spn__eq_energy_delta(e, nt->p, 1), rho = isfinite(de) ? -de / (0.5 * slope) : -1;
+    /* Along the web's soft in-plane modes a Newton step can be long enough to
+     * leave threads slack, and a slack thread has no stiffness for the next
+     * model: cut the step where the first taut thread would go slack. */
+    double step = fmax(SLACK_FLOOR, spn__eq_slack_limit(e, nt->p, SLACK_CAP));
+    if (step < 1) {
+        for (size_t i = 0; i < n3; i++) nt->p[i] *= step;
+        slope *= step;
+    }
+    /* CG from zero keeps p^T A p = f^T p, so the model predicts a drop of slope (1 - step / 2) */
+    double de = spn__eq_energy_delta(e, nt->p, 1), rho = isfinite(de) ? -de / (slope * (1 - 0.5 * step)) : -1;
     bool armijo = de <= -ARMIJO * slope, rounding = fabs(de) <= e->noise;
     if (!armijo && !rounding) { /* the model was wrong: shift and retry */
         nt->rep.backtracks++;
@@ -207,7 +218,7 @@ static void run(newton *nt, const spn_equilibrium_def *d)
     nt->rep.force_scale = d->force_scale > 0 ? d->force_scale : auto_force_scale(e);
     nt->target = fmax(d->abs_tolerance, d->tolerance * nt->rep.force_scale);
     nt->max_cg = d->max_cg_iterations;
-    nt->eta = 0.5;
+    nt->eta = ETA0;
     nt->residual = spn__eq_assemble(e, 0, &nt->worst);
     nt->rep.residual_start = fmax(nt->residual, e->iso_force);
     nt->rep.reason = SPN_EQUILIBRIUM_MAX_ITERATIONS;

@@ -62,6 +62,9 @@ double spn__eq_assemble(spn__eq *e, double lambda, uint32_t *worst);
 /* Energy change of moving the free particles from x to x + alpha p; the
  * trial positions are left in e->xtrial. */
 double spn__eq_energy_delta(spn__eq *e, const double *p, double alpha);
+/* The largest step along p (<= 1) that shortens no taut tension-only spring,
+ * to first order, by more than cap times its stretch. */
+double spn__eq_slack_limit(const spn__eq *e, const double *p, double cap);
 /* y = A p over free particles; the _dot form also returns p . y. */
 void spn__eq_matvec(const spn__eq *e, const double *p, double *y);
 double spn__eq_matvec_dot(const spn__eq *e, const double *p, double *y);

@@ -334,6 +334,28 @@ double spn__eq_assemble(spn__eq *e, double lambda, uint32_t *worst)
     return sqrt(best);
 }
 
+double spn__eq_slack_limit(const spn__eq *e, const double *p, double cap)
+{
+    double alpha = 1;
+    for (uint32_t s = 0; s < e->m; s++) {
+        if (!e->tonly[s]) continue;
+        uint32_t a = e->sa[s], b = e->sb[s];
+        const double *xa = e->x + 3 * (size_t)a, *xb = e->x + 3 * (size_t)b;
+        double l[3] = {xa[0] - xb[0], xa[1] - xb[1], xa[2] - xb[2]};
+        double len = sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]), d = len - e->rest[s];
+        if (!(d > 0)) continue;
+        const double *pa = p + 3 * (size_t)a;
+        double dp[3] = {pa[0], pa[1], pa[2]};
+        if (b < e->n) {
+            const double *pb = p + 3 * (size_t)b;
+            dp[0] -= pb[0], dp[1] -= pb[1], dp[2] -= pb[2];
+        }
+        double dl = (l[0] * dp[0] + l[1] * dp[1] + l[2] * dp[2]) / len;
+        if (dl < -cap * d) alpha = fmin(alpha, cap * d / -dl);
+    }
+    return alpha;
+}
+
 static double spring_energy_delta(const spn__eq *e, uint32_t s)
 {
     const double *xa = e->x + 3 * (size_t)e->sa[s], *xb = e->x + 3 * (size_t)e->sb[s];
