@@ -11,8 +11,10 @@
  * the coarse 3x3 blocks are sums of fine ones). Levels continue until a level
  * has at most COARSEST particles, solved there by dense Cholesky.
  *
- * Smoothing: damped block Jacobi (the 3x3 diagonal blocks inverted), the same
- * number of sweeps before and after, so the cycle is symmetric.
+ * Smoothing: block Gauss-Seidel on the finest level (forward before the coarse
+ * correction, backward after) and damped block Jacobi on the coarse ones (the
+ * 3x3 diagonal blocks inverted), as many sweeps after as before, so the cycle
+ * is symmetric.
  *
  * The aggregates and the coarse sparsity depend only on the graph and the
  * stiffness k, so they are built once per solve; each Newton iteration only
@@ -24,18 +26,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define THETA 0.25
-#define COARSEST 96u
+#define THETA 0.25     /* strong coupling: a spring of at least this fraction of the stiffest */
+#define COARSEST 96u    /* particles on the level solved by dense Cholesky */
 #define MAX_LEVELS 24
-#ifndef SWEEPS
-#define SWEEPS 1
-#endif
-#ifndef OMEGA
-#define OMEGA 0.6
-#endif
-#ifndef FINE_GS
-#define FINE_GS 1
-#endif
+#define SWEEPS 1        /* smoothing sweeps each way (2: fewer CG iterations, more time; measured) */
+#define OMEGA 0.6       /* block-Jacobi damping on the coarse levels */
+#define FINE_GS 1       /* Gauss-Seidel (forward before, backward after) on the finest level */
 #define PAR_MIN 32768u
 
 typedef struct mg_level {
