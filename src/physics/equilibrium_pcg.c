@@ -143,6 +143,42 @@ static void xpby(const spn__eq *e, const double *x, double b, double *y)
     for (uint32_t i = 0; i < n3; i++) y[i] = x[i] + b * y[i];
 }
 
+/* The block preconditioners in one pass with the update: p += alpha d,
+ * r -= alpha q, z = M^-1 r; returns r . r and sets *rz = r . z. */
+static double update_precond(const spn__precond *pc, const spn__eq *e, double alpha, const double *d,
+                             const double *q, double *p, double *r, double *z, double *rz)
+{
+    const uint32_t n = e->n, nchunks = e->nchunks;
+    double *part = e->partial;
+#pragma omp parallel for schedule(static) num_threads(team(e))
+    for (uint32_t c = 0; c < nchunks; c++) {
+        uint32_t end = (c + 1) * SPN__EQ_CHUNK < n ? (c + 1) * SPN__EQ_CHUNK : n;
+        double rr = 0, rzs = 0;
+        for (uint32_t i = c * SPN__EQ_CHUNK; i < end; i++) {
+            size_t k = 3 * (size_t)i;
+            const double *h = pc->inv + 6 * (size_t)i;
+            p[k] += alpha * d[k], p[k + 1] += alpha * d[k + 1], p[k + 2] += alpha * d[k + 2];
+            double r0 = r[k] - alpha * q[k], r1 = r[k + 1] - alpha * q[k + 1], r2 = r[k + 2] - alpha * q[k + 2];
+            double z0 = h[0] * r0 + h[3] * r1 + h[4] * r2;
+            double z1 = h[3] * r0 + h[1] * r1 + h[5] * r2;
+            double z2 = h[4] * r0 + h[5] * r1 + h[2] * r2;
+            r[k] = r0, r[k + 1] = r1, r[k + 2] = r2;
+            z[k] = z0, z[k + 1] = z1, z[k + 2] = z2;
+            rr += r0 * r0 + r1 * r1 + r2 * r2;
+            rzs += r0 * z0 + r1 * z1 + r2 * z2;
+        }
+        part[2 * c] = rr;
+        part[2 * c + 1] = rzs;
+    }
+    double rr = 0, rzs = 0;
+    for (uint32_t c = 0; c < nchunks; c++) {
+        rr += part[2 * c];
+        rzs += part[2 * c + 1];
+    }
+    *rz = rzs;
+    return rr;
+}
+
 int spn__eq_pcg(const spn__eq *e, const spn__precond *pc, double *p, double eta, double floor, int max_iter,
                 double *work)
 {
@@ -160,13 +196,20 @@ int spn__eq_pcg(const spn__eq *e, const spn__precond *pc, double *p, double eta,
     if (sqrt(spn__eq_dot(e, r, r)) <= stop) return 0;
     double rz = precond_dot(pc, e, r, z);
     memcpy(d, z, n3 * sizeof *d);
+    /* Jacobi and block Jacobi are applied in the same pass as the update */
+    bool fused = pc->kind == SPN_PRECOND_JACOBI || pc->kind == SPN_PRECOND_BLOCK_JACOBI;
     for (int it = 0; it < max_iter; it++) {
         double dq = spn__eq_matvec_dot(e, d, q);
         if (!(dq > 0)) return -1;
-        double alpha = rz / dq;
-        double rr = spn__eq_update(e, alpha, d, q, p, r);
-        if (sqrt(rr) <= stop) return it + 1;
-        double rz_new = precond_dot(pc, e, r, z);
+        double alpha = rz / dq, rz_new = 0, rr;
+        if (fused) {
+            rr = update_precond(pc, e, alpha, d, q, p, r, z, &rz_new);
+            if (sqrt(rr) <= stop) return it + 1;
+        } else {
+            rr = spn__eq_update(e, alpha, d, q, p, r);
+            if (sqrt(rr) <= stop) return it + 1;
+            rz_new = precond_dot(pc, e, r, z);
+        }
         if (!(rz_new > 0)) return it + 1;
         xpby(e, z, rz_new / rz, d);
         rz = rz_new;
