@@ -93,6 +93,35 @@ static void test_ink_where_expected(void **state)
     spn_world_destroy(w);
 }
 
+/* Widths follow the kind: anchor 2.4 / capture 1.0 / generic 1.3 (and an
+ * unknown tag draws like generic), measured as ink per unit length. */
+static void test_kind_widths(void **state)
+{
+    (void)state;
+    const uint32_t tags[4] = {SPN_THREAD_ANCHOR, SPN_THREAD_CAPTURE, SPN_THREAD_GENERIC, 999};
+    double ink[4];
+    for (int k = 0; k < 4; k++) {
+        const double seg[1][4] = {{-0.4, 0.0, 0.4, 0.0}};
+        spn_world *w = segments_world(seg, 1, tags[k]);
+        spn_render_def d = known_def(5);  /* generic: 5 px */
+        for (int c = 0; c < 3; c++) d.shade_rgb[c] = 1;
+        uint8_t *px = malloc(SIDE * SIDE * 4);
+        assert_int_equal(spn_render_rgba(w, &d, px), SPN_OK);
+        ink[k] = 0;
+        for (int y = 0; y < SIDE; y++)
+            for (int x = 40; x < 160; x++) ink[k] += px[(y * SIDE + x) * 4] / 255.0; /* away from the caps */
+        ink[k] /= spn_thread_kind_shade(tags[k]); /* capture is drawn a little greyer */
+        free(px);
+        spn_world_destroy(w);
+    }
+    double generic = 5 * 120;
+    assert_true(fabs(ink[2] - generic) < 0.02 * generic);
+    assert_true(fabs(ink[0] / ink[2] - spn_thread_kind_width(SPN_THREAD_ANCHOR) / 1.3) < 0.03);
+    assert_true(fabs(ink[1] / ink[2] - spn_thread_kind_width(SPN_THREAD_CAPTURE) / 1.3) < 0.03);
+    assert_true(spn_thread_kind_width(SPN_THREAD_ANCHOR) > spn_thread_kind_width(SPN_THREAD_CAPTURE));
+    assert_true(fabs(ink[3] - ink[2]) < 1e-9);
+}
+
 /* A bent chain of three springs: one strand, so its joints blend like its middle. */
 static void test_alpha_blend_and_joints(void **state)
 {
@@ -307,6 +336,132 @@ static void test_colour_by_tension(void **state)
     spn_world_destroy(w);
 }
 
+/* A pinhole at (0, 0, 1) with a 90 degree field of view: focal length half the
+ * canvas, so the segment from (-0.5, 0, 0) to (0.5, 0, 0) spans the middle
+ * half of the middle row. */
+static void test_perspective_projection(void **state)
+{
+    (void)state;
+    const double seg[1][4] = {{-0.5, 0.0, 0.5, 0.0}};
+    spn_world *w = segments_world(seg, 1, SPN_THREAD_GENERIC);
+    spn_render_def d = known_def(3);
+    d.camera.kind = SPN_CAMERA_PERSPECTIVE;
+    d.camera.eye = spn_v3(0, 0, 1);
+    d.camera.target = spn_v3(0, 0, 0);
+    d.camera.fov_degrees = 90;
+    uint8_t *px = malloc(SIDE * SIDE * 4);
+    assert_int_equal(spn_render_rgba(w, &d, px), SPN_OK);
+    int first = -1, last = -1;
+    for (int x = 0; x < SIDE; x++)
+        if (px[(100 * SIDE + x) * 4] > 128) {
+            if (first < 0) first = x;
+            last = x;
+        }
+    /* 50 .. 150 plus the round caps (1.5 px) */
+    assert_true(abs(first - 49) <= 1 && abs(last - 150) <= 1);
+    assert_int_equal(px[(90 * SIDE + 100) * 4], 0);
+    free(px);
+    spn_world_destroy(w);
+}
+
+/* --smooth: a closed hexagon of one kind becomes a Catmull-Rom curve through
+ * its corners; midway between two corners it passes (-P0 + 9 P1 + 9 P2 - P3)
+ * / 16 (equal spacing), outside the straight chord. */
+static void test_smooth_strands(void **state)
+{
+    (void)state;
+    spn_world *w = spn_world_create(NULL);
+    const double r = 0.4;
+    for (int i = 0; i < 6; i++) {
+        spn_particle_def p = spn_particle_def_default();
+        p.position = spn_v3(r * cos(i * SPN_PI / 3), r * sin(i * SPN_PI / 3), 0);
+        assert_int_equal(spn_world_add_particle(w, &p, NULL), SPN_OK);
+    }
+    for (uint32_t i = 0; i < 6; i++) {
+        spn_spring_def sd = spn_spring_def_default();
+        sd.a = i;
+        sd.b = (i + 1) % 6;
+        sd.k = 1;
+        sd.rest = -1;
+        assert_int_equal(spn_world_add_spring(w, &sd, NULL), SPN_OK);
+    }
+    /* Along the 30 degree bisector: the chord at r cos 30, the curve at
+     * (9 + 9) r cos 30 / 16 - 2 r cos 90 / 16 (P0 and P3 at -60 and 120 degrees). */
+    double chord = r * cos(SPN_PI / 6), curve = 18 * r * cos(SPN_PI / 6) / 16 - 2 * r * cos(SPN_PI / 2) / 16;
+    uint8_t *px = malloc(SIDE * SIDE * 4);
+    spn_render_def d = known_def(2);
+    for (int smooth = 0; smooth < 2; smooth++) {
+        d.smooth = smooth;
+        assert_int_equal(spn_render_rgba(w, &d, px), SPN_OK);
+        int xc = (int)(100 + 200 * chord * cos(SPN_PI / 6)), yc = (int)(100 - 200 * chord * sin(SPN_PI / 6));
+        int xs = (int)(100 + 200 * curve * cos(SPN_PI / 6)), ys = (int)(100 - 200 * curve * sin(SPN_PI / 6));
+        uint8_t on_chord = px[(yc * SIDE + xc) * 4], on_curve = px[(ys * SIDE + xs) * 4];
+        assert_true(smooth ? (on_curve > 100 && on_chord == 0) : (on_chord > 100 && on_curve == 0));
+        /* Both pass through the corners. */
+        assert_true(px[(100 * SIDE + (int)(100 + 200 * r) - 1) * 4] > 100);
+    }
+    free(px);
+    spn_world_destroy(w);
+}
+
+/* Sheen lights the thread lying across the half vector, not the one along it:
+ * light from +x behind, eye on +z: h ~ (1, 0, 0) + (0, 0, 1) minus the light's
+ * z, so a vertical thread glints and a horizontal one does not. */
+static void test_sheen_glints_across_half_vector(void **state)
+{
+    (void)state;
+    const double seg[2][4] = {{-0.4, 0.3, 0.4, 0.3}, {0.0, -0.45, 0.0, 0.1}};
+    spn_world *w = segments_world(seg, 2, SPN_THREAD_GENERIC);
+    spn_render_def d = known_def(3);
+    for (int c = 0; c < 3; c++) d.shade_rgb[c] = 0.5;
+    uint8_t *plain = malloc(SIDE * SIDE * 4), *lit = malloc(SIDE * SIDE * 4);
+    assert_int_equal(spn_render_rgba(w, &d, plain), SPN_OK);
+    d.sheen = 1;
+    d.light = spn_v3(1, 0, -1);
+    assert_int_equal(spn_render_rgba(w, &d, lit), SPN_OK);
+    int horizontal = (40 * SIDE + 100) * 4, vertical = (150 * SIDE + 100) * 4;
+    assert_true(lit[vertical] > plain[vertical] + 60);   /* across h: glints */
+    assert_true(lit[horizontal] < plain[horizontal]);    /* along h: fades */
+    free(plain);
+    free(lit);
+    spn_world_destroy(w);
+}
+
+static spn_status keep_bead(void *user, const spn_bead *b)
+{
+    *(spn_bead *)user = *b;
+    return SPN_OK;
+}
+
+/* A dew drop reads as water: a near-white highlight towards the light (upper
+ * left), a body much darker than it, a rim, and no ink beyond its radius. */
+static void test_dew_drop_is_lit(void **state)
+{
+    (void)state;
+    const double seg[1][4] = {{-0.5, 0.0, 0.5, 0.0}};
+    spn_world *w = segments_world(seg, 1, SPN_THREAD_CAPTURE);
+    spn_render_def d = known_def(0.01);
+    d.dew.enabled = true;
+    d.dew.spacing = 0.9;  /* the first drop within 0.9 m, the next beyond the 1 m thread */
+    d.dew.radius = 0.1;   /* 20 px at 200 px/m */
+    d.dew.radius_jitter = 0;
+    spn_bead b = {{0, 0, 0}, 0, 0};
+    spn_draw_fns fns = {NULL, keep_bead, NULL};
+    assert_int_equal(spn_draw_world(w, &d, &fns, &b), SPN_OK);
+    assert_true(fabs(b.radius - 0.1) < 1e-12);
+    uint8_t *px = malloc(SIDE * SIDE * 4);
+    assert_int_equal(spn_render_rgba(w, &d, px), SPN_OK);
+    double cx = 100 + 200 * b.centre.x, cy = 100 - 200 * b.centre.y, r = 20;
+#define G(x, y) px[((int)(y) * SIDE + (int)(x)) * 4 + 1]
+    assert_true(G(cx - 0.36 * r, cy - 0.38 * r) > 230);       /* highlight */
+    assert_true(G(cx, cy) < 120);                              /* clear body */
+    assert_true(G(cx - 0.95 * r, cy) > G(cx - 0.5 * r, cy));   /* brighter rim on a dark backdrop */
+    assert_true(G(cx, cy - 1.3 * r) == 0 && G(cx + 1.3 * r, cy - 0.5 * r) == 0);
+#undef G
+    free(px);
+    spn_world_destroy(w);
+}
+
 static void test_bad_definitions(void **state)
 {
     (void)state;
@@ -360,11 +515,14 @@ static void test_vector_outputs(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_ink_where_expected),      cmocka_unit_test(test_alpha_blend_and_joints),
+        cmocka_unit_test(test_ink_where_expected),      cmocka_unit_test(test_kind_widths),
+        cmocka_unit_test(test_alpha_blend_and_joints),
         cmocka_unit_test(test_background_shows_where_no_thread), cmocka_unit_test(test_orb_web_strands),
         cmocka_unit_test(test_dew_spacing_and_radius),  cmocka_unit_test(test_deterministic_pixels),
         cmocka_unit_test(test_colour_by_tension),       cmocka_unit_test(test_bad_definitions),
-        cmocka_unit_test(test_vector_outputs),
+        cmocka_unit_test(test_vector_outputs),          cmocka_unit_test(test_perspective_projection),
+        cmocka_unit_test(test_sheen_glints_across_half_vector), cmocka_unit_test(test_dew_drop_is_lit),
+        cmocka_unit_test(test_smooth_strands),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

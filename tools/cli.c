@@ -8,20 +8,21 @@
 #include <string.h>
 #include <ctype.h>
 
-static void vprint(const char *cmd, const char *fmt, va_list ap)
+static void vprint(const char *cmd, const char *hint, const char *fmt, va_list ap)
 {
     fprintf(stderr, "spinneret%s%s: ", cmd ? " " : "", cmd ? cmd : "");
     vfprintf(stderr, fmt, ap);
+    if (hint) fprintf(stderr, " (see 'spinneret %s --help')", hint);
     fputc('\n', stderr);
 }
 
+/* One line: the complaint, then where the options are explained. */
 int cli_usage(const char *cmd, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    vprint(cmd, fmt, ap);
+    vprint(cmd, cmd ? cmd : "", fmt, ap);
     va_end(ap);
-    fprintf(stderr, "try 'spinneret %s --help'\n", cmd ? cmd : "");
     return CLI_EXIT_USAGE;
 }
 
@@ -29,7 +30,7 @@ int cli_fail(const char *cmd, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    vprint(cmd, fmt, ap);
+    vprint(cmd, NULL, fmt, ap);
     va_end(ap);
     return CLI_EXIT_FAIL;
 }

@@ -9,7 +9,7 @@
 #define CLI_EXIT_FAIL 1
 #define CLI_EXIT_USAGE 2
 
-/* "spinneret CMD: message" and a hint to --help; returns CLI_EXIT_USAGE. */
+/* "spinneret CMD: message (see 'spinneret CMD --help')" on one line; returns CLI_EXIT_USAGE. */
 int cli_usage(const char *cmd, const char *fmt, ...) SPN_PRINTF(2, 3);
 /* "spinneret CMD: message"; returns CLI_EXIT_FAIL. */
 int cli_fail(const char *cmd, const char *fmt, ...) SPN_PRINTF(2, 3);

@@ -52,6 +52,11 @@ typedef struct spn_render_def {
     spn_dew_def dew;
     bool legend;                   ///< draw the legend for colour_by modes, default true
     double glow;                   ///< soft halo around threads 0..1, default 0 (the thesis look)
+    double sheen;                  ///< glints where a thread reflects the light 0..1, default 0
+    spn_vec3 light;                ///< direction towards the (distant) light, default (-0.4, 0.5, -0.75):
+                                   ///< a low sun behind the web, which makes silk glint in arcs
+    bool smooth;                   ///< draw strands as centripetal Catmull-Rom curves through their
+                                   ///< particles instead of straight segments, default false
 } spn_render_def;
 
 SPN_API spn_render_def spn_render_def_default(void);
@@ -98,6 +103,7 @@ typedef struct spn_strand {
     double rgb[3];               ///< colour of the whole strand (shade or kind colour)
     const double *segment_rgb;   ///< colour_by tension/strain: 3 values per segment, else NULL
     double alpha;                ///< opacity 0..1
+    const double *segment_glint; ///< sheen > 0: specular glint 0..1 per segment, else NULL
 } spn_strand;
 
 /// A dew droplet: a small water sphere.
@@ -128,16 +134,35 @@ typedef struct spn_draw_fns {
 /// callback that fails and returns its status.
 SPN_API spn_status spn_draw_world(const spn_world *w, const spn_render_def *def, const spn_draw_fns *fns, void *user);
 
-/// Defaults for dew: spacing 4 mm, radius 0.7 mm, jitter 0.35, seed 1, disabled.
+/// Defaults for dew: spacing 6 mm, radius 1.3 mm, jitter 0.35, seed 1, disabled
+/// (heavy morning dew on a web some 30 cm across: drops of a few pixels at 1200 px).
 SPN_API spn_dew_def spn_dew_def_default(void);
 
 /// Check a render definition; SPN_ERR_INVALID naming the first bad field.
 SPN_API spn_status spn_render_def_check(const spn_render_def *def);
 
+/// A perspective camera looking at the centre of the web's bounding box from
+/// `yaw_degrees` to the right and `pitch_degrees` above the front (+z) view,
+/// far enough back that the whole box fits in the vertical field of view.
+SPN_API spn_camera spn_camera_orbit(const spn_world *w, double yaw_degrees, double pitch_degrees, double fov_degrees);
+
+/// Width and height of a PNG file, reading it fully so a damaged file is
+/// refused here (SPN_ERR_IO: unreadable, SPN_ERR_FORMAT: not a PNG).
+SPN_API spn_status spn_png_size(const char *path, int *width, int *height);
+
 /// Is the ffmpeg program on PATH (or $SPN_FFMPEG)? Frame sequences to .mp4/.gif need it.
 SPN_API bool spn_frames_have_ffmpeg(void);
+/// Render `w` with `def` (its size must be the sequence's) and add it as the
+/// next frame: the one call an animation loop needs.
+SPN_API spn_status spn_frames_add_world(spn_frames *frames, const spn_world *w, const spn_render_def *def);
 /// The frame size a sequence was opened with.
 SPN_API void spn_frames_size(const spn_frames *frames, int *width, int *height);
+
+/// Release the font and surface caches cairo and fontconfig keep for the
+/// life of the process (legend text fills them), so leak checkers see a clean
+/// exit. Call once, just before exiting, when nothing else uses cairo; the
+/// commands that draw do.
+SPN_API void spn_render_release_caches(void);
 
 /* ---- progress on stderr ------------------------------------------------ */
 

@@ -10,5 +10,8 @@
 #include "scenes.h"
 #include "equilibrium.h"
 #include "render.h"
+#include "export.h"
+#include "mesh.h"
+#include "shoot.h"
 
 #endif

@@ -48,6 +48,8 @@ typedef struct spn_world_def {
     double provot_max_strain;  ///< Provot deformation limit (0 = off), e.g. 0.1 = 10%
     int provot_iterations;     ///< Provot passes per step, default 4
     uint64_t seed;             ///< for anything random in the world, default 1
+    uint32_t parallel_min;     ///< loops over fewer items than this run on one thread
+                               ///< (waking threads costs more), default 32768
 } spn_world_def;
 
 SPN_API spn_world_def spn_world_def_default(void);
@@ -154,6 +156,8 @@ typedef void (*spn_force_fn)(void *user, const spn_world *w, double t,
 SPN_API void spn_world_set_force_callback(spn_world *w, spn_force_fn fn, void *user);
 
 /// Air velocity at a point and time [m/s], for aerodynamic drag on threads.
+/// Called from one thread, once per tagged segment (at its midpoint) per
+/// force evaluation, in a fixed order, so it may keep state.
 typedef spn_vec3 (*spn_air_fn)(void *user, double t, spn_vec3 position);
 /// Air and its properties: segments whose tag has a diameter (below) feel drag
 /// from the air velocity relative to them, normal component only, with a drag
@@ -161,7 +165,9 @@ typedef spn_vec3 (*spn_air_fn)(void *user, double t, spn_vec3 position);
 SPN_API void spn_world_set_air(spn_world *w, spn_air_fn fn, void *user, double rho, double mu);
 /// Thread diameter [m] for springs with `tag` (0: no aerodynamic drag).
 SPN_API void spn_world_set_tag_diameter(spn_world *w, uint32_t tag, double diameter);
-/// Drag coefficient of a cylinder in cross-flow at Reynolds number `re`.
+/// Drag coefficient of a cylinder in cross-flow at Reynolds number `re`:
+/// Lamb's Oseen result 8 pi / (Re (2.002 - ln Re)) below Re 0.5, White's
+/// 1 + 10 Re^(-2/3) above Re 2, blended in ln Re between (docs/physics.md).
 SPN_API double spn_cylinder_drag_coefficient(double re);
 
 /// Called after the step in which spring `s` broke, with the time and length.
@@ -205,8 +211,8 @@ typedef struct spn_energy {
     double kinetic;       ///< sum 1/2 m v^2 [J]
     double elastic;       ///< sum 1/2 k (|l| - r)^2 over intact, non-slack springs
     double gravitational; ///< sum -m g . x
-    double external_work; ///< work done so far by the force callback and air
-    double dissipated;    ///< energy removed so far by damping, drag and collisions
+    double external_work; ///< work done so far by the force callback and air (net of the thread's drag)
+    double dissipated;    ///< energy removed so far by damping, drag, collisions and Provot passes
 } spn_energy;
 
 SPN_API spn_energy spn_world_energy(const spn_world *w);

@@ -1,7 +1,7 @@
-/* The spring world: construction, compilation to flat arrays, accessors.
- * Construction appends to growable arrays; compiling builds the CSR adjacency
- * and scratch buffers. Adding anything invalidates the compiled data, and the
- * next step compiles again (cheap: one counting sort over the springs). */
+/* The spring world: definitions, construction, accessors, callbacks and
+ * colliders, cloning. Construction appends to growable arrays; adding
+ * anything invalidates the compiled data (compile.c), and the next step
+ * compiles again. */
 #include "world_internal.h"
 
 #include <math.h>
@@ -25,6 +25,7 @@ spn_world_def spn_world_def_default(void)
     d.provot_max_strain = 0;
     d.provot_iterations = 4;
     d.seed = 1;
+    d.parallel_min = 32768;
     return d;
 }
 
@@ -76,33 +77,10 @@ spn_world *spn_world_create(const spn_world_def *def)
     return w;
 }
 
-static void free_compiled(spn_world *w)
-{
-    free(w->adj_start);
-    free(w->adj);
-    free(w->fs);
-    free(w->fair);
-    free(w->sdiam);
-    free(w->f);
-    free(w->x0);
-    free(w->v0);
-    free(w->xt);
-    free(w->vt);
-    for (int i = 0; i < 4; i++) {
-        free(w->kx[i]);
-        free(w->kv[i]);
-        w->kx[i] = w->kv[i] = NULL;
-    }
-    w->adj_start = w->adj = NULL;
-    w->fs = w->fair = w->f = w->x0 = w->v0 = w->xt = w->vt = NULL;
-    w->sdiam = NULL;
-    w->compiled = false;
-}
-
 void spn_world_destroy(spn_world *w)
 {
     if (!w) return;
-    free_compiled(w);
+    spn__free_compiled(w);
     free(w->x);
     free(w->v);
     free(w->mass);
@@ -234,58 +212,6 @@ spn_status spn_world_remove_springs(spn_world *w, const bool *remove)
     return SPN_OK;
 }
 
-static double tag_diameter(const spn_world *w, uint32_t tag)
-{
-    for (uint32_t i = 0; i < w->ndiam; i++)
-        if (w->diam[i].tag == tag) return w->diam[i].diameter;
-    return 0;
-}
-
-spn_status spn_world_compile(spn_world *w)
-{
-    if (w->compiled) return SPN_OK;
-    free_compiled(w);
-    size_t np = w->np ? w->np : 1, ns = w->ns ? w->ns : 1;
-    w->adj_start = calloc(np + 1, sizeof *w->adj_start);
-    w->adj = malloc(2 * ns * sizeof *w->adj);
-    w->fs = malloc(ns * sizeof *w->fs);
-    w->fair = calloc(ns, sizeof *w->fair);
-    w->sdiam = malloc(ns * sizeof *w->sdiam);
-    w->f = malloc(np * sizeof *w->f);
-    w->x0 = malloc(np * sizeof *w->x0);
-    w->v0 = malloc(np * sizeof *w->v0);
-    w->xt = malloc(np * sizeof *w->xt);
-    w->vt = malloc(np * sizeof *w->vt);
-    bool ok = w->adj_start && w->adj && w->fs && w->fair && w->sdiam && w->f && w->x0 && w->v0 && w->xt && w->vt;
-    for (int i = 0; i < 4 && ok; i++) {
-        w->kx[i] = malloc(np * sizeof **w->kx);
-        w->kv[i] = malloc(np * sizeof **w->kv);
-        ok = w->kx[i] && w->kv[i];
-    }
-    if (!ok) {
-        free_compiled(w);
-        return spn_error(SPN_ERR_NOMEM, "out of memory compiling a world of %u particles and %u springs", w->np, w->ns);
-    }
-    for (uint32_t s = 0; s < w->ns; s++) {
-        w->adj_start[w->sa[s] + 1]++;
-        w->adj_start[w->sb[s] + 1]++;
-        w->sdiam[s] = tag_diameter(w, w->stag[s]);
-    }
-    for (uint32_t i = 0; i < w->np; i++) w->adj_start[i + 1] += w->adj_start[i];
-    uint32_t *fill = calloc(np, sizeof *fill);
-    if (!fill) {
-        free_compiled(w);
-        return spn_error(SPN_ERR_NOMEM, "out of memory");
-    }
-    for (uint32_t s = 0; s < w->ns; s++) {
-        w->adj[w->adj_start[w->sa[s]] + fill[w->sa[s]]++] = s << 1;
-        w->adj[w->adj_start[w->sb[s]] + fill[w->sb[s]]++] = (s << 1) | 1u;
-    }
-    free(fill);
-    w->compiled = true;
-    return SPN_OK;
-}
-
 uint32_t spn_world_particle_count(const spn_world *w) { return w->np; }
 uint32_t spn_world_spring_count(const spn_world *w) { return w->ns; }
 const spn_vec3 *spn_world_positions(const spn_world *w) { return w->x; }
@@ -299,17 +225,23 @@ void spn_world_set_position(spn_world *w, uint32_t i, spn_vec3 p) { w->x[i] = p;
 void spn_world_set_velocity(spn_world *w, uint32_t i, spn_vec3 v) { w->v[i] = v; }
 void spn_world_set_particle_tag(spn_world *w, uint32_t i, uint32_t tag) { w->ptag[i] = tag; }
 
+static double free_mass_of(const spn_world *w, uint32_t i) { return w->inv_mass[i] > 0 ? w->mass[i] : 0; }
+
 void spn_world_set_fixed(spn_world *w, uint32_t i, bool fixed)
 {
+    w->free_mass -= free_mass_of(w, i);
     w->inv_mass[i] = (fixed || w->mass[i] == 0) ? 0 : 1.0 / w->mass[i];
     if (fixed) w->v[i] = spn_v3(0, 0, 0);
+    w->free_mass += free_mass_of(w, i);
 }
 
 void spn_world_set_mass(spn_world *w, uint32_t i, double mass)
 {
     bool fixed = w->inv_mass[i] == 0 && w->mass[i] != 0;
+    w->free_mass -= free_mass_of(w, i);
     w->mass[i] = mass;
     w->inv_mass[i] = (fixed || mass == 0) ? 0 : 1.0 / mass;
+    w->free_mass += free_mass_of(w, i);
 }
 
 spn_spring_info spn_world_spring(const spn_world *w, uint32_t s)
@@ -333,18 +265,31 @@ spn_spring_info spn_world_spring(const spn_world *w, uint32_t s)
     return info;
 }
 
-void spn_world_set_spring_rest(spn_world *w, uint32_t s, double rest) { w->rest[s] = rest; }
+void spn_world_set_spring_rest(spn_world *w, uint32_t s, double rest)
+{
+    w->rest[s] = rest;
+    if (w->compiled) w->hs[w->iperm[s]].rest = rest;
+}
+
 void spn_world_set_spring_stiffness(spn_world *w, uint32_t s, double k, double kd)
 {
     w->k[s] = k;
     w->kd[s] = kd;
+    if (w->compiled) {
+        w->hs[w->iperm[s]].k = k;
+        w->hs[w->iperm[s]].kd = kd;
+    }
 }
 void spn_world_set_spring_tag(spn_world *w, uint32_t s, uint32_t tag)
 {
     w->stag[s] = tag;
-    if (w->compiled) w->sdiam[s] = tag_diameter(w, tag);
+    w->compiled = false; /* the air buffers depend on the tags' diameters */
 }
-void spn_world_break_spring(spn_world *w, uint32_t s) { w->sflags[s] |= SPN_SPRING_BROKEN; }
+void spn_world_break_spring(spn_world *w, uint32_t s)
+{
+    w->sflags[s] |= SPN_SPRING_BROKEN;
+    if (w->compiled) w->hflags[w->iperm[s]] |= SPN_SPRING_BROKEN;
+}
 
 void spn_world_set_integrator(spn_world *w, spn_integrator integrator) { w->def.integrator = integrator; }
 void spn_world_set_gravity(spn_world *w, spn_vec3 g) { w->def.gravity = g; }
@@ -457,10 +402,14 @@ spn_world *spn_world_clone(const spn_world *w)
     if (!c) return NULL;
     *c = *w;
     c->compiled = false;
-    c->adj_start = c->adj = NULL;
-    c->fs = c->fair = c->f = c->x0 = c->v0 = c->xt = c->vt = NULL;
-    c->sdiam = NULL;
-    for (int i = 0; i < 4; i++) c->kx[i] = c->kv[i] = NULL;
+    c->adj_start = c->adj = c->perm = c->iperm = NULL;
+    c->hs = NULL;
+    c->hflags = NULL;
+    c->fs = c->f = c->fext = c->x0 = c->v0 = c->fair = c->wind = NULL;
+    c->sdiam = c->cair = c->partial = c->pinv = NULL;
+    c->jac = NULL;
+    c->npartial = 0;
+    for (int i = 0; i < SPN_TMP_COUNT; i++) c->tmp[i] = NULL;
     /* Nothing may alias w's arrays if a copy below fails and c is destroyed. */
     c->x = c->v = NULL;
     c->mass = c->inv_mass = c->k = c->kd = c->rest = c->bmin = c->bmax = NULL;

@@ -2,18 +2,37 @@
  * separate flat arrays (structure of arrays): the stepping loops read only the
  * hot ones (positions, velocities, inverse masses, spring ends, stiffness,
  * rest lengths). A CSR adjacency (particle -> incident springs, in spring id
- * order) lets forces be gathered per particle without atomics, so the sum is
- * done in a fixed order and the result is the same with any thread count. */
+ * order) lets forces be gathered per particle without atomics, so each sum is
+ * done in a fixed order and the result is the same with any thread count.
+ *
+ * Reductions (energies, dot products) are summed per block of SPN_BLOCK items
+ * into a partial array, then the partials are added serially in block order:
+ * the blocks do not depend on the number of threads, so neither do the bits. */
 #ifndef SPN_WORLD_INTERNAL_H
 #define SPN_WORLD_INTERNAL_H
 
 #include "spinneret/world.h"
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #define SPN_SPRING_TENSION_ONLY 1u
 #define SPN_SPRING_BROKEN 2u
 
+/* Items per reduction block; fixed so sums do not depend on the thread count. */
+#define SPN_BLOCK 1024u
+/* Partial sums kept per block. */
+#define SPN_NSUMS 6
+
+/* Per-particle scratch buffers, allocated on first use (see spn__scratch). */
+enum {
+    SPN_TMP_A, SPN_TMP_B, SPN_TMP_C, SPN_TMP_D, SPN_TMP_E, SPN_TMP_F, SPN_TMP_G,
+    SPN_TMP_COUNT
+};
+
 typedef struct spn_collider {
-    int kind; /* 0 plane, 1 sphere */
+    int kind;   /* 0 plane, 1 sphere */
     spn_vec3 p; /* plane normal or sphere centre */
     double d;   /* plane offset (n.x = d on the plane) or sphere radius */
     double restitution, friction;
@@ -23,6 +42,29 @@ typedef struct spn_tag_diameter {
     uint32_t tag;
     double diameter;
 } spn_tag_diameter;
+
+/* The hot fields of one spring, in the compiled (internal) order. */
+typedef struct spn__spring {
+    uint32_t a, b;
+    double k, kd, rest;
+} spn__spring;
+
+/* What one force evaluation measured at its state (x, v). */
+typedef struct spn__eval {
+    double elastic;     /* sum 1/2 k stretch^2 (intact, non-slack springs) */
+    double kinetic;     /* sum 1/2 m v^2 over free particles */
+    double damp_power;  /* power removed by spring damping and viscous drag [W] */
+    double ext_power;   /* power of external forces (callback + air), sum fext . v */
+    double gross;       /* sum of |spring force| plus m |g|: the scale of round-off in forces */
+} spn__eval;
+
+/* Implicit Euler's per-spring Jacobian data (see implicit.c). */
+typedef struct spn__jac {
+    spn_vec3 u;    /* unit direction a - b */
+    double axial;  /* coefficient of u (u . d) */
+    double iso;    /* coefficient of d (transverse stiffness, kept >= 0) */
+    double air;    /* air-drag velocity coupling, applied to p_a + p_b */
+} spn__jac;
 
 struct spn_world {
     spn_world_def def;
@@ -40,20 +82,41 @@ struct spn_world {
     uint8_t *sflags;
     uint32_t *stag, *sstage, *sorder;
 
-    /* compiled data: valid while `compiled` */
+    /* compiled data: valid while `compiled`. Springs are stepped in an
+     * internal order, sorted by their lower particle id (so consecutive
+     * springs touch nearby particles); perm / iperm map between internal and
+     * public ids, and everything indexed per spring below (fs, jac, ...) is
+     * in internal order. The public arrays above stay the reference; the
+     * setters write both. */
     bool compiled;
+    spn__spring *hs;      /* hot spring records, internal order */
+    uint8_t *hflags;      /* spring flags, internal order */
+    uint32_t *perm;       /* internal -> public spring id */
+    uint32_t *iperm;      /* public -> internal spring id */
     uint32_t *adj_start;  /* np + 1 */
     uint32_t *adj;        /* spring id << 1 | (1 if the particle is end b) */
     spn_vec3 *fs;         /* per-spring force on end a (scratch) */
-    spn_vec3 *fair;       /* per-spring air force, half to each end (scratch) */
     double *sdiam;        /* per-spring diameter for air drag */
-    spn_vec3 *f, *x0, *v0, *kx[4], *kv[4], *xt, *vt; /* per-particle scratch */
+    bool any_diam;        /* some spring has a diameter */
+    bool any_limits;      /* some spring has a break length */
+    double free_mass;     /* total mass of the free particles */
+    spn_vec3 *f, *fext;   /* per-particle total and external force */
+    spn_vec3 *x0, *v0;    /* state before the step (restored on blow-up) */
+    spn_vec3 *tmp[SPN_TMP_COUNT]; /* per-particle scratch, allocated on demand */
+    spn_vec3 *fair;       /* per-spring air force (on demand) */
+    spn_vec3 *wind;       /* per-spring air velocity at the midpoint (on demand) */
+    double *cair;         /* per-spring linear air-drag coefficient (on demand) */
+    spn__jac *jac;        /* implicit: per-spring Jacobian (on demand) */
+    double *pinv;         /* implicit: per-particle inverse 3x3 block, 6 each (on demand) */
+    double *partial;      /* SPN_NSUMS per block */
+    uint32_t npartial;    /* blocks the partial array holds */
 
     /* time and statistics */
     double t;
     uint64_t steps;
     spn_step_report last;
     double external_work, dissipated;
+    double adaptive_dt;   /* next sub-step the adaptive stepper tries (0: the outer step) */
 
     /* callbacks */
     spn_force_fn force_fn;
@@ -74,13 +137,103 @@ struct spn_world {
     char *metadata;
 };
 
-/* Forces on state (x, v) at time t into f (all particles; fixed ones too). */
-void spn__eval_forces(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v, spn_vec3 *f);
-/* Spring force on end a of spring s for state (x, v); zero when broken or slack. */
-spn_vec3 spn__spring_force(const spn_world *w, uint32_t s, const spn_vec3 *x, const spn_vec3 *v);
-/* Elastic energy of the springs at positions x. */
+/* ---- compile.c ---- */
+
+/* Free every compiled array (the world goes back to construction mode). */
+void spn__free_compiled(spn_world *w);
+
+/* ---- forces.c ---- */
+
+/* Threads for a loop over n items (1 below def.parallel_min). */
+int spn__threads(const spn_world *w, uint32_t n);
+/* Ensure the first `count` per-particle scratch buffers exist. */
+spn_status spn__scratch(spn_world *w, int count);
+/* Sum the SPN_NSUMS partials of `blocks` blocks in block order into out[]. */
+void spn__sum_partials(const spn_world *w, uint32_t blocks, double *out);
+static inline uint32_t spn__blocks(uint32_t n) { return (n + SPN_BLOCK - 1) / SPN_BLOCK; }
+
+/* True when air drag acts on some segment. */
+bool spn__air_active(const spn_world *w);
+/* Spring pass at (x, v): w->fs per spring (and w->fair with air); returns the
+ * elastic energy and the spring damping power through `e`. */
+void spn__spring_pass(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v, spn__eval *e);
+/* The external forces at (x, v) into w->fext: the user callback, then air
+ * (the air part needs spn__spring_pass first). False when there are none. */
+bool spn__external(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v);
+/* Gather the total force on every particle into f: gravity, viscous drag,
+ * springs (w->fs), w->fext when `has_ext`. Adds kinetic energy, drag power and
+ * external power of the state to `e`. */
+void spn__gather(spn_world *w, const spn_vec3 *x, const spn_vec3 *v, bool has_ext, spn_vec3 *f, spn__eval *e);
+/* The whole force evaluation: the three above in order. */
+void spn__eval_forces(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v, spn_vec3 *f, spn__eval *e);
+
 double spn__elastic_energy(const spn_world *w, const spn_vec3 *x);
 double spn__kinetic_energy(const spn_world *w, const spn_vec3 *v);
 double spn__gravity_energy(const spn_world *w, const spn_vec3 *x);
+
+/* What the gather reads, copied out of the world into locals so the
+ * compiler knows stores to positions and velocities cannot change them
+ * (otherwise it reloads every pointer from the world on every particle). */
+typedef struct spn__gather_ctx {
+    const uint32_t *restrict adj_start, *restrict adj;
+    const spn_vec3 *restrict fs, *restrict fext;
+    const double *restrict mass, *restrict inv_mass;
+    spn_vec3 g;
+    double drag;
+} spn__gather_ctx;
+
+static inline spn__gather_ctx spn__gather_ctx_of(const spn_world *w)
+{
+    spn__gather_ctx c = {w->adj_start, w->adj, w->fs, w->fext, w->mass, w->inv_mass, w->def.gravity, w->def.drag};
+    return c;
+}
+
+/* Net force on particle i: gravity, viscous drag, its springs (from fs, in
+ * adjacency order) and, when `has_ext`, fext[i]. */
+static inline spn_vec3 spn__force_on(const spn__gather_ctx *c, uint32_t i, spn_vec3 vi, bool has_ext)
+{
+    const double m = c->mass[i], dm = c->drag * m;
+    spn_vec3 fi = {m * c->g.x - dm * vi.x, m * c->g.y - dm * vi.y, m * c->g.z - dm * vi.z};
+    const uint32_t end = c->adj_start[i + 1];
+    for (uint32_t j = c->adj_start[i]; j < end; j++) {
+        const uint32_t e = c->adj[j];
+        const spn_vec3 fe = c->fs[e >> 1];
+        /* Branch-free sign: which end a particle is follows no pattern. */
+        const double sg = 1.0 - 2.0 * (double)(e & 1u);
+        fi.x += sg * fe.x, fi.y += sg * fe.y, fi.z += sg * fe.z;
+    }
+    if (has_ext) fi = spn_v3_add(fi, c->fext[i]);
+    return fi;
+}
+
+/* ---- step.c ---- */
+
+/* What an integrator reports to the step driver, for the blow-up check and
+ * the energy accounting. */
+typedef struct spn__step_result {
+    double e_before;   /* kinetic + elastic + gravitational before the step */
+    double gain_kp;    /* change of kinetic + gravitational energy over the step */
+    double work;       /* work of the external forces over the step */
+    double dissipated; /* damping and drag losses over the step */
+    double kinetic;    /* kinetic energy after the step (NaN/inf: blown up) */
+    double elastic;    /* elastic energy before the step */
+} spn__step_result;
+
+/* ---- integrators (explicit.c, adaptive.c, implicit.c) ---- */
+
+void spn__step_explicit(spn_world *w, double dt, bool symplectic, spn__step_result *r);
+spn_status spn__step_rk4(spn_world *w, double dt, spn__step_result *r);
+spn_status spn__step_adaptive(spn_world *w, double dt, spn__step_result *r);
+spn_status spn__step_implicit(spn_world *w, double dt, spn__step_result *r);
+
+/* ---- constraints.c ---- */
+
+/* Built-in colliders and the collision callback after a step; returns the
+ * energy removed. */
+double spn__collide(spn_world *w, double dt);
+/* Provot deformation limits; returns the energy removed. */
+double spn__provot(spn_world *w, double dt);
+/* Break the springs that left [min, max]; returns how many broke. */
+int spn__check_breakage(spn_world *w);
 
 #endif

@@ -9,6 +9,7 @@
 
 #include <cairo.h>
 #include <math.h>
+#include <stdlib.h>
 
 typedef struct canvas {
     cairo_t *cr;
@@ -68,9 +69,52 @@ static void paint_background(canvas *c)
     cairo_restore(cr);
 }
 
+/* Bezier control points of the centripetal Catmull-Rom segment p1 -> p2
+ * (Yuksel, Schaefer & Keyser 2011: no cusps or overshoot on uneven spacing). */
+static void catmull_rom(const double *p0, const double *p1, const double *p2, const double *p3, double c[4])
+{
+    double d1 = pow(hypot(p1[0] - p0[0], p1[1] - p0[1]), 0.5), d2 = pow(hypot(p2[0] - p1[0], p2[1] - p1[1]), 0.5);
+    double d3 = pow(hypot(p3[0] - p2[0], p3[1] - p2[1]), 0.5);
+    for (int k = 0; k < 2; k++) {
+        c[k] = d1 > 1e-9 ? (d1 * d1 * p2[k] - d2 * d2 * p0[k] + (2 * d1 * d1 + 3 * d1 * d2 + d2 * d2) * p1[k]) /
+                               (3 * d1 * (d1 + d2))
+                         : p1[k];
+        c[2 + k] = d3 > 1e-9 ? (d3 * d3 * p1[k] - d2 * d2 * p3[k] + (2 * d3 * d3 + 3 * d3 * d2 + d2 * d2) * p2[k]) /
+                                   (3 * d3 * (d3 + d2))
+                             : p2[k];
+    }
+}
+
+/* The strand as one curve through its projected points; false (nothing
+ * drawn) when a point is behind the camera. */
+static bool smooth_path(canvas *c, const spn_strand *s)
+{
+    uint32_t n = s->count;
+    double(*p)[2] = malloc((size_t)n * sizeof *p);
+    bool ok = p != NULL;
+    for (uint32_t i = 0; i < n && ok; i++) ok = spn__view_project(&c->view, s->points[i], &p[i][0], &p[i][1], NULL);
+    if (ok) {
+        cairo_new_path(c->cr);
+        cairo_move_to(c->cr, p[0][0], p[0][1]);
+        uint32_t segs = s->closed ? n : n - 1;
+        for (uint32_t i = 0; i < segs; i++) {
+            /* Ends of an open strand repeat their point: the curve meets them straight. */
+            uint32_t i0 = s->closed ? (i + n - 1) % n : (i > 0 ? i - 1 : 0), i2 = (i + 1) % n;
+            uint32_t i3 = s->closed ? (i + 2) % n : (i + 2 < n ? i + 2 : n - 1);
+            double ctl[4];
+            catmull_rom(p[i0], p[i], p[i2], p[i3], ctl);
+            cairo_curve_to(c->cr, ctl[0], ctl[1], ctl[2], ctl[3], p[i2][0], p[i2][1]);
+        }
+        if (s->closed) cairo_close_path(c->cr);
+    }
+    free(p);
+    return ok;
+}
+
 /* Build the strand's path; a point behind the camera breaks it. */
 static void strand_path(canvas *c, const spn_strand *s)
 {
+    if (c->def->smooth && s->count > 2 && smooth_path(c, s)) return;
     cairo_new_path(c->cr);
     bool pen = false;
     uint32_t n = s->closed ? s->count + 1 : s->count;
@@ -111,6 +155,31 @@ static void draw_segments(canvas *c, const spn_strand *s, double width)
     cairo_new_path(c->cr);
 }
 
+/* Glints over the strand: each lit segment again, brighter and wider, with a
+ * bloom; butt caps, so overlaps at joints stay under the base stroke's width. */
+static void draw_glints(canvas *c, const spn_strand *s, double width)
+{
+    uint32_t segs = s->closed ? s->count : s->count - 1;
+    double u = c->view.px_per_ref, hot[3];
+    for (int j = 0; j < 3; j++) hot[j] = 0.2 * s->rgb[j] + 0.8;
+    cairo_set_line_cap(c->cr, CAIRO_LINE_CAP_BUTT);
+    for (uint32_t k = 0; k < segs; k++) {
+        double g = s->segment_glint[k], x0, y0, x1, y1;
+        if (g < 0.02 || !spn__view_project(&c->view, s->points[k], &x0, &y0, NULL) ||
+            !spn__view_project(&c->view, s->points[(k + 1) % s->count], &x1, &y1, NULL))
+            continue;
+        cairo_new_path(c->cr);
+        cairo_move_to(c->cr, x0, y0);
+        cairo_line_to(c->cr, x1, y1);
+        double a = fmin(1, s->alpha * 2 * g);
+        stroke_rgb(c, hot, a * 0.10, width + 8 * u);
+        stroke_rgb(c, hot, a * 0.25, width + 2.5 * u);
+        stroke_rgb(c, hot, a, width * 1.2);
+    }
+    cairo_new_path(c->cr);
+    cairo_set_line_cap(c->cr, CAIRO_LINE_CAP_ROUND);
+}
+
 static spn_status draw_strand(void *user, const spn_strand *s)
 {
     canvas *c = user;
@@ -129,6 +198,7 @@ static spn_status draw_strand(void *user, const spn_strand *s)
     }
     stroke_rgb(c, s->rgb, s->alpha, width);
     cairo_new_path(c->cr);
+    if (s->segment_glint) draw_glints(c, s, width);
     return SPN_OK;
 }
 

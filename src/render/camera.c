@@ -99,3 +99,19 @@ bool spn__view_project(const spn__view *v, spn_vec3 p, double *x, double *y, dou
     *y = 0.5 * v->height - v->focal * spn_v3_dot(d, v->up) / z;
     return true;
 }
+
+spn_camera spn_camera_orbit(const spn_world *w, double yaw_degrees, double pitch_degrees, double fov_degrees)
+{
+    spn_camera c = spn_render_def_default().camera;
+    spn_vec3 lo = spn_v3(-1, -1, 0), hi = spn_v3(1, 1, 0);
+    spn__world_bounds(w, &lo, &hi);
+    double radius = fmax(0.5 * spn_v3_len(spn_v3_sub(hi, lo)), 1e-9);
+    double fov = fov_degrees > 0 && fov_degrees < 180 ? fov_degrees : 40;
+    double dist = 1.05 * radius / sin(0.5 * fov * SPN_PI / 180);
+    double yaw = yaw_degrees * SPN_PI / 180, pitch = pitch_degrees * SPN_PI / 180;
+    c.kind = SPN_CAMERA_PERSPECTIVE;
+    c.fov_degrees = fov;
+    c.target = spn_v3_scale(spn_v3_add(lo, hi), 0.5);
+    c.eye = spn_v3_add(c.target, spn_v3(dist * cos(pitch) * sin(yaw), dist * sin(pitch), dist * cos(pitch) * cos(yaw)));
+    return c;
+}

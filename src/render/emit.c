@@ -50,28 +50,56 @@ static void strand_colour(const spn_render_def *def, uint32_t kind, double rgb[3
     for (int j = 0; j < 3; j++) rgb[j] = def->shade_rgb[j] * f;
 }
 
+/* Specular glint of a thin cylinder (Kajiya & Kay 1989, the hair model): a
+ * thread of tangent t reflects the light into the eye in proportion to
+ * sin(t, h)^n, h halfway between light and eye, so threads lying across h
+ * light up. On a ring of spiral that gives the two bright arcs of a web
+ * seen against the sun. */
+static double glint(spn_vec3 a, spn_vec3 b, spn_vec3 light, const spn_camera *cam)
+{
+    spn_vec3 t = spn_v3_norm(spn_v3_sub(b, a));
+    spn_vec3 view = spn_v3(0, 0, 1);
+    if (cam->kind == SPN_CAMERA_PERSPECTIVE) view = spn_v3_norm(spn_v3_sub(cam->eye, spn_v3_scale(spn_v3_add(a, b), 0.5)));
+    spn_vec3 h = spn_v3_norm(spn_v3_add(light, view));
+    if (spn_v3_len(h) == 0) h = view;
+    double c = spn_v3_dot(t, h), s2 = fmax(0, 1 - c * c);
+    return pow(s2, 0.5 * 24);
+}
+
 static spn_status emit_strands(const spn_world *w, const spn_render_def *def, const spn__strands *s,
                                const spn_draw_fns *fns, void *user)
 {
     bool scaled = def->colour_by == SPN_COLOUR_TENSION || def->colour_by == SPN_COLOUR_STRAIN;
     value_range r = scaled ? find_range(w, def->colour_by) : (value_range){0, 1};
     double *seg_rgb = scaled ? malloc(((size_t)s->point_count + 1) * 3 * sizeof *seg_rgb) : NULL;
-    if (scaled && !seg_rgb) return spn_error(SPN_ERR_NOMEM, "render: out of memory");
+    double *seg_glint = def->sheen > 0 ? malloc(((size_t)s->point_count + 1) * sizeof *seg_glint) : NULL;
+    spn_vec3 light = spn_v3_norm(def->light);
+    if ((scaled && !seg_rgb) || (def->sheen > 0 && !seg_glint)) {
+        free(seg_rgb);
+        return spn_error(SPN_ERR_NOMEM, "render: out of memory");
+    }
     spn_status st = SPN_OK;
     for (uint32_t i = 0; i < s->chain_count && st == SPN_OK; i++) {
         const spn__chain *c = &s->chains[i];
         spn_strand out = {c->kind, c->count, s->points + c->first, s->particles + c->first, s->springs + c->first,
-                          c->closed, spn_thread_kind_width(c->kind) * def->width_scale, {0, 0, 0}, NULL, def->alpha};
+                          c->closed, spn_thread_kind_width(c->kind) * def->width_scale, {0, 0, 0}, NULL, def->alpha,
+                          NULL};
         strand_colour(def, c->kind, out.rgb);
+        /* With sheen, silk away from the glints fades, as in backlight. */
+        out.alpha *= 1 - 0.5 * def->sheen;
         uint32_t segs = c->closed ? c->count : c->count - 1;
         for (uint32_t k = 0; scaled && k < segs; k++) {
             double v = spring_value(w, out.springs[k], def->colour_by);
             spn__scale_colour((v - r.lo) / (r.hi - r.lo), seg_rgb + 3 * k);
         }
+        for (uint32_t k = 0; seg_glint && k < segs; k++)
+            seg_glint[k] = def->sheen * glint(out.points[k], out.points[(k + 1) % c->count], light, &def->camera);
         out.segment_rgb = seg_rgb;
+        out.segment_glint = seg_glint;
         st = fns->strand(user, &out);
     }
     free(seg_rgb);
+    free(seg_glint);
     return st;
 }
 

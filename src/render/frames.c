@@ -32,6 +32,7 @@ struct spn_frames {
     pid_t pid;
     int pipe_fd;
     struct sigaction old_pipe;
+    uint8_t *scratch;          /* one frame of RGBA for spn_frames_add_world */
 };
 
 static const char *ffmpeg_program(void)
@@ -234,6 +235,17 @@ spn_status spn_frames_add(spn_frames *frames, const uint8_t *rgba)
     return st;
 }
 
+spn_status spn_frames_add_world(spn_frames *frames, const spn_world *w, const spn_render_def *def)
+{
+    if (def->width != frames->width || def->height != frames->height)
+        return spn_error(SPN_ERR_INVALID, "frames: picture is %dx%d but the sequence is %dx%d", def->width,
+                         def->height, frames->width, frames->height);
+    if (!frames->scratch) frames->scratch = malloc((size_t)frames->width * frames->height * 4);
+    if (!frames->scratch) return spn_error(SPN_ERR_NOMEM, "frames: out of memory");
+    spn_status st = spn_render_rgba(w, def, frames->scratch);
+    return st == SPN_OK ? spn_frames_add(frames, frames->scratch) : st;
+}
+
 /* Close the pipe, wait for ffmpeg; true when it exited with status 0. */
 static bool finish_ffmpeg(spn_frames *f)
 {
@@ -262,6 +274,7 @@ spn_status spn_frames_close(spn_frames *frames, bool commit)
         }
     }
     free(frames->dir);
+    free(frames->scratch);
     free(frames);
     return st;
 }

@@ -13,10 +13,11 @@
 #include <string.h>
 
 #define MAX_SIDE 16384
+#define MAX_PIXELS (100.0 * 1000 * 1000) /* 400 MB of ARGB: beyond that, render in tiles */
 
 spn_dew_def spn_dew_def_default(void)
 {
-    spn_dew_def d = {false, 4e-3, 0.7e-3, 0.35, 1};
+    spn_dew_def d = {false, 6e-3, 1.3e-3, 0.35, 1};
     return d;
 }
 
@@ -39,6 +40,9 @@ spn_render_def spn_render_def_default(void)
     d.dew = spn_dew_def_default();
     d.legend = true;
     d.glow = 0;
+    d.sheen = 0;
+    d.light = spn_v3(-0.4, 0.5, -0.75);
+    d.smooth = false;
     return d;
 }
 
@@ -86,11 +90,17 @@ spn_status spn_render_def_check(const spn_render_def *d)
     if (d->width < 1 || d->height < 1 || d->width > MAX_SIDE || d->height > MAX_SIDE)
         return spn_error(SPN_ERR_INVALID, "render: size must be between 1x1 and %dx%d, got %dx%d", MAX_SIDE, MAX_SIDE,
                          d->width, d->height);
+    if ((double)d->width * d->height > MAX_PIXELS)
+        return spn_error(SPN_ERR_INVALID, "render: %dx%d is more than %.0f million pixels", d->width, d->height,
+                         MAX_PIXELS / 1e6);
     spn_status st = check_rgb(d->background_rgb, "background_rgb");
     if (st == SPN_OK) st = check_rgb(d->shade_rgb, "shade_rgb");
     if (st != SPN_OK) return st;
     if (!in01(d->alpha)) return spn_error(SPN_ERR_INVALID, "render: alpha must be in [0, 1], got %g", d->alpha);
     if (!in01(d->glow)) return spn_error(SPN_ERR_INVALID, "render: glow must be in [0, 1], got %g", d->glow);
+    if (!in01(d->sheen)) return spn_error(SPN_ERR_INVALID, "render: sheen must be in [0, 1], got %g", d->sheen);
+    if (!spn_v3_finite(d->light) || spn_v3_len(d->light) == 0)
+        return spn_error(SPN_ERR_INVALID, "render: light must be a finite, non-zero direction");
     if (!(d->width_scale > 0 && d->width_scale <= 1000))
         return spn_error(SPN_ERR_INVALID, "render: width_scale must be in (0, 1000], got %g", d->width_scale);
     if ((unsigned)d->colour_by > SPN_COLOUR_STRAIN)
@@ -198,4 +208,33 @@ spn_status spn_render_file(const spn_world *w, const spn_render_def *def, const 
     if (type == OUT_UNKNOWN)
         return spn_error(SPN_ERR_INVALID, "%s: unknown output type (use .png, .svg or .pdf)", path ? path : "(null)");
     return type == OUT_PNG ? write_png(w, def, path) : write_vector(w, def, path, type);
+}
+
+spn_status spn_png_size(const char *path, int *width, int *height)
+{
+    if (!path || !*path) return spn_error(SPN_ERR_INVALID, "image path is empty");
+    cairo_surface_t *s = cairo_image_surface_create_from_png(path);
+    cairo_status_t cs = cairo_surface_status(s);
+    if (cs != CAIRO_STATUS_SUCCESS) {
+        cairo_surface_destroy(s);
+        return spn_error(cs == CAIRO_STATUS_FILE_NOT_FOUND || cs == CAIRO_STATUS_READ_ERROR ? SPN_ERR_IO : SPN_ERR_FORMAT,
+                         "%s: cannot read image: %s", path, cairo_status_to_string(cs));
+    }
+    *width = cairo_image_surface_get_width(s);
+    *height = cairo_image_surface_get_height(s);
+    cairo_surface_destroy(s);
+    return SPN_OK;
+}
+
+#if defined(__GNUC__)
+/* fontconfig is cairo's dependency, not ours: resolved at run time if loaded. */
+extern void FcFini(void) __attribute__((weak));
+#endif
+
+void spn_render_release_caches(void)
+{
+    cairo_debug_reset_static_data();
+#if defined(__GNUC__)
+    if (FcFini) FcFini();
+#endif
 }

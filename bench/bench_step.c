@@ -1,0 +1,133 @@
+/* bench_step: nanoseconds per spring per step for each integrator on the
+ * standard orb web (spn_scene_orb: hub, rings x radials, outer ring fixed,
+ * 2% pre-strain, EA 0.07 N) at about 5,000, 100,000 and 1,000,000
+ * particles, on 1 and 2 threads. One JSON line per figure on stdout.
+ *
+ *   bench_step            the full run (a couple of minutes)
+ *   bench_step --quick    the 5,000-particle web only
+ *
+ * Explicit steps use dt = 1e-7 s (inside the stability limit of the finest
+ * web); the adaptive stepper an outer step of 1e-6 s (its sub-step count is
+ * reported); the implicit solver dt = 1e-4 s with its CG iterations
+ * reported, as its cost per step is its iteration count times one
+ * matrix-vector product. Wall-clock time of the steps only, after one
+ * warm-up step (which compiles the world); also the process CPU time (all
+ * threads) per spring-step and the load average, because on a shared machine
+ * the wall clock measures the neighbours too. */
+#include <spinneret/spinneret.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+typedef struct size_case {
+    int rings, radials;
+    int steps[SPN_INTEGRATOR_COUNT]; /* per integrator */
+} size_case;
+
+static const size_case cases[] = {
+    {50, 100, {400, 400, 100, 20, 4}},
+    {400, 250, {40, 40, 10, 4, 1}},
+    {1000, 1000, {8, 8, 3, 2, 1}},
+};
+
+static double clock_of(clockid_t id)
+{
+    struct timespec ts;
+    clock_gettime(id, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* One-minute load average: on a shared machine the wall-clock figures mean
+ * little when it exceeds the core count. */
+static double load_average(void)
+{
+    double load = -1;
+    FILE *fp = fopen("/proc/loadavg", "r");
+    if (fp) {
+        if (fscanf(fp, "%lf", &load) != 1) load = -1;
+        fclose(fp);
+    }
+    return load;
+}
+
+static double step_size(spn_integrator integ)
+{
+    switch (integ) {
+    case SPN_INTEGRATOR_ADAPTIVE: return 1e-6;
+    case SPN_INTEGRATOR_IMPLICIT: return 1e-4;
+    default: return 1e-7;
+    }
+}
+
+/* Time `steps` steps of one integrator on 1 or 2 threads; print one line. */
+static int bench_one(const size_case *c, spn_integrator integ, int threads)
+{
+    spn_world_def def = spn_world_def_default();
+    def.integrator = integ;
+    def.threads = threads;
+    def.cg_tolerance = 1e-8;
+    spn_orb_scene_def od = spn_orb_scene_def_default();
+    od.rings = c->rings;
+    od.radials = c->radials;
+    spn_world *w;
+    if (spn_scene_orb(&def, &od, &w) != SPN_OK) {
+        fprintf(stderr, "bench_step: %s\n", spn_last_error());
+        return 1;
+    }
+    const double dt = step_size(integ);
+    if (spn_world_step(w, dt) != SPN_OK) {
+        fprintf(stderr, "bench_step: %s\n", spn_last_error());
+        spn_world_destroy(w);
+        return 1;
+    }
+    long substeps = 0, cg = 0;
+    const int steps = c->steps[integ];
+    double t0 = clock_of(CLOCK_MONOTONIC), c0 = clock_of(CLOCK_PROCESS_CPUTIME_ID);
+    for (int i = 0; i < steps; i++) {
+        if (spn_world_step(w, dt) != SPN_OK) {
+            fprintf(stderr, "bench_step: %s\n", spn_last_error());
+            spn_world_destroy(w);
+            return 1;
+        }
+        spn_step_report r = spn_world_last_step(w);
+        substeps += r.substeps;
+        cg += r.cg_iterations;
+    }
+    double sec = clock_of(CLOCK_MONOTONIC) - t0, cpu = clock_of(CLOCK_PROCESS_CPUTIME_ID) - c0;
+    double per = 1e9 / ((double)steps * spn_world_spring_count(w));
+    double ns_spring_step = sec * per;
+    printf("{\"bench\":\"step\",\"scene\":\"orb\",\"integrator\":\"%s\",\"particles\":%u,\"springs\":%u,"
+           "\"threads\":%d,\"steps\":%d,\"dt\":%g,\"ns_per_spring_step\":%.3f,\"cpu_ns_per_spring_step\":%.3f,"
+           "\"load\":%.2f",
+           spn_integrator_name(integ), spn_world_particle_count(w), spn_world_spring_count(w), threads, steps, dt,
+           ns_spring_step, cpu * per, load_average());
+    if (integ == SPN_INTEGRATOR_ADAPTIVE)
+        printf(",\"substeps_per_step\":%.1f,\"ns_per_spring_substep\":%.3f", (double)substeps / steps,
+               ns_spring_step * steps / (double)substeps);
+    if (integ == SPN_INTEGRATOR_IMPLICIT)
+        printf(",\"cg_iterations_per_step\":%.1f,\"ns_per_spring_cg_iteration\":%.3f", (double)cg / steps,
+               cg ? ns_spring_step * steps / (double)cg : 0.0);
+    printf("}\n");
+    fflush(stdout);
+    spn_world_destroy(w);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    int ncases = 3;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--quick") == 0) ncases = 1;
+        else {
+            fprintf(stderr, "usage: bench_step [--quick]\n");
+            return 2;
+        }
+    }
+    for (int c = 0; c < ncases; c++)
+        for (int integ = 0; integ < SPN_INTEGRATOR_COUNT; integ++)
+            for (int threads = 1; threads <= 2; threads++)
+                if (bench_one(&cases[c], (spn_integrator)integ, threads)) return 1;
+    return 0;
+}

@@ -1,0 +1,148 @@
+/* Compiling a world: the flat arrays the stepping loops read. Springs get
+ * an internal order sorted by their lower particle id (a stable counting
+ * sort), their hot fields copied into 32-byte records; the CSR adjacency
+ * lists each particle's springs in that order; scratch buffers are sized.
+ * O(particles + springs), so adding to a world and stepping again stays
+ * cheap. Buffers only some integrators need are allocated on first use. */
+#include "world_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void spn__free_compiled(spn_world *w)
+{
+    free(w->adj_start);
+    free(w->adj);
+    free(w->hs);
+    free(w->hflags);
+    free(w->perm);
+    free(w->iperm);
+    free(w->fs);
+    free(w->sdiam);
+    free(w->f);
+    free(w->fext);
+    free(w->x0);
+    free(w->v0);
+    for (int i = 0; i < SPN_TMP_COUNT; i++) {
+        free(w->tmp[i]);
+        w->tmp[i] = NULL;
+    }
+    free(w->fair);
+    free(w->wind);
+    free(w->cair);
+    free(w->jac);
+    free(w->pinv);
+    free(w->partial);
+    w->adj_start = w->adj = w->perm = w->iperm = NULL;
+    w->hs = NULL;
+    w->hflags = NULL;
+    w->fs = w->f = w->fext = w->x0 = w->v0 = w->fair = w->wind = NULL;
+    w->sdiam = w->cair = w->partial = w->pinv = NULL;
+    w->jac = NULL;
+    w->npartial = 0;
+    w->compiled = false;
+}
+
+static double tag_diameter(const spn_world *w, uint32_t tag)
+{
+    for (uint32_t i = 0; i < w->ndiam; i++)
+        if (w->diam[i].tag == tag) return w->diam[i].diameter;
+    return 0;
+}
+
+/* Allocate the compiled arrays; false when out of memory. */
+static bool alloc_compiled(spn_world *w)
+{
+    size_t np = w->np ? w->np : 1, ns = w->ns ? w->ns : 1;
+    uint32_t nb = spn__blocks(w->np > w->ns ? w->np : w->ns);
+    w->npartial = nb ? nb : 1;
+    w->adj_start = calloc(np + 1, sizeof *w->adj_start);
+    w->adj = malloc(2 * ns * sizeof *w->adj);
+    w->hs = malloc(ns * sizeof *w->hs);
+    w->hflags = malloc(ns * sizeof *w->hflags);
+    w->perm = malloc(ns * sizeof *w->perm);
+    w->iperm = malloc(ns * sizeof *w->iperm);
+    w->fs = malloc(ns * sizeof *w->fs);
+    w->sdiam = malloc(ns * sizeof *w->sdiam);
+    w->f = malloc(np * sizeof *w->f);
+    w->fext = calloc(np, sizeof *w->fext);
+    w->x0 = malloc(np * sizeof *w->x0);
+    w->v0 = malloc(np * sizeof *w->v0);
+    w->partial = calloc((size_t)w->npartial * SPN_NSUMS, sizeof *w->partial);
+    return w->adj_start && w->adj && w->hs && w->hflags && w->perm && w->iperm && w->fs && w->sdiam && w->f && w->fext && w->x0 && w->v0 && w->partial;
+}
+
+/* Air buffers, only for worlds with threads that have a diameter. */
+static bool alloc_air(spn_world *w)
+{
+    w->any_diam = false;
+    for (uint32_t s = 0; s < w->ns; s++) {
+        w->sdiam[s] = tag_diameter(w, w->stag[w->perm[s]]);
+        if (w->sdiam[s] > 0) w->any_diam = true;
+    }
+    if (!w->any_diam) return true;
+    w->fair = calloc(w->ns, sizeof *w->fair);
+    w->wind = calloc(w->ns, sizeof *w->wind);
+    w->cair = calloc(w->ns, sizeof *w->cair);
+    return w->fair && w->wind && w->cair;
+}
+
+/* The internal spring order: by lower particle id, ties in public order
+ * (counting sort, so it is stable and O(n)); `count` has np + 1 zeros. */
+static void order_springs(spn_world *w, uint32_t *count)
+{
+    for (uint32_t s = 0; s < w->ns; s++) count[(w->sa[s] < w->sb[s] ? w->sa[s] : w->sb[s]) + 1]++;
+    for (uint32_t i = 0; i < w->np; i++) count[i + 1] += count[i];
+    for (uint32_t s = 0; s < w->ns; s++) w->perm[count[w->sa[s] < w->sb[s] ? w->sa[s] : w->sb[s]]++] = s;
+    for (uint32_t k = 0; k < w->ns; k++) {
+        uint32_t s = w->perm[k];
+        w->iperm[s] = k;
+        w->hs[k] = (spn__spring){w->sa[s], w->sb[s], w->k[s], w->kd[s], w->rest[s]};
+        w->hflags[k] = w->sflags[s];
+    }
+}
+
+/* CSR adjacency by counting sort: each particle's springs in internal order. */
+static void build_adjacency(spn_world *w, uint32_t *fill)
+{
+    for (uint32_t k = 0; k < w->ns; k++) {
+        w->adj_start[w->hs[k].a + 1]++;
+        w->adj_start[w->hs[k].b + 1]++;
+    }
+    for (uint32_t i = 0; i < w->np; i++) w->adj_start[i + 1] += w->adj_start[i];
+    for (uint32_t k = 0; k < w->ns; k++) {
+        uint32_t a = w->hs[k].a, b = w->hs[k].b;
+        w->adj[w->adj_start[a] + fill[a]++] = k << 1;
+        w->adj[w->adj_start[b] + fill[b]++] = (k << 1) | 1u;
+    }
+}
+
+spn_status spn_world_compile(spn_world *w)
+{
+    if (w->compiled) return SPN_OK;
+    spn__free_compiled(w);
+    uint32_t *count = calloc((size_t)w->np + 1, sizeof *count);
+    if (!count || !alloc_compiled(w)) {
+        free(count);
+        spn__free_compiled(w);
+        return spn_error(SPN_ERR_NOMEM, "out of memory compiling a world of %u particles and %u springs", w->np, w->ns);
+    }
+    order_springs(w, count);
+    memset(count, 0, ((size_t)w->np + 1) * sizeof *count);
+    build_adjacency(w, count);
+    free(count);
+    if (!alloc_air(w)) {
+        spn__free_compiled(w);
+        return spn_error(SPN_ERR_NOMEM, "out of memory for air drag on %u springs", w->ns);
+    }
+    w->any_limits = false;
+    for (uint32_t s = 0; s < w->ns; s++)
+        if (w->bmin[s] > 0 || w->bmax[s] < INFINITY) w->any_limits = true;
+    w->free_mass = 0;
+    for (uint32_t i = 0; i < w->np; i++)
+        if (w->inv_mass[i] > 0) w->free_mass += w->mass[i];
+    w->compiled = true;
+    return SPN_OK;
+}
+

@@ -1,0 +1,249 @@
+/* Forces on the spring world: springs with axial damping (Mehla 2005,
+ * eq. 4.14), gravity and viscous drag (eqs. 4.6-4.7, drag per unit mass here),
+ * the user force callback, and aerodynamic drag on threads.
+ *
+ * A force evaluation is two passes. The spring pass computes each spring's
+ * force on its end a into w->fs (end b gets the opposite, eq. 4.15). The
+ * gather pass sums, for each particle, gravity, drag and its springs' forces
+ * in adjacency order. No two threads write the same element and every sum runs
+ * in a fixed order, so the result is bit-identical for any thread count.
+ *
+ * Air drag on a tagged segment (independence principle for a yawed cylinder):
+ * only the air velocity normal to the segment counts,
+ *   u = w(midpoint) - (v_a + v_b) / 2,  u_n = u - t (t . u),
+ *   F = 1/2 rho C_d(Re) d L |u_n| u_n,   Re = rho |u_n| d / mu,
+ * half of F on each end. The air callback is called serially in a fixed
+ * order, so it may keep state (a seeded gust generator, say). */
+#include "world_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+int spn__threads(const spn_world *w, uint32_t n)
+{
+#ifdef _OPENMP
+    if (n < w->def.parallel_min) return 1;
+    return w->def.threads > 0 ? w->def.threads : omp_get_max_threads();
+#else
+    (void)w;
+    (void)n;
+    return 1;
+#endif
+}
+
+spn_status spn__scratch(spn_world *w, int count)
+{
+    size_t np = w->np ? w->np : 1;
+    for (int i = 0; i < count; i++) {
+        if (w->tmp[i]) continue;
+        w->tmp[i] = calloc(np, sizeof *w->tmp[i]);
+        if (!w->tmp[i]) return spn_error(SPN_ERR_NOMEM, "out of memory for %u particles' scratch", w->np);
+    }
+    return SPN_OK;
+}
+
+void spn__sum_partials(const spn_world *w, uint32_t blocks, double *out)
+{
+    for (int k = 0; k < SPN_NSUMS; k++) out[k] = 0;
+    for (uint32_t b = 0; b < blocks; b++)
+        for (int k = 0; k < SPN_NSUMS; k++) out[k] += w->partial[(size_t)b * SPN_NSUMS + k];
+}
+
+bool spn__air_active(const spn_world *w) { return w->air_fn && w->any_diam && w->fair; }
+
+/* Spring s's force on end a at (x, v); its elastic energy and damping power. */
+static inline spn_vec3 spring_force(const spn__spring *restrict hs, const uint8_t *restrict hflags, uint32_t s,
+                                    const spn_vec3 *restrict x, const spn_vec3 *restrict v, double *energy,
+                                    double *power, double *gross)
+{
+    const spn_vec3 zero = {0, 0, 0};
+    const uint8_t flags = hflags[s];
+    if (flags & SPN_SPRING_BROKEN) return zero;
+    const spn__spring sp = hs[s];
+    const uint32_t a = sp.a, b = sp.b;
+    const spn_vec3 l = spn_v3_sub(x[a], x[b]);
+    const double len = sqrt(spn_v3_dot(l, l));
+    if (!(len > 0)) return zero;
+    const double stretch = len - sp.rest;
+    if (stretch < 0 && (flags & SPN_SPRING_TENSION_ONLY)) return zero;
+    const double inv = 1 / len;
+    const double rate = spn_v3_dot(spn_v3_sub(v[a], v[b]), l) * inv; /* d|l|/dt */
+    const double k = sp.k, kd = sp.kd;
+    *energy += 0.5 * k * stretch * stretch;
+    *power += kd * rate * rate;
+    const double mag = k * stretch + kd * rate;
+    *gross += fabs(mag);
+    return spn_v3_scale(l, -mag * inv);
+}
+
+double spn_cylinder_drag_coefficient(double re)
+{
+    /* Re <= 0.5: Lamb's (1911) Oseen solution, C_d = 8 pi / (Re (2.002 - ln Re)).
+     * Re >= 2: White's correlation C_d = 1 + 10 Re^(-2/3) (Viscous Fluid
+     * Flow, 1-10 <= Re <= 2e5, within about 10% of the measured curve).
+     * Between them the logarithms are blended linearly in ln Re, so C_d is
+     * continuous; see docs/physics.md. Silk in a breeze sits at Re ~ 0.01-1. */
+    if (!(re > 0)) return 0;
+    if (re > 2e5) re = 2e5; /* beyond the drag crisis the thread would have snapped */
+    const double lo = 0.5, hi = 2.0;
+    double lamb = 0, white = 0;
+    if (re < hi) lamb = 8 * SPN_PI / (re * (2.002 - log(re)));
+    if (re > lo) white = 1 + 10 / pow(re, 2.0 / 3.0);
+    if (re <= lo) return lamb;
+    if (re >= hi) return white;
+    double s = log(re / lo) / log(hi / lo);
+    return exp((1 - s) * log(lamb) + s * log(white));
+}
+
+/* Air force on segment s (both ends together) and its linear coefficient c
+ * (F = c u_n), at the state (x, v) with air velocity w->wind[s]. */
+static spn_vec3 air_force(const spn_world *w, uint32_t s, const spn_vec3 *x, const spn_vec3 *v, double *c)
+{
+    const spn_vec3 zero = {0, 0, 0};
+    *c = 0;
+    const double d = w->sdiam[s];
+    if (!(d > 0) || (w->hflags[s] & SPN_SPRING_BROKEN)) return zero;
+    const uint32_t a = w->hs[s].a, b = w->hs[s].b;
+    const spn_vec3 l = spn_v3_sub(x[a], x[b]);
+    const double len = spn_v3_len(l);
+    if (!(len > 0)) return zero;
+    const spn_vec3 t = spn_v3_scale(l, 1 / len);
+    const spn_vec3 vm = spn_v3_scale(spn_v3_add(v[a], v[b]), 0.5);
+    const spn_vec3 u = spn_v3_sub(w->wind[s], vm);
+    const spn_vec3 un = spn_v3_sub(u, spn_v3_scale(t, spn_v3_dot(t, u)));
+    const double speed = spn_v3_len(un);
+    if (!(speed > 0)) return zero;
+    const double re = w->air_rho * speed * d / w->air_mu;
+    *c = 0.5 * w->air_rho * spn_cylinder_drag_coefficient(re) * d * len * speed;
+    return spn_v3_scale(un, *c);
+}
+
+/* Air velocity at each tagged segment's midpoint, serially in the internal
+ * spring order. */
+static void sample_air(spn_world *w, double t, const spn_vec3 *x)
+{
+    for (uint32_t s = 0; s < w->ns; s++) {
+        if (!(w->sdiam[s] > 0)) continue;
+        spn_vec3 mid = spn_v3_scale(spn_v3_add(x[w->hs[s].a], x[w->hs[s].b]), 0.5);
+        w->wind[s] = w->air_fn(w->air_user, t, mid);
+    }
+}
+
+void spn__spring_pass(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v, spn__eval *e)
+{
+    const uint32_t ns = w->ns, nb = spn__blocks(ns);
+    const bool air = spn__air_active(w);
+    if (air) sample_air(w, t, x);
+    spn_vec3 *restrict fs = w->fs;
+    const spn__spring *restrict hs = w->hs;
+    const uint8_t *restrict hflags = w->hflags;
+    double *partial = w->partial;
+#pragma omp parallel for schedule(static) num_threads(spn__threads(w, ns))
+    for (uint32_t blk = 0; blk < nb; blk++) {
+        const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < ns ? lo + SPN_BLOCK : ns;
+        double energy = 0, power = 0, gross = 0;
+        for (uint32_t s = lo; s < hi; s++) fs[s] = spring_force(hs, hflags, s, x, v, &energy, &power, &gross);
+        if (air)
+            for (uint32_t s = lo; s < hi; s++) w->fair[s] = air_force(w, s, x, v, &w->cair[s]);
+        partial[(size_t)blk * SPN_NSUMS + 0] = energy;
+        partial[(size_t)blk * SPN_NSUMS + 1] = power;
+        partial[(size_t)blk * SPN_NSUMS + 2] = gross;
+    }
+    double elastic = 0, damp = 0, gross = 0;
+    for (uint32_t blk = 0; blk < nb; blk++) {
+        elastic += partial[(size_t)blk * SPN_NSUMS + 0];
+        damp += partial[(size_t)blk * SPN_NSUMS + 1];
+        gross += partial[(size_t)blk * SPN_NSUMS + 2];
+    }
+    e->elastic = elastic;
+    e->damp_power = damp;
+    e->gross = gross + w->free_mass * spn_v3_len(w->def.gravity);
+    e->kinetic = 0;
+    e->ext_power = 0;
+}
+
+bool spn__external(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v)
+{
+    const bool air = spn__air_active(w);
+    if (!w->force_fn && !air) return false;
+    const uint32_t np = w->np;
+    memset(w->fext, 0, np * sizeof *w->fext);
+    if (w->force_fn) w->force_fn(w->force_user, w, t, x, v, w->fext);
+    if (!air) return true;
+#pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
+    for (uint32_t i = 0; i < np; i++) {
+        spn_vec3 fi = w->fext[i];
+        for (uint32_t j = w->adj_start[i]; j < w->adj_start[i + 1]; j++)
+            fi = spn_v3_add(fi, spn_v3_scale(w->fair[w->adj[j] >> 1], 0.5));
+        w->fext[i] = fi;
+    }
+    return true;
+}
+
+void spn__gather(spn_world *w, const spn_vec3 *x, const spn_vec3 *v, bool has_ext, spn_vec3 *f, spn__eval *e)
+{
+    (void)x;
+    const uint32_t np = w->np, nb = spn__blocks(np);
+    const double drag = w->def.drag;
+    double *partial = w->partial;
+    const spn__gather_ctx ctx = spn__gather_ctx_of(w);
+#pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
+    for (uint32_t blk = 0; blk < nb; blk++) {
+        const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < np ? lo + SPN_BLOCK : np;
+        const spn__gather_ctx c = ctx;
+        double ke = 0, dp = 0, ep = 0;
+        for (uint32_t i = lo; i < hi; i++) {
+            const spn_vec3 vi = v[i];
+            f[i] = spn__force_on(&c, i, vi, has_ext);
+            if (w->inv_mass[i] == 0) continue;
+            const double v2 = spn_v3_dot(vi, vi), m = w->mass[i];
+            ke += 0.5 * m * v2;
+            dp += drag * m * v2;
+            if (has_ext) ep += spn_v3_dot(w->fext[i], vi);
+        }
+        partial[(size_t)blk * SPN_NSUMS + 0] = ke;
+        partial[(size_t)blk * SPN_NSUMS + 1] = dp;
+        partial[(size_t)blk * SPN_NSUMS + 2] = ep;
+    }
+    for (uint32_t blk = 0; blk < nb; blk++) {
+        e->kinetic += partial[(size_t)blk * SPN_NSUMS + 0];
+        e->damp_power += partial[(size_t)blk * SPN_NSUMS + 1];
+        e->ext_power += partial[(size_t)blk * SPN_NSUMS + 2];
+    }
+}
+
+void spn__eval_forces(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v, spn_vec3 *f, spn__eval *e)
+{
+    spn__spring_pass(w, t, x, v, e);
+    bool ext = spn__external(w, t, x, v);
+    spn__gather(w, x, v, ext, f, e);
+}
+
+double spn__kinetic_energy(const spn_world *w, const spn_vec3 *v)
+{
+    double e = 0;
+    for (uint32_t i = 0; i < w->np; i++)
+        if (w->inv_mass[i] > 0) e += 0.5 * w->mass[i] * spn_v3_dot(v[i], v[i]);
+    return e;
+}
+
+double spn__elastic_energy(const spn_world *w, const spn_vec3 *x)
+{
+    double e = 0;
+    for (uint32_t s = 0; s < w->ns; s++) {
+        if (w->sflags[s] & SPN_SPRING_BROKEN) continue;
+        double d = spn_v3_len(spn_v3_sub(x[w->sa[s]], x[w->sb[s]])) - w->rest[s];
+        if (d < 0 && (w->sflags[s] & SPN_SPRING_TENSION_ONLY)) continue;
+        e += 0.5 * w->k[s] * d * d;
+    }
+    return e;
+}
+
+double spn__gravity_energy(const spn_world *w, const spn_vec3 *x)
+{
+    double e = 0;
+    for (uint32_t i = 0; i < w->np; i++)
+        if (w->inv_mass[i] > 0) e -= w->mass[i] * spn_v3_dot(w->def.gravity, x[i]);
+    return e;
+}

@@ -1,0 +1,295 @@
+/* Linearised backward Euler after Baraff & Witkin, "Large Steps in Cloth
+ * Simulation" (SIGGRAPH 1998), section 3: one Newton step per time step,
+ *   (M - h df/dv - h^2 df/dx) dv = h (f0 + h df/dx v0),
+ *   v1 = v0 + dv,  x1 = x0 + h v1,
+ * solved by conjugate gradients with a block-Jacobi preconditioner (the
+ * inverse of each particle's 3x3 diagonal block).
+ * Fixed particles are filtered out (their rows and columns are the identity
+ * with a zero right-hand side: their dv stays exactly 0).
+ *
+ * Spring Jacobian for l = x_a - x_b, L = |l|, u = l / L, rest r:
+ *   df_a/dx_a = -k [ (1 - tau) u u^T + tau I ],  tau = 1 - r / L,
+ * and df_a/dx_b = -df_a/dx_a. For a compressed spring tau < 0 makes the
+ * matrix indefinite; tau is clamped at 0 (the negative transverse term
+ * dropped), which keeps the system positive definite and CG applicable.
+ * Slack tension-only and broken springs contribute nothing. Axial damping
+ * gives df_a/dv_a = -kd u u^T; viscous drag -drag m I; air drag on a segment
+ * -(c / 4) (I - u u^T) on each end and between them (c from the drag law at
+ * the current relative air speed, the derivative of |u_n| frozen). The
+ * damping force's dependence on x is left out (it is not symmetric and would
+ * break CG; Baraff & Witkin drop that part too).
+ *
+ * Matrix-free: per spring we keep u and three coefficients (48 bytes) and
+ * apply A as one spring pass plus one gather, the same fixed-order pattern
+ * as the forces, so results do not depend on the thread count. An assembled
+ * block-sparse matrix (symmetric 3x3 blocks, 104 bytes per spring) measured
+ * slower per product at every web size and costs 60-108 ns per spring to
+ * assemble each step (bench/bench_matvec.c, docs/physics.md).
+ *
+ * The fixed points of the step are exactly f(x) = 0 at v = 0, so a run
+ * settles to the true equilibrium whatever the step. */
+#include "world_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { T_DV = SPN_TMP_A, T_R, T_Z, T_P, T_AP, T_B };
+
+/* Per-spring Jacobian and the stiffness term of the right-hand side,
+ * h^2 K (v_a - v_b), into w->fs. */
+static void build_jacobian(spn_world *w, double h)
+{
+    const uint32_t ns = w->ns;
+    const bool air = spn__air_active(w);
+    const spn_vec3 *x = w->x, *v = w->v;
+#pragma omp parallel for schedule(static) num_threads(spn__threads(w, ns))
+    for (uint32_t s = 0; s < ns; s++) {
+        spn__jac j = {{0, 0, 0}, 0, 0, 0};
+        spn_vec3 g = {0, 0, 0};
+        const spn__spring sp = w->hs[s];
+        const uint32_t a = sp.a, b = sp.b;
+        const spn_vec3 l = spn_v3_sub(x[a], x[b]);
+        const double len = spn_v3_len(l);
+        if (len > 0 && !(w->hflags[s] & SPN_SPRING_BROKEN)) {
+            j.u = spn_v3_scale(l, 1 / len);
+            const double rest = sp.rest, k = sp.k;
+            const bool slack = len < rest && (w->hflags[s] & SPN_SPRING_TENSION_ONLY);
+            if (!slack) {
+                const double tau = len > rest ? 1 - rest / len : 0;
+                const double h2k = h * h * k;
+                j.axial = h * sp.kd + h2k * (1 - tau);
+                j.iso = h2k * tau;
+                const spn_vec3 dv = spn_v3_sub(v[a], v[b]);
+                g = spn_v3_add(spn_v3_scale(j.u, -h2k * (1 - tau) * spn_v3_dot(j.u, dv)), spn_v3_scale(dv, -j.iso));
+            }
+            if (air) j.air = h * w->cair[s] / 4;
+        }
+        w->jac[s] = j;
+        w->fs[s] = g;
+    }
+}
+
+/* Inverse of the symmetric 3x3 block (xx, yy, zz, xy, xz, yz), by cofactors. */
+static void invert_sym3(const double a[6], double out[6])
+{
+    const double xx = a[0], yy = a[1], zz = a[2], xy = a[3], xz = a[4], yz = a[5];
+    const double c0 = yy * zz - yz * yz, c1 = xx * zz - xz * xz, c2 = xx * yy - xy * xy;
+    const double c3 = xz * yz - xy * zz, c4 = xy * yz - xz * yy, c5 = xy * xz - xx * yz;
+    const double det = xx * c0 + xy * c3 + xz * c4;
+    const double inv = 1 / det;
+    out[0] = c0 * inv, out[1] = c1 * inv, out[2] = c2 * inv;
+    out[3] = c3 * inv, out[4] = c4 * inv, out[5] = c5 * inv;
+}
+
+/* Right-hand side b = h f + h^2 K v, and the inverse of each particle's 3x3
+ * diagonal block of A (block Jacobi: a strand's node is stiff along the
+ * thread and soft across it, which a scalar diagonal cannot see). */
+static void build_rhs(spn_world *w, double h)
+{
+    const uint32_t np = w->np;
+    spn_vec3 *b = w->tmp[T_B];
+    double *minv = w->pinv;
+    const double drag = w->def.drag;
+#pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
+    for (uint32_t i = 0; i < np; i++) {
+        double *mi = minv + 6 * (size_t)i;
+        if (w->inv_mass[i] == 0) {
+            b[i] = spn_v3(0, 0, 0);
+            for (int c = 0; c < 6; c++) mi[c] = 0;
+            continue;
+        }
+        spn_vec3 bi = spn_v3_scale(w->f[i], h);
+        const double m = w->mass[i] * (1 + h * drag);
+        double d[6] = {m, m, m, 0, 0, 0};
+        for (uint32_t k = w->adj_start[i]; k < w->adj_start[i + 1]; k++) {
+            const uint32_t e = w->adj[k], s = e >> 1;
+            const spn__jac *j = &w->jac[s];
+            bi = (e & 1u) ? spn_v3_sub(bi, w->fs[s]) : spn_v3_add(bi, w->fs[s]);
+            const double iso = j->iso + j->air, ax = j->axial - j->air;
+            const spn_vec3 u = j->u;
+            d[0] += iso + ax * u.x * u.x, d[1] += iso + ax * u.y * u.y, d[2] += iso + ax * u.z * u.z;
+            d[3] += ax * u.x * u.y, d[4] += ax * u.x * u.z, d[5] += ax * u.y * u.z;
+        }
+        b[i] = bi;
+        invert_sym3(d, mi);
+    }
+}
+
+/* Ap = A p (fixed rows zero); returns p . Ap summed in block order. */
+static double apply(spn_world *w, double h, const spn_vec3 *p, spn_vec3 *ap)
+{
+    const uint32_t ns = w->ns, np = w->np, nb = spn__blocks(np);
+    const bool air = spn__air_active(w);
+#pragma omp parallel for schedule(static) num_threads(spn__threads(w, ns))
+    for (uint32_t s = 0; s < ns; s++) {
+        const spn__jac *j = &w->jac[s];
+        const spn_vec3 pa = p[w->hs[s].a], pb = p[w->hs[s].b];
+        const spn_vec3 d = spn_v3_sub(pa, pb);
+        w->fs[s] = spn_v3_add(spn_v3_scale(d, j->iso), spn_v3_scale(j->u, j->axial * spn_v3_dot(j->u, d)));
+        if (air) {
+            const spn_vec3 q = spn_v3_add(pa, pb);
+            w->fair[s] = spn_v3_scale(spn_v3_sub(q, spn_v3_scale(j->u, spn_v3_dot(j->u, q))), j->air);
+        }
+    }
+    const double diag = 1 + h * w->def.drag;
+    double *partial = w->partial;
+#pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
+    for (uint32_t blk = 0; blk < nb; blk++) {
+        const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < np ? lo + SPN_BLOCK : np;
+        double dot = 0;
+        for (uint32_t i = lo; i < hi; i++) {
+            if (w->inv_mass[i] == 0) {
+                ap[i] = spn_v3(0, 0, 0);
+                continue;
+            }
+            spn_vec3 y = spn_v3_scale(p[i], w->mass[i] * diag);
+            for (uint32_t k = w->adj_start[i]; k < w->adj_start[i + 1]; k++) {
+                const uint32_t e = w->adj[k], s = e >> 1;
+                y = (e & 1u) ? spn_v3_sub(y, w->fs[s]) : spn_v3_add(y, w->fs[s]);
+                if (air) y = spn_v3_add(y, w->fair[s]);
+            }
+            ap[i] = y;
+            dot += spn_v3_dot(p[i], y);
+        }
+        partial[(size_t)blk * SPN_NSUMS] = dot;
+    }
+    double sum = 0;
+    for (uint32_t blk = 0; blk < nb; blk++) sum += partial[(size_t)blk * SPN_NSUMS];
+    return sum;
+}
+
+/* dv += alpha p; r -= alpha Ap; z = M^-1 r. Returns r.z and r.r via out. */
+static void cg_update(spn_world *w, double alpha, double *rz, double *rr)
+{
+    spn_vec3 *dv = w->tmp[T_DV], *r = w->tmp[T_R], *z = w->tmp[T_Z];
+    const spn_vec3 *p = w->tmp[T_P], *ap = w->tmp[T_AP];
+    const double *minv = w->pinv;
+    const uint32_t np = w->np, nb = spn__blocks(np);
+    double *partial = w->partial;
+#pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
+    for (uint32_t blk = 0; blk < nb; blk++) {
+        const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < np ? lo + SPN_BLOCK : np;
+        double a = 0, c = 0;
+        for (uint32_t i = lo; i < hi; i++) {
+            dv[i] = spn_v3_add(dv[i], spn_v3_scale(p[i], alpha));
+            const spn_vec3 ri = spn_v3_sub(r[i], spn_v3_scale(ap[i], alpha));
+            const double *m = minv + 6 * (size_t)i;
+            const spn_vec3 zi = spn_v3(m[0] * ri.x + m[3] * ri.y + m[4] * ri.z, m[3] * ri.x + m[1] * ri.y + m[5] * ri.z,
+                                       m[4] * ri.x + m[5] * ri.y + m[2] * ri.z);
+            r[i] = ri;
+            z[i] = zi;
+            a += spn_v3_dot(ri, zi);
+            c += spn_v3_dot(ri, ri);
+        }
+        partial[(size_t)blk * SPN_NSUMS] = a;
+        partial[(size_t)blk * SPN_NSUMS + 1] = c;
+    }
+    double sum[SPN_NSUMS];
+    spn__sum_partials(w, nb, sum);
+    *rz = sum[0];
+    *rr = sum[1];
+}
+
+/* p = z + beta p */
+static void cg_direction(spn_world *w, double beta)
+{
+    spn_vec3 *p = w->tmp[T_P];
+    const spn_vec3 *z = w->tmp[T_Z];
+    const uint32_t np = w->np;
+#pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
+    for (uint32_t i = 0; i < np; i++) p[i] = spn_v3_add(z[i], spn_v3_scale(p[i], beta));
+}
+
+/* Preconditioned CG for A dv = b from dv = 0; returns the iterations. It
+ * stops at relative residual def.cg_tolerance, or when the residual is down
+ * to the round-off of the forces themselves (h times 1e-13 of their gross
+ * scale): at rest b is itself round-off and no tolerance relative to it
+ * could be met. */
+static int solve(spn_world *w, double h, double gross)
+{
+    const uint32_t np = w->np;
+    spn_vec3 *dv = w->tmp[T_DV], *r = w->tmp[T_R], *z = w->tmp[T_Z], *p = w->tmp[T_P];
+    memset(dv, 0, np * sizeof *dv);
+    memcpy(r, w->tmp[T_B], np * sizeof *r);
+    double rz, rr;
+    memset(p, 0, np * sizeof *p);
+    memset(w->tmp[T_AP], 0, np * sizeof *p);
+    cg_update(w, 0, &rz, &rr); /* z = M^-1 r and the norms */
+    memcpy(p, z, np * sizeof *p);
+    const double floor = 1e-13 * h * gross;
+    double stop = w->def.cg_tolerance * w->def.cg_tolerance * rr;
+    if (stop < floor * floor) stop = floor * floor;
+    int it = 0;
+    while (it < w->def.cg_max_iterations && rr > stop && rz > 0) {
+        double pap = apply(w, h, p, w->tmp[T_AP]);
+        if (!(pap > 0)) break;
+        double rz_old = rz;
+        cg_update(w, rz / pap, &rz, &rr);
+        it++;
+        if (rr <= stop) break;
+        cg_direction(w, rz / rz_old);
+    }
+    return it;
+}
+
+/* v = v0 + dv, x = x0 + h v; the energy sums of the step. */
+static void finish(spn_world *w, double h, bool ext, spn__step_result *r)
+{
+    const spn_vec3 *dv = w->tmp[T_DV], g = w->def.gravity;
+    const uint32_t np = w->np, nb = spn__blocks(np);
+    const double drag = w->def.drag;
+    double *partial = w->partial;
+#pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
+    for (uint32_t blk = 0; blk < nb; blk++) {
+        const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < np ? lo + SPN_BLOCK : np;
+        double gain = 0, ke = 0, work = 0, damp = 0;
+        for (uint32_t i = lo; i < hi; i++) {
+            if (w->inv_mass[i] == 0) continue;
+            const spn_vec3 vi = w->v[i], vn = spn_v3_add(vi, dv[i]), dx = spn_v3_scale(vn, h);
+            w->x[i] = spn_v3_add(w->x[i], dx);
+            w->v[i] = vn;
+            const double m = w->mass[i], vn2 = spn_v3_dot(vn, vn);
+            gain += 0.5 * m * spn_v3_dot(dv[i], spn_v3_add(vn, vi)) - m * spn_v3_dot(g, dx);
+            ke += 0.5 * m * vn2;
+            damp += drag * m * vn2;
+            if (ext) work += spn_v3_dot(w->fext[i], dx);
+        }
+        double *pp = partial + (size_t)blk * SPN_NSUMS;
+        pp[0] = gain, pp[1] = ke, pp[2] = work, pp[3] = damp;
+    }
+    double sum[SPN_NSUMS];
+    spn__sum_partials(w, nb, sum);
+    double spring_damp = 0; /* axial damping power at the new velocities */
+    for (uint32_t s = 0; s < w->ns; s++) {
+        const spn__spring *sp = &w->hs[s];
+        const double rate = spn_v3_dot(w->jac[s].u, spn_v3_sub(w->v[sp->a], w->v[sp->b]));
+        spring_damp += sp->kd * rate * rate;
+    }
+    r->gain_kp = sum[0];
+    r->kinetic = sum[1];
+    r->work = sum[2];
+    r->dissipated = h * (sum[3] + spring_damp);
+}
+
+spn_status spn__step_implicit(spn_world *w, double h, spn__step_result *r)
+{
+    spn_status st = spn__scratch(w, 6);
+    if (st != SPN_OK) return st;
+    if (!w->pinv && !(w->pinv = malloc((w->np ? w->np : 1) * 6 * sizeof *w->pinv)))
+        return spn_error(SPN_ERR_NOMEM, "out of memory for the implicit solver (%u particles)", w->np);
+    if (!w->jac && !(w->jac = malloc((w->ns ? w->ns : 1) * sizeof *w->jac)))
+        return spn_error(SPN_ERR_NOMEM, "out of memory for the implicit solver (%u springs)", w->ns);
+    memcpy(w->x0, w->x, w->np * sizeof *w->x);
+    memcpy(w->v0, w->v, w->np * sizeof *w->v);
+    spn__eval e;
+    spn__eval_forces(w, w->t, w->x, w->v, w->f, &e);
+    bool ext = w->force_fn || spn__air_active(w);
+    r->e_before = e.kinetic + e.elastic;
+    r->elastic = e.elastic;
+    build_jacobian(w, h);
+    build_rhs(w, h);
+    w->last.cg_iterations = solve(w, h, e.gross);
+    finish(w, h, ext, r);
+    return SPN_OK;
+}

@@ -1,0 +1,3 @@
+#version 3.7;
+#include "colors.inc"
+mesh2 { vertex_vectors { 3, <0, 0, 0>, <1, 0, 0>, <0, 0, 1> } face_indices { 1, <0, 1, 2> } }

@@ -1,0 +1,7 @@
+#version 3.7;
+mesh2 {
+  #local spring_system_ks = 600;
+  #local spring_system_fixed = false;
+  vertex_vectors { 3, <0, 0, 0>, <1, 0, 0>, <0, 0, 1> }
+  face_indices { 1, <0, 1, 2> }
+}

@@ -1,0 +1,193 @@
+/* Frame sequences: numbered PNGs that read back to the frames written, MP4 and
+ * GIF through ffmpeg that decode back to the colour written, nothing left on
+ * an abandoned encode, and a clear refusal when ffmpeg is missing. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <cairo.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include <spinneret/spinneret.h>
+
+static char folder[512];
+
+static int setup(void **state)
+{
+    (void)state;
+    snprintf(folder, sizeof folder, "%s/frames_test_XXXXXX", SPN_BUILD_DIR);
+    return mkdtemp(folder) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", folder);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+static uint8_t *solid(int w, int h, uint8_t r, uint8_t g, uint8_t b)
+{
+    uint8_t *px = malloc((size_t)w * h * 4);
+    for (int i = 0; i < w * h; i++) px[4 * i] = r, px[4 * i + 1] = g, px[4 * i + 2] = b, px[4 * i + 3] = 255;
+    return px;
+}
+
+static void test_png_folder(void **state)
+{
+    (void)state;
+    char dir[600], path[700];
+    snprintf(dir, sizeof dir, "%s/png", folder);
+    spn_frames *f;
+    assert_int_equal(spn_frames_open(dir, 32, 16, 25, &f), SPN_OK);
+    spn_frames_set_first_index(f, 5);
+    for (int i = 0; i < 3; i++) {
+        uint8_t *px = solid(32, 16, (uint8_t)(40 * i), 100, 200);
+        assert_int_equal(spn_frames_add(f, px), SPN_OK);
+        free(px);
+    }
+    assert_int_equal(spn_frames_close(f, true), SPN_OK);
+    for (int i = 0; i < 3; i++) {
+        snprintf(path, sizeof path, "%s/frame_%05d.png", dir, 5 + i);
+        cairo_surface_t *s = cairo_image_surface_create_from_png(path);
+        assert_int_equal(cairo_surface_status(s), CAIRO_STATUS_SUCCESS);
+        assert_int_equal(cairo_image_surface_get_width(s), 32);
+        uint32_t v = *(uint32_t *)cairo_image_surface_get_data(s);
+        assert_int_equal((v >> 16) & 255, 40 * i);
+        assert_int_equal(v & 255, 200);
+        cairo_surface_destroy(s);
+    }
+    snprintf(path, sizeof path, "%s/frame_%05d.png", dir, 8);
+    assert_int_equal(access(path, F_OK), -1);
+}
+
+/* A world straight into a sequence; a picture of the wrong size is refused. */
+static void test_add_world(void **state)
+{
+    (void)state;
+    char dir[600], path[700];
+    snprintf(dir, sizeof dir, "%s/world", folder);
+    spn_world *w;
+    assert_int_equal(spn_scene_orb(NULL, NULL, &w), SPN_OK);
+    spn_render_def d = spn_render_def_default();
+    d.width = 40;
+    d.height = 30;
+    spn_frames *f;
+    assert_int_equal(spn_frames_open(dir, 40, 30, 25, &f), SPN_OK);
+    assert_int_equal(spn_frames_add_world(f, w, &d), SPN_OK);
+    d.width = 41;
+    assert_int_equal(spn_frames_add_world(f, w, &d), SPN_ERR_INVALID);
+    assert_int_equal(spn_frames_close(f, true), SPN_OK);
+    snprintf(path, sizeof path, "%s/frame_00000.png", dir);
+    assert_int_equal(access(path, F_OK), 0);
+    snprintf(path, sizeof path, "%s/frame_00001.png", dir);
+    assert_int_equal(access(path, F_OK), -1);
+    spn_world_destroy(w);
+}
+
+/* Decode the first frame of a video with ffmpeg; its middle pixel. */
+static void first_pixel(const char *video, int w, int h, int rgb[3])
+{
+    char cmd[900];
+    snprintf(cmd, sizeof cmd, "ffmpeg -loglevel error -i '%s' -frames:v 1 -f rawvideo -pix_fmt rgb24 -", video);
+    FILE *p = popen(cmd, "r");
+    assert_non_null(p);
+    size_t n = (size_t)w * h * 3;
+    uint8_t *buf = malloc(n);
+    size_t got = fread(buf, 1, n, p);
+    pclose(p);
+    assert_true(got >= n / 2);
+    size_t mid = ((size_t)(h / 2) * w + w / 2) * 3;
+    for (int c = 0; c < 3; c++) rgb[c] = buf[mid + c];
+    free(buf);
+}
+
+static void encode(const char *name, int w, int h, bool commit, spn_status want_close)
+{
+    char path[700];
+    snprintf(path, sizeof path, "%s/%s", folder, name);
+    spn_frames *f;
+    assert_int_equal(spn_frames_open(path, w, h, 10, &f), SPN_OK);
+    uint8_t *px = solid(w, h, 200, 60, 30);
+    for (int i = 0; i < 8; i++) assert_int_equal(spn_frames_add(f, px), SPN_OK);
+    free(px);
+    assert_int_equal(spn_frames_close(f, commit), want_close);
+}
+
+static void test_video(void **state)
+{
+    (void)state;
+    if (!spn_frames_have_ffmpeg()) {
+        printf("skipped: ffmpeg is not installed\n");
+        skip();
+    }
+    char path[700];
+    encode("clip.mp4", 65, 49, true, SPN_OK); /* odd sides: padded for yuv420p */
+    snprintf(path, sizeof path, "%s/clip.mp4", folder);
+    int rgb[3];
+    first_pixel(path, 66, 50, rgb);
+    assert_true(abs(rgb[0] - 200) < 12 && abs(rgb[1] - 60) < 12 && abs(rgb[2] - 30) < 12);
+    encode("clip.gif", 40, 30, true, SPN_OK);
+    snprintf(path, sizeof path, "%s/clip.gif", folder);
+    FILE *fp = fopen(path, "rb");
+    char head[6];
+    assert_non_null(fp);
+    assert_int_equal(fread(head, 1, 6, fp), 6);
+    fclose(fp);
+    assert_memory_equal(head, "GIF89a", 6);
+    first_pixel(path, 40, 30, rgb);
+    assert_true(abs(rgb[0] - 200) < 12 && abs(rgb[1] - 60) < 12 && abs(rgb[2] - 30) < 12);
+    /* Abandoned: no file, and no temporary left beside it. */
+    encode("gone.mp4", 32, 32, false, SPN_OK);
+    snprintf(path, sizeof path, "%s/gone.mp4", folder);
+    assert_int_equal(access(path, F_OK), -1);
+    char cmd[800];
+    snprintf(cmd, sizeof cmd, "ls '%s' | grep -q tmp", folder);
+    assert_int_not_equal(system(cmd), 0);
+}
+
+static void test_missing_ffmpeg(void **state)
+{
+    (void)state;
+    char path[700];
+    snprintf(path, sizeof path, "%s/none.mp4", folder);
+    setenv("SPN_FFMPEG", "/nonexistent/ffmpeg", 1);
+    spn_frames *f = NULL;
+    assert_false(spn_frames_have_ffmpeg());
+    assert_int_equal(spn_frames_open(path, 32, 32, 10, &f), SPN_ERR_UNSUPPORTED);
+    assert_null(f);
+    assert_non_null(strstr(spn_last_error(), "ffmpeg"));
+    assert_non_null(strstr(spn_last_error(), "PNG"));
+    assert_int_equal(access(path, F_OK), -1);
+    unsetenv("SPN_FFMPEG");
+}
+
+static void test_bad_arguments(void **state)
+{
+    (void)state;
+    char path[700];
+    snprintf(path, sizeof path, "%s/bad", folder);
+    spn_frames *f = NULL;
+    assert_int_equal(spn_frames_open(path, 0, 10, 10, &f), SPN_ERR_INVALID);
+    assert_int_equal(spn_frames_open(path, 10, 10, 0, &f), SPN_ERR_INVALID);
+    assert_int_equal(spn_frames_open("", 10, 10, 10, &f), SPN_ERR_INVALID);
+    assert_null(f);
+    /* The progress bar stays silent when asked to, and is NULL-safe. */
+    spn_progress *p = spn_progress_begin("x", 10, true);
+    assert_null(p);
+    spn_progress_update(p, 5);
+    spn_progress_end(p);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_png_folder), cmocka_unit_test(test_add_world), cmocka_unit_test(test_video), cmocka_unit_test(test_missing_ffmpeg),
+        cmocka_unit_test(test_bad_arguments)};
+    return cmocka_run_group_tests(tests, setup, teardown);
+}

@@ -1,0 +1,131 @@
+/* spinneret render FILE -o OUT: draw a web to PNG, SVG or PDF with cairo
+ * (spn_render_file). With --turntable N, a perspective camera circles the web
+ * and the frames go to a video or a PNG folder (spn_frames_*). The picture
+ * options are shared with `export` (render_options.h). */
+#include "render_options.h"
+
+#include <stdio.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *const CMD = "render";
+
+static void usage(FILE *out)
+{
+    fprintf(out,
+            "usage: spinneret render FILE -o OUT [options]\n"
+            "       spinneret render FILE -o OUT.mp4|OUT.gif|DIR --turntable N [options]\n"
+            "Draw the web in FILE (a web file, or scene:orb, scene:orb:RINGSxRADIALS,\n"
+            "scene:chain, scene:cloth) to OUT: .png, .svg or .pdf. Same file and options,\n"
+            "same pixels.\n\n"
+            "  -o, --output OUT           the picture (required)\n"
+            "      --turntable N          N frames of a camera swinging around the web, to .mp4\n"
+            "                             or .gif (needs the ffmpeg program) or a folder of PNGs\n"
+            "      --fps F                turntable frames per second, 1..120 (default 24)\n"
+            "      --quiet                no progress bar\n"
+            "  -h, --help                 this text\n");
+    render_options_help(out);
+}
+
+typedef struct cmd_options {
+    render_options ro;
+    const char *in, *out;
+    long turntable;
+    double fps;
+    bool quiet;
+} cmd_options;
+
+enum { OPT_TURNTABLE = 400, OPT_FPS, OPT_QUIET };
+
+static int check_output(const cmd_options *o)
+{
+    if (!o->out || !*o->out) return cli_usage(CMD, "-o/--output: the output picture is required");
+    const char *ext = cli_extension(o->out);
+    if (o->turntable > 0) {
+        if (*ext && strcmp(ext, "mp4") != 0 && strcmp(ext, "gif") != 0)
+            return cli_usage(CMD, "%s: a turntable goes to .mp4, .gif or a folder, not '.%s'", o->out, ext);
+        return -1;
+    }
+    if (strcmp(ext, "png") != 0 && strcmp(ext, "svg") != 0 && strcmp(ext, "pdf") != 0)
+        return cli_usage(CMD, "%s: unknown output type '.%s' (use .png, .svg or .pdf)", o->out, ext);
+    return -1;
+}
+
+static int parse(int argc, char **argv, cmd_options *o)
+{
+    static const struct option options[] = {{"output", required_argument, NULL, 'o'},
+                                            {"turntable", required_argument, NULL, OPT_TURNTABLE},
+                                            {"fps", required_argument, NULL, OPT_FPS},
+                                            {"quiet", no_argument, NULL, OPT_QUIET},
+                                            {"help", no_argument, NULL, 'h'},
+                                            RENDER_LONG_OPTIONS,
+                                            {NULL, 0, NULL, 0}};
+    opterr = 0;
+    for (int c; (c = getopt_long(argc, argv, ":o:h", options, NULL)) != -1;) {
+        bool ok = true;
+        if (c == 'o') o->out = optarg;
+        else if (c == 'h') return usage(stdout), 0;
+        else if (c == ':') return cli_usage(CMD, "%s: missing value", argv[optind - 1]);
+        else if (c == '?') return cli_usage(CMD, "unknown option '%s'", argv[optind - 1]);
+        else if (c == OPT_TURNTABLE) ok = cli_int(CMD, "--turntable", optarg, 1, 100000, &o->turntable);
+        else if (c == OPT_FPS) ok = cli_double(CMD, "--fps", optarg, 1, 120, &o->fps);
+        else if (c == OPT_QUIET) o->quiet = true;
+        else ok = render_options_parse(CMD, c, optarg, &o->ro) > 0;
+        if (!ok) return CLI_EXIT_USAGE;
+    }
+    if (optind >= argc) return cli_usage(CMD, "missing FILE");
+    if (optind + 1 < argc) return cli_usage(CMD, "unexpected argument '%s'", argv[optind + 1]);
+    o->in = argv[optind];
+    return check_output(o);
+}
+
+/* The camera swings from -yaw to +yaw and back (a planar web seen edge-on
+ * shows nothing, so it does not go all the way round). */
+static int turntable(cmd_options *o, const spn_world *w)
+{
+    spn_render_def *d = &o->ro.def;
+    d->camera.kind = SPN_CAMERA_PERSPECTIVE;
+    spn_frames *frames;
+    if (spn_frames_open(o->out, d->width, d->height, o->fps, &frames) != SPN_OK)
+        return cli_fail(CMD, "%s", spn_last_error());
+    spn_progress *bar = spn_progress_begin("render", (uint64_t)o->turntable, o->quiet);
+    double swing = o->ro.yaw != 0 ? o->ro.yaw : 25;
+    spn_status st = SPN_OK;
+    for (long i = 0; i < o->turntable && st == SPN_OK; i++) {
+        double yaw = swing * sin(2 * SPN_PI * (double)i / (double)o->turntable);
+        spn_camera cam = spn_camera_orbit(w, yaw, o->ro.pitch, d->camera.fov_degrees);
+        d->camera.eye = cam.eye;
+        d->camera.target = cam.target;
+        st = spn_frames_add_world(frames, w, d);
+        spn_progress_update(bar, (uint64_t)i + 1);
+    }
+    spn_progress_end(bar);
+    if (st != SPN_OK) {
+        spn_frames_close(frames, false);
+        return cli_fail_status(CMD, st);
+    }
+    return spn_frames_close(frames, true) == SPN_OK ? 0 : cli_fail(CMD, "%s", spn_last_error());
+}
+
+int cmd_render(int argc, char **argv)
+{
+    cmd_options o;
+    memset(&o, 0, sizeof o);
+    render_options_init(&o.ro);
+    o.fps = 24;
+    int code = parse(argc, argv, &o);
+    if (code >= 0) return code;
+    spn_world *w;
+    if ((code = render_load_world(CMD, o.in, &w)) != 0) return code;
+    render_options_finish(&o.ro, w);
+    if (o.turntable > 0) {
+        code = turntable(&o, w);
+    } else {
+        spn_status st = spn_render_file(w, &o.ro.def, o.out);
+        code = st == SPN_OK ? 0 : cli_fail_status(CMD, st);
+    }
+    spn_world_destroy(w);
+    spn_render_release_caches();
+    return code;
+}
