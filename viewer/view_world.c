@@ -90,9 +90,9 @@ spn_status view_build_web(view_state *v)
         d.anchor_count = v->nanchors;
         d.seed = v->opt.seed;
         st = spn_web_build_physical(&d, &w);
-    } else if (strcmp(v->opt.method, "geometric") == 0 && strcmp(v->opt.species, "generic") != 0) {
+    } else if (v->opt.method_given && strcmp(v->opt.species, "generic") != 0) {
         return spn_error(SPN_ERR_INVALID, "--species %s needs the species builder: leave --method unset", v->opt.species);
-    } else if (strcmp(v->opt.method, "geometric") == 0 && v->opt.method_given) {
+    } else if (v->opt.method_given) {
         spn_geometric_def d = spn_geometric_def_default();
         d.anchors = anchors;
         d.anchor_count = v->nanchors;

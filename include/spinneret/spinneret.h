@@ -8,6 +8,7 @@
 #include "web.h"
 #include "io.h"
 #include "scenes.h"
+#include "equilibrium.h"
 #include "render.h"
 #include "anim.h"
 #include "export.h"
