@@ -28,6 +28,7 @@ bool cli_vec3(const char *cmd, const char *opt, const char *text, bool allow_2d,
 #define CLI_MAX_COORD 1e6 /* positions [m] */
 #define CLI_MAX_ACCEL 1e4 /* accelerations, gravity [m/s^2]: a thousand g */
 #define CLI_MAX_SPEED 1e3 /* velocities of bodies and air [m/s] */
+#define CLI_MAX_FORCE 1e6 /* forces on a particle [N] */
 bool cli_vec3_bounded(const char *cmd, const char *opt, const char *text, double bound, spn_vec3 *out);
 /* "WxH" with 1 <= W, H <= max_side. */
 bool cli_size(const char *cmd, const char *opt, const char *text, int max_side, int *w, int *h);

@@ -83,7 +83,7 @@ static int parse_options(int argc, char **argv, settle_options *o)
             else return cli_usage(CMD, "--method: '%s' is not dynamic or equilibrium", optarg);
             break;
         case OPT_REL_TOL: ok = cli_double(CMD, "--rel-tol", optarg, 0, 1, &o->eq.tolerance); break;
-        case OPT_LOAD: ok = cli_vec3(CMD, "--load", optarg, false, &o->eq.load); break;
+        case OPT_LOAD: ok = cli_vec3_bounded(CMD, "--load", optarg, CLI_MAX_FORCE, &o->eq.load); break;
         case OPT_PRECOND:
             if (spn_precond_parse(optarg, &o->eq.preconditioner) != SPN_OK)
                 return cli_usage(CMD, "--preconditioner: %s", spn_last_error());
