@@ -44,6 +44,13 @@ void spn__free_compiled(spn_world *w)
     w->compiled = false;
 }
 
+spn__spring spn__hot_spring(const spn_world *w, uint32_t s)
+{
+    const bool broken = (w->sflags[s] & SPN_SPRING_BROKEN) != 0;
+    const uint32_t tonly = (w->sflags[s] & SPN_SPRING_TENSION_ONLY) ? 1u << 31 : 0;
+    return (spn__spring){w->sa[s], w->sb[s] | tonly, broken ? 0 : w->k[s], broken ? 0 : w->kd[s], w->rest[s]};
+}
+
 static double tag_diameter(const spn_world *w, uint32_t tag)
 {
     for (uint32_t i = 0; i < w->ndiam; i++)
@@ -98,8 +105,8 @@ static void order_springs(spn_world *w, uint32_t *count)
     for (uint32_t k = 0; k < w->ns; k++) {
         uint32_t s = w->perm[k];
         w->iperm[s] = k;
-        w->hs[k] = (spn__spring){w->sa[s], w->sb[s], w->k[s], w->kd[s], w->rest[s]};
         w->hflags[k] = w->sflags[s];
+        w->hs[k] = spn__hot_spring(w, s);
     }
 }
 
@@ -108,11 +115,11 @@ static void build_adjacency(spn_world *w, uint32_t *fill)
 {
     for (uint32_t k = 0; k < w->ns; k++) {
         w->adj_start[w->hs[k].a + 1]++;
-        w->adj_start[w->hs[k].b + 1]++;
+        w->adj_start[spn__end_b(w->hs[k]) + 1]++;
     }
     for (uint32_t i = 0; i < w->np; i++) w->adj_start[i + 1] += w->adj_start[i];
     for (uint32_t k = 0; k < w->ns; k++) {
-        uint32_t a = w->hs[k].a, b = w->hs[k].b;
+        uint32_t a = w->hs[k].a, b = spn__end_b(w->hs[k]);
         w->adj[w->adj_start[a] + fill[a]++] = k << 1;
         w->adj[w->adj_start[b] + fill[b]++] = (k << 1) | 1u;
     }
@@ -122,6 +129,8 @@ spn_status spn_world_compile(spn_world *w)
 {
     if (w->compiled) return SPN_OK;
     spn__free_compiled(w);
+    if (w->np > SPN__END_MASK)
+        return spn_error(SPN_ERR_INVALID, "a world steps at most %u particles, not %u", SPN__END_MASK, w->np);
     uint32_t *count = calloc((size_t)w->np + 1, sizeof *count);
     if (!count || !alloc_compiled(w)) {
         free(count);

@@ -48,7 +48,7 @@ static void build_jacobian(spn_world *w, double h)
         spn__jac j = {{0, 0, 0}, 0, 0, 0};
         spn_vec3 g = {0, 0, 0};
         const spn__spring sp = w->hs[s];
-        const uint32_t a = sp.a, b = sp.b;
+        const uint32_t a = sp.a, b = spn__end_b(sp);
         const spn_vec3 l = spn_v3_sub(x[a], x[b]);
         const double len = spn_v3_len(l);
         if (len > 0 && !(w->hflags[s] & SPN_SPRING_BROKEN)) {
@@ -124,7 +124,7 @@ static double apply(spn_world *w, double h, const spn_vec3 *p, spn_vec3 *ap)
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, ns))
     for (uint32_t s = 0; s < ns; s++) {
         const spn__jac *j = &w->jac[s];
-        const spn_vec3 pa = p[w->hs[s].a], pb = p[w->hs[s].b];
+        const spn_vec3 pa = p[w->hs[s].a], pb = p[spn__end_b(w->hs[s])];
         const spn_vec3 d = spn_v3_sub(pa, pb);
         w->fs[s] = spn_v3_add(spn_v3_scale(d, j->iso), spn_v3_scale(j->u, j->axial * spn_v3_dot(j->u, d)));
         if (air) {
@@ -263,7 +263,7 @@ static void finish(spn_world *w, double h, bool ext, spn__step_result *r)
     double spring_damp = 0; /* axial damping power at the new velocities */
     for (uint32_t s = 0; s < w->ns; s++) {
         const spn__spring *sp = &w->hs[s];
-        const double rate = spn_v3_dot(w->jac[s].u, spn_v3_sub(w->v[sp->a], w->v[sp->b]));
+        const double rate = spn_v3_dot(w->jac[s].u, spn_v3_sub(w->v[sp->a], w->v[spn__end_b(*sp)]));
         spring_damp += sp->kd * rate * rate;
     }
     r->gain_kp = sum[0];

@@ -275,10 +275,7 @@ void spn_world_set_spring_stiffness(spn_world *w, uint32_t s, double k, double k
 {
     w->k[s] = k;
     w->kd[s] = kd;
-    if (w->compiled) {
-        w->hs[w->iperm[s]].k = k;
-        w->hs[w->iperm[s]].kd = kd;
-    }
+    if (w->compiled) w->hs[w->iperm[s]] = spn__hot_spring(w, s);
 }
 void spn_world_set_spring_tag(spn_world *w, uint32_t s, uint32_t tag)
 {
@@ -288,7 +285,10 @@ void spn_world_set_spring_tag(spn_world *w, uint32_t s, uint32_t tag)
 void spn_world_break_spring(spn_world *w, uint32_t s)
 {
     w->sflags[s] |= SPN_SPRING_BROKEN;
-    if (w->compiled) w->hflags[w->iperm[s]] |= SPN_SPRING_BROKEN;
+    if (w->compiled) {
+        w->hflags[w->iperm[s]] |= SPN_SPRING_BROKEN;
+        w->hs[w->iperm[s]] = spn__hot_spring(w, s);
+    }
 }
 
 void spn_world_set_integrator(spn_world *w, spn_integrator integrator) { w->def.integrator = integrator; }

@@ -43,11 +43,20 @@ typedef struct spn_tag_diameter {
     double diameter;
 } spn_tag_diameter;
 
-/* The hot fields of one spring, in the compiled (internal) order. */
+/* The hot fields of one spring, in the compiled (internal) order: 32 bytes.
+ * The top bit of `bt` is the tension-only flag (read it with spn__end_b /
+ * spn__tension_only), and a broken spring has k = kd = 0 here (its public k
+ * and kd are kept), so the force loop needs no flag array. Particles are
+ * therefore limited to 2^31 - 1. */
 typedef struct spn__spring {
-    uint32_t a, b;
+    uint32_t a;
+    uint32_t bt; /* end b | tension-only << 31 (named apart so a plain `.b` does not compile) */
     double k, kd, rest;
 } spn__spring;
+
+#define SPN__END_MASK 0x7fffffffu
+static inline uint32_t spn__end_b(spn__spring s) { return s.bt & SPN__END_MASK; }
+static inline bool spn__tension_only(spn__spring s) { return (s.bt >> 31) != 0; }
 
 /* What one force evaluation measured at its state (x, v). */
 typedef struct spn__eval {
@@ -137,10 +146,22 @@ struct spn_world {
     char *metadata;
 };
 
+/* A kernel also compiled for AVX2, chosen when the program loads (GCC on
+ * x86-64 with ifunc support). -ffp-contract=off keeps FMA out, and every
+ * operation is correctly rounded at any vector width, so both versions give
+ * the same bits. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && !defined(SPN_NO_CLONES)
+#define SPN__KERNEL __attribute__((target_clones("avx2", "default")))
+#else
+#define SPN__KERNEL
+#endif
+
 /* ---- compile.c ---- */
 
 /* Free every compiled array (the world goes back to construction mode). */
 void spn__free_compiled(spn_world *w);
+/* Public spring s's hot record (flags folded in, see spn__spring). */
+spn__spring spn__hot_spring(const spn_world *w, uint32_t s);
 
 /* ---- forces.c ---- */
 
