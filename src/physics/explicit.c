@@ -4,7 +4,9 @@
  *
  * Euler and symplectic Euler are one spring pass and one fused particle pass
  * that gathers the force, updates v and x in place, keeps the old state for a
- * blow-up restore, and sums the energy terms the step driver checks. Energy
+ * blow-up restore (unless w->no_backup: spn_world_advance keeps one copy per
+ * call and replays instead, see step.c), and sums the energy terms the step
+ * driver checks. Energy
  * changes are summed per particle (1/2 m (v'-v).(v'+v) - m g.(x'-x)), never
  * as differences of large totals, so they stay accurate far from the origin.
  *
@@ -29,6 +31,7 @@ void spn__step_explicit(spn_world *w, double dt, bool symplectic, spn__step_resu
     spn_vec3 *restrict x = w->x, *restrict v = w->v, *restrict x0 = w->x0, *restrict v0 = w->v0;
     double *partial = w->partial;
     const spn__gather_ctx ctx = spn__gather_ctx_of(w);
+    const bool backup = !w->no_backup;
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
     for (uint32_t blk = 0; blk < nb; blk++) {
         const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < np ? lo + SPN_BLOCK : np;
@@ -36,8 +39,7 @@ void spn__step_explicit(spn_world *w, double dt, bool symplectic, spn__step_resu
         double ke_old = 0, gain = 0, damp = 0, work = 0, ke_new = 0;
         for (uint32_t i = lo; i < hi; i++) {
             const spn_vec3 xi = x[i], vi = v[i];
-            x0[i] = xi;
-            v0[i] = vi;
+            if (backup) x0[i] = xi, v0[i] = vi;
             const double im = c.inv_mass[i];
             if (im == 0) continue;
             const spn_vec3 fi = spn__force_on(&c, i, vi, ext);
@@ -96,14 +98,14 @@ static void rk4_finish(spn_world *w, double dt, spn__step_result *r)
     const spn_vec3 g = w->def.gravity;
     const uint32_t np = w->np, nb = spn__blocks(np);
     double *partial = w->partial;
+    const bool backup = !w->no_backup;
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
     for (uint32_t blk = 0; blk < nb; blk++) {
         const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < np ? lo + SPN_BLOCK : np;
         double gain = 0, ke_new = 0;
         for (uint32_t i = lo; i < hi; i++) {
             const spn_vec3 xi = x[i], vi = v[i];
-            x0[i] = xi;
-            v0[i] = vi;
+            if (backup) x0[i] = xi, v0[i] = vi;
             const double im = w->inv_mass[i];
             if (im == 0) continue;
             const spn_vec3 dx = spn_v3_scale(spn_v3_add(ax[i], vt[i]), dt / 6);

@@ -292,6 +292,17 @@ void spn_world_break_spring(spn_world *w, uint32_t s)
 }
 
 void spn_world_set_integrator(spn_world *w, spn_integrator integrator) { w->def.integrator = integrator; }
+
+spn_status spn_world_set_solver_tolerance(spn_world *w, double cg_tolerance, int cg_max_iterations)
+{
+    if (!(cg_tolerance > 0 && cg_tolerance < 1))
+        return spn_error(SPN_ERR_INVALID, "cg_tolerance must be in (0, 1), not %g", cg_tolerance);
+    if (cg_max_iterations < 1)
+        return spn_error(SPN_ERR_INVALID, "cg_max_iterations must be at least 1, not %d", cg_max_iterations);
+    w->def.cg_tolerance = cg_tolerance;
+    w->def.cg_max_iterations = cg_max_iterations;
+    return SPN_OK;
+}
 void spn_world_set_gravity(spn_world *w, spn_vec3 g) { w->def.gravity = g; }
 void spn_world_set_drag(spn_world *w, double drag) { w->def.drag = drag; }
 double spn_world_time(const spn_world *w) { return w->t; }

@@ -111,6 +111,7 @@ struct spn_world {
     double free_mass;     /* total mass of the free particles */
     spn_vec3 *f, *fext;   /* per-particle total and external force */
     spn_vec3 *x0, *v0;    /* state before the step (restored on blow-up) */
+    bool no_backup;       /* explicit and RK4 steps leave x0, v0 alone (spn_world_advance) */
     spn_vec3 *tmp[SPN_TMP_COUNT]; /* per-particle scratch, allocated on demand */
     spn_vec3 *fair;       /* per-spring air force (on demand) */
     spn_vec3 *wind;       /* per-spring air velocity at the midpoint (on demand) */
