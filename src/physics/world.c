@@ -413,7 +413,7 @@ spn_world *spn_world_clone(const spn_world *w)
     if (!c) return NULL;
     *c = *w;
     c->compiled = false;
-    c->adj_start = c->adj = c->perm = c->iperm = NULL;
+    c->adj_start = c->adj = c->perm = c->iperm = c->a_start = c->b_start = c->b_adj = NULL;
     c->hs = NULL;
     c->hflags = NULL;
     c->fs = c->f = c->fext = c->x0 = c->v0 = c->fair = c->wind = NULL;

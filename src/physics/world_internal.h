@@ -104,6 +104,10 @@ struct spn_world {
     uint32_t *iperm;      /* public -> internal spring id */
     uint32_t *adj_start;  /* np + 1 */
     uint32_t *adj;        /* spring id << 1 | (1 if the particle is end b) */
+    uint32_t *a_start;    /* np + 1: internal end a is the lower particle id, so particle i's
+                           * springs as end a are the contiguous run [a_start[i], a_start[i+1]) */
+    uint32_t *b_start;    /* np + 1, into b_adj */
+    uint32_t *b_adj;      /* springs with the particle as end b, internal order */
     spn_vec3 *fs;         /* per-spring force on end a (scratch) */
     double *sdiam;        /* per-spring diameter for air drag */
     bool any_diam;        /* some spring has a diameter */
@@ -197,7 +201,7 @@ double spn__gravity_energy(const spn_world *w, const spn_vec3 *x);
  * compiler knows stores to positions and velocities cannot change them
  * (otherwise it reloads every pointer from the world on every particle). */
 typedef struct spn__gather_ctx {
-    const uint32_t *restrict adj_start, *restrict adj;
+    const uint32_t *restrict a_start, *restrict b_start, *restrict b_adj;
     const spn_vec3 *restrict fs, *restrict fext;
     const double *restrict mass, *restrict inv_mass;
     spn_vec3 g;
@@ -206,23 +210,24 @@ typedef struct spn__gather_ctx {
 
 static inline spn__gather_ctx spn__gather_ctx_of(const spn_world *w)
 {
-    spn__gather_ctx c = {w->adj_start, w->adj, w->fs, w->fext, w->mass, w->inv_mass, w->def.gravity, w->def.drag};
+    spn__gather_ctx c = {w->a_start, w->b_start, w->b_adj, w->fs, w->fext, w->mass, w->inv_mass, w->def.gravity, w->def.drag};
     return c;
 }
 
-/* Net force on particle i: gravity, viscous drag, its springs (from fs, in
- * adjacency order) and, when `has_ext`, fext[i]. */
+/* Net force on particle i: gravity, viscous drag, its springs (from fs: first
+ * those it is end a of, a contiguous run, then those it is end b of, in
+ * internal order) and, when `has_ext`, fext[i]. */
 static inline spn_vec3 spn__force_on(const spn__gather_ctx *c, uint32_t i, spn_vec3 vi, bool has_ext)
 {
     const double m = c->mass[i], dm = c->drag * m;
     spn_vec3 fi = {m * c->g.x - dm * vi.x, m * c->g.y - dm * vi.y, m * c->g.z - dm * vi.z};
-    const uint32_t end = c->adj_start[i + 1];
-    for (uint32_t j = c->adj_start[i]; j < end; j++) {
-        const uint32_t e = c->adj[j];
-        const spn_vec3 fe = c->fs[e >> 1];
-        /* Branch-free sign: which end a particle is follows no pattern. */
-        const double sg = 1.0 - 2.0 * (double)(e & 1u);
-        fi.x += sg * fe.x, fi.y += sg * fe.y, fi.z += sg * fe.z;
+    for (uint32_t s = c->a_start[i], end = c->a_start[i + 1]; s < end; s++) {
+        const spn_vec3 fe = c->fs[s];
+        fi.x += fe.x, fi.y += fe.y, fi.z += fe.z;
+    }
+    for (uint32_t j = c->b_start[i], end = c->b_start[i + 1]; j < end; j++) {
+        const spn_vec3 fe = c->fs[c->b_adj[j]];
+        fi.x -= fe.x, fi.y -= fe.y, fi.z -= fe.z;
     }
     if (has_ext) fi = spn_v3_add(fi, c->fext[i]);
     return fi;
