@@ -20,42 +20,53 @@
 
 enum { S_KE_OLD, S_GAIN, S_DAMP, S_WORK, S_KE_NEW };
 
+/* Particles [lo, hi) of an Euler or symplectic Euler step; the block's sums
+ * into p[]. Inlined with constant flags below, so the common case (symplectic,
+ * no external force, no backup) has no tests in its loop. */
+static inline __attribute__((always_inline)) void explicit_block(
+    const spn__gather_ctx *restrict c, uint32_t lo, uint32_t hi, double dt, bool symplectic, bool ext, bool backup,
+    spn_vec3 *restrict x, spn_vec3 *restrict v, spn_vec3 *restrict x0, spn_vec3 *restrict v0, double *p)
+{
+    const spn_vec3 g = c->g;
+    double ke_old = 0, gain = 0, work = 0, ke_new = 0;
+    for (uint32_t i = lo; i < hi; i++) {
+        const spn_vec3 xi = x[i], vi = v[i];
+        if (backup) x0[i] = xi, v0[i] = vi;
+        const double im = c->inv_mass[i];
+        if (im == 0) continue;
+        const spn_vec3 fi = spn__force_on(c, i, vi, ext);
+        const spn_vec3 vn = spn_v3_add(vi, spn_v3_scale(fi, dt * im));
+        const spn_vec3 dx = spn_v3_scale(symplectic ? vn : vi, dt);
+        x[i] = spn_v3_add(xi, dx);
+        v[i] = vn;
+        const double m = c->mass[i];
+        ke_old += m * spn_v3_dot(vi, vi);
+        ke_new += m * spn_v3_dot(vn, vn);
+        gain += m * (0.5 * spn_v3_dot(spn_v3_sub(vn, vi), spn_v3_add(vn, vi)) - spn_v3_dot(g, dx));
+        if (ext) work += spn_v3_dot(c->fext[i], dx);
+    }
+    /* sum m v^2 is twice the kinetic energy, and drag dissipates drag m v^2 */
+    p[S_KE_OLD] = 0.5 * ke_old, p[S_GAIN] = gain, p[S_DAMP] = c->drag * ke_old, p[S_WORK] = work,
+    p[S_KE_NEW] = 0.5 * ke_new;
+}
+
 void spn__step_explicit(spn_world *w, double dt, bool symplectic, spn__step_result *r)
 {
     spn__eval e;
     spn__spring_pass(w, w->t, w->x, w->v, &e);
     const bool ext = spn__external(w, w->t, w->x, w->v);
     const uint32_t np = w->np, nb = spn__blocks(np);
-    const spn_vec3 g = w->def.gravity;
-    const double drag = w->def.drag;
     spn_vec3 *restrict x = w->x, *restrict v = w->v, *restrict x0 = w->x0, *restrict v0 = w->v0;
     double *partial = w->partial;
     const spn__gather_ctx ctx = spn__gather_ctx_of(w);
-    const bool backup = !w->no_backup;
+    const bool backup = !w->no_backup, fast = symplectic && !ext && !backup;
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
     for (uint32_t blk = 0; blk < nb; blk++) {
         const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < np ? lo + SPN_BLOCK : np;
         const spn__gather_ctx c = ctx;
-        double ke_old = 0, gain = 0, damp = 0, work = 0, ke_new = 0;
-        for (uint32_t i = lo; i < hi; i++) {
-            const spn_vec3 xi = x[i], vi = v[i];
-            if (backup) x0[i] = xi, v0[i] = vi;
-            const double im = c.inv_mass[i];
-            if (im == 0) continue;
-            const spn_vec3 fi = spn__force_on(&c, i, vi, ext);
-            const spn_vec3 vn = spn_v3_add(vi, spn_v3_scale(fi, dt * im));
-            const spn_vec3 dx = spn_v3_scale(symplectic ? vn : vi, dt);
-            x[i] = spn_v3_add(xi, dx);
-            v[i] = vn;
-            const double m = c.mass[i], v2 = spn_v3_dot(vi, vi), vn2 = spn_v3_dot(vn, vn);
-            ke_old += 0.5 * m * v2;
-            ke_new += 0.5 * m * vn2;
-            gain += 0.5 * m * spn_v3_dot(spn_v3_sub(vn, vi), spn_v3_add(vn, vi)) - m * spn_v3_dot(g, dx);
-            damp += drag * m * v2;
-            if (ext) work += spn_v3_dot(c.fext[i], dx);
-        }
         double *p = partial + (size_t)blk * SPN_NSUMS;
-        p[S_KE_OLD] = ke_old, p[S_GAIN] = gain, p[S_DAMP] = damp, p[S_WORK] = work, p[S_KE_NEW] = ke_new;
+        if (fast) explicit_block(&c, lo, hi, dt, true, false, false, x, v, x0, v0, p);
+        else explicit_block(&c, lo, hi, dt, symplectic, ext, backup, x, v, x0, v0, p);
     }
     double sum[SPN_NSUMS];
     spn__sum_partials(w, nb, sum);
