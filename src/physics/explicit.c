@@ -78,62 +78,78 @@ void spn__step_explicit(spn_world *w, double dt, bool symplectic, spn__step_resu
     r->kinetic = sum[S_KE_NEW];
 }
 
-/* One RK4 stage's state: xt = x + h vprev, vt = v + h f / m (f from the
- * previous stage), accumulating weight c of the previous stage first. */
-static void rk4_stage(spn_world *w, double h, double c, bool first)
+/* RK4 (eqs. 4.16-4.19) in four fused passes. Stage s evaluates the forces at
+ * (X_s, V_s) (stage 0: x, v; then the trial state xt, vt) and, in the same
+ * particle pass that gathers them, accumulates the weighted sums
+ *   ax = v + 2 V_1 + 2 V_2,  av = f_0 + 2 f_1 + 2 f_2
+ * and writes the next trial state xt = x + c h V_s, vt = v + c h f_s / m
+ * (in place: particle i's gather reads only its own V_s[i]); the last pass
+ * takes x += h/6 (ax + V_3), v += h/6 (av + f_3) / m. The forces go straight
+ * from the gather into the update, so no force array is written or read. */
+enum { R_KE, R_DAMP, R_EXT, R_GAIN, R_KE_NEW };
+
+typedef struct rk4_ctx {
+    spn__gather_ctx c;
+    const spn_vec3 *restrict x, *restrict v;
+    spn_vec3 *restrict xt, *restrict vt, *restrict ax, *restrict av;
+    double h_next, weight, dt;
+    int stage;
+    bool ext;
+} rk4_ctx;
+
+static void rk4_block(const rk4_ctx *k, uint32_t lo, uint32_t hi, double *p)
 {
-    spn_vec3 *xt = w->tmp[SPN_TMP_A], *vt = w->tmp[SPN_TMP_B], *ax = w->tmp[SPN_TMP_C], *av = w->tmp[SPN_TMP_D];
-    const spn_vec3 *x = w->x, *v = w->v, *f = w->f;
-    const uint32_t np = w->np;
-#pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
-    for (uint32_t i = 0; i < np; i++) {
-        const spn_vec3 vprev = first ? v[i] : vt[i];
-        if (first) {
-            ax[i] = vprev;
-            av[i] = f[i];
-        } else {
-            ax[i] = spn_v3_add(ax[i], spn_v3_scale(vprev, c));
-            av[i] = spn_v3_add(av[i], spn_v3_scale(f[i], c));
+    const spn__gather_ctx *c = &k->c;
+    const spn_vec3 *vs = k->stage == 0 ? k->v : k->vt;
+    double ke = 0, ep = 0;
+    for (uint32_t i = lo; i < hi; i++) {
+        const spn_vec3 vi = vs[i];
+        const double im = c->inv_mass[i];
+        if (im == 0) { /* a fixed particle stays where it is in every stage */
+            k->xt[i] = k->x[i], k->vt[i] = k->v[i];
+            continue;
         }
-        const double im = w->inv_mass[i];
-        xt[i] = im > 0 ? spn_v3_add(x[i], spn_v3_scale(vprev, h)) : x[i];
-        vt[i] = im > 0 ? spn_v3_add(v[i], spn_v3_scale(f[i], h * im)) : v[i];
+        const spn_vec3 f = spn__force_on(c, i, vi, k->ext);
+        ke += c->mass[i] * spn_v3_dot(vi, vi);
+        if (k->ext) ep += spn_v3_dot(c->fext[i], vi);
+        if (k->stage == 0) {
+            k->ax[i] = vi;
+            k->av[i] = f;
+        } else {
+            k->ax[i] = spn_v3_add(k->ax[i], spn_v3_scale(vi, k->weight));
+            k->av[i] = spn_v3_add(k->av[i], spn_v3_scale(f, k->weight));
+        }
+        k->xt[i] = spn_v3_add(k->x[i], spn_v3_scale(vi, k->h_next));
+        k->vt[i] = spn_v3_add(k->v[i], spn_v3_scale(f, k->h_next * im));
     }
+    p[R_KE] = 0.5 * ke, p[R_DAMP] = c->drag * ke, p[R_EXT] = ep;
 }
 
-/* x += dt/6 (sum of weighted stage velocities), v likewise with forces. */
-static void rk4_finish(spn_world *w, double dt, spn__step_result *r)
+/* The last stage: x += h/6 (ax + V_3), v += h/6 (av + f_3) / m. */
+static void rk4_last_block(const rk4_ctx *k, spn_vec3 *restrict x, spn_vec3 *restrict v, spn_vec3 *restrict x0,
+                           spn_vec3 *restrict v0, bool backup, uint32_t lo, uint32_t hi, double *p)
 {
-    const spn_vec3 *vt = w->tmp[SPN_TMP_B], *ax = w->tmp[SPN_TMP_C], *av = w->tmp[SPN_TMP_D], *f = w->f;
-    spn_vec3 *x = w->x, *v = w->v, *x0 = w->x0, *v0 = w->v0;
-    const spn_vec3 g = w->def.gravity;
-    const uint32_t np = w->np, nb = spn__blocks(np);
-    double *partial = w->partial;
-    const bool backup = !w->no_backup;
-#pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
-    for (uint32_t blk = 0; blk < nb; blk++) {
-        const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < np ? lo + SPN_BLOCK : np;
-        double gain = 0, ke_new = 0;
-        for (uint32_t i = lo; i < hi; i++) {
-            const spn_vec3 xi = x[i], vi = v[i];
-            if (backup) x0[i] = xi, v0[i] = vi;
-            const double im = w->inv_mass[i];
-            if (im == 0) continue;
-            const spn_vec3 dx = spn_v3_scale(spn_v3_add(ax[i], vt[i]), dt / 6);
-            const spn_vec3 vn = spn_v3_add(vi, spn_v3_scale(spn_v3_add(av[i], f[i]), dt / 6 * im));
-            x[i] = spn_v3_add(xi, dx);
-            v[i] = vn;
-            const double m = w->mass[i];
-            ke_new += 0.5 * m * spn_v3_dot(vn, vn);
-            gain += 0.5 * m * spn_v3_dot(spn_v3_sub(vn, vi), spn_v3_add(vn, vi)) - m * spn_v3_dot(g, dx);
-        }
-        partial[(size_t)blk * SPN_NSUMS + S_GAIN] = gain;
-        partial[(size_t)blk * SPN_NSUMS + S_KE_NEW] = ke_new;
+    const spn__gather_ctx *c = &k->c;
+    const spn_vec3 gr = c->g;
+    const double h6 = k->dt / 6;
+    double ke = 0, ep = 0, gain = 0, ke_new = 0;
+    for (uint32_t i = lo; i < hi; i++) {
+        const spn_vec3 v3 = k->vt[i], xi = x[i], vi = v[i];
+        if (backup) x0[i] = xi, v0[i] = vi;
+        const double im = c->inv_mass[i];
+        if (im == 0) continue;
+        const spn_vec3 f = spn__force_on(c, i, v3, k->ext);
+        const double m = c->mass[i];
+        ke += m * spn_v3_dot(v3, v3);
+        if (k->ext) ep += spn_v3_dot(c->fext[i], v3);
+        const spn_vec3 dx = spn_v3_scale(spn_v3_add(k->ax[i], v3), h6);
+        const spn_vec3 vn = spn_v3_add(vi, spn_v3_scale(spn_v3_add(k->av[i], f), h6 * im));
+        x[i] = spn_v3_add(xi, dx);
+        v[i] = vn;
+        ke_new += 0.5 * m * spn_v3_dot(vn, vn);
+        gain += 0.5 * m * spn_v3_dot(spn_v3_sub(vn, vi), spn_v3_add(vn, vi)) - m * spn_v3_dot(gr, dx);
     }
-    double sum[SPN_NSUMS];
-    spn__sum_partials(w, nb, sum);
-    r->gain_kp = sum[S_GAIN];
-    r->kinetic = sum[S_KE_NEW];
+    p[R_KE] = 0.5 * ke, p[R_DAMP] = c->drag * ke, p[R_EXT] = ep, p[R_GAIN] = gain, p[R_KE_NEW] = ke_new;
 }
 
 spn_status spn__step_rk4(spn_world *w, double dt, spn__step_result *r)
@@ -141,21 +157,39 @@ spn_status spn__step_rk4(spn_world *w, double dt, spn__step_result *r)
     spn_status st = spn__scratch(w, 4);
     if (st != SPN_OK) return st;
     static const double weight[4] = {1, 2, 2, 1}, frac[4] = {0, 0.5, 0.5, 1};
-    double work = 0, damp = 0;
-    spn__eval e;
-    spn__eval_forces(w, w->t, w->x, w->v, w->f, &e);
-    r->e_before = e.kinetic + e.elastic;
-    r->elastic = e.elastic;
-    work += e.ext_power;
-    damp += e.damp_power;
-    for (int stage = 1; stage < 4; stage++) {
-        double h = frac[stage] * dt;
-        rk4_stage(w, h, weight[stage - 1], stage == 1);
-        spn__eval_forces(w, w->t + h, w->tmp[SPN_TMP_A], w->tmp[SPN_TMP_B], w->f, &e);
-        work += weight[stage] * e.ext_power;
-        damp += weight[stage] * e.damp_power;
+    const uint32_t np = w->np, nb = spn__blocks(np);
+    double *partial = w->partial;
+    const bool backup = !w->no_backup;
+    rk4_ctx k = {spn__gather_ctx_of(w), w->x, w->v, w->tmp[SPN_TMP_A], w->tmp[SPN_TMP_B], w->tmp[SPN_TMP_C],
+                 w->tmp[SPN_TMP_D], 0, 0, dt, 0, false};
+    double work = 0, damp = 0, sum[SPN_NSUMS];
+    for (int stage = 0; stage < 4; stage++) {
+        const double t = w->t + frac[stage] * dt;
+        const spn_vec3 *xs = stage ? k.xt : w->x, *vs = stage ? k.vt : w->v;
+        spn__eval e;
+        spn__spring_pass(w, t, xs, vs, &e);
+        k.ext = spn__external(w, t, xs, vs);
+        k.stage = stage;
+        k.weight = weight[stage];
+        k.h_next = stage < 3 ? frac[stage + 1] * dt : 0;
+        const rk4_ctx kc = k;
+#pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
+        for (uint32_t blk = 0; blk < nb; blk++) {
+            const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < np ? lo + SPN_BLOCK : np;
+            double *p = partial + (size_t)blk * SPN_NSUMS;
+            if (stage < 3) rk4_block(&kc, lo, hi, p);
+            else rk4_last_block(&kc, w->x, w->v, w->x0, w->v0, backup, lo, hi, p);
+        }
+        spn__sum_partials(w, nb, sum);
+        if (stage == 0) {
+            r->e_before = sum[R_KE] + e.elastic;
+            r->elastic = e.elastic;
+        }
+        work += weight[stage] * sum[R_EXT];
+        damp += weight[stage] * (e.damp_power + sum[R_DAMP]);
     }
-    rk4_finish(w, dt, r);
+    r->gain_kp = sum[R_GAIN];
+    r->kinetic = sum[R_KE_NEW];
     r->work = dt / 6 * work;
     r->dissipated = dt / 6 * damp;
     return SPN_OK;
