@@ -12,6 +12,7 @@
 
 void spn__free_compiled(spn_world *w)
 {
+    spn__sweep_free(w);
     free(w->adj_start);
     free(w->adj);
     free(w->a_start);

@@ -52,6 +52,7 @@ static inline __attribute__((always_inline)) void explicit_block(
 
 void spn__step_explicit(spn_world *w, double dt, bool symplectic, spn__step_result *r)
 {
+    if (!w->force_fn && !spn__air_active(w) && spn__step_sweep(w, dt, symplectic, r)) return;
     spn__eval e;
     spn__spring_pass(w, w->t, w->x, w->v, &e);
     const bool ext = spn__external(w, w->t, w->x, w->v);

@@ -15,6 +15,7 @@
  * half of F on each end. The air callback is called serially in a fixed
  * order, so it may keep state (a seeded gust generator, say). */
 #include "world_internal.h"
+#include "chunk.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -51,82 +52,6 @@ void spn__sum_partials(const spn_world *w, uint32_t blocks, double *out)
 }
 
 bool spn__air_active(const spn_world *w) { return w->air_fn && w->any_diam && w->fair; }
-
-/* The spring pass works on chunks of SPN_CHUNK springs in three loops: a
- * gather of each spring's end differences (l = x_a - x_b, u = v_a - v_b) and
- * constants into small arrays, the force arithmetic over those arrays (no
- * indirection and no branches, so the compiler vectorises it, square roots
- * and divisions included), and the sums of the block. Each spring's
- * arithmetic is the same expression whatever the vector width, so the bits do
- * not depend on it. Broken springs have k = kd = 0 in the hot records, so they
- * cost the same as any other and need no flag. */
-#define SPN_CHUNK 128
-
-typedef struct chunk {
-    double lx[SPN_CHUNK], ly[SPN_CHUNK], lz[SPN_CHUNK];
-    double ux[SPN_CHUNK], uy[SPN_CHUNK], uz[SPN_CHUNK];
-    double k[SPN_CHUNK], kd[SPN_CHUNK], rest[SPN_CHUNK], tonly[SPN_CHUNK];
-    double s[SPN_CHUNK], e[SPN_CHUNK], p[SPN_CHUNK], g[SPN_CHUNK];
-} chunk;
-
-static inline void chunk_load(chunk *restrict c, const spn__spring *restrict hs, uint32_t n,
-                              const spn_vec3 *restrict x, const spn_vec3 *restrict v)
-{
-    for (uint32_t j = 0; j < n; j++) {
-        const spn__spring sp = hs[j];
-        const uint32_t a = sp.a, b = spn__end_b(sp);
-        const spn_vec3 xa = x[a], xb = x[b], va = v[a], vb = v[b];
-        c->lx[j] = xa.x - xb.x, c->ly[j] = xa.y - xb.y, c->lz[j] = xa.z - xb.z;
-        c->ux[j] = va.x - vb.x, c->uy[j] = va.y - vb.y, c->uz[j] = va.z - vb.z;
-        c->k[j] = sp.k, c->kd[j] = sp.kd, c->rest[j] = sp.rest;
-        c->tonly[j] = (double)spn__tension_only(sp);
-    }
-}
-
-/* Force on end a of each spring of the chunk, into fs; the elastic energy,
- * damping power and force magnitude of each into c->e, c->p, c->g. */
-static inline void chunk_forces(chunk *restrict c, uint32_t n, spn_vec3 *restrict fs)
-{
-    for (uint32_t j = 0; j < n; j++) {
-        const double lx = c->lx[j], ly = c->ly[j], lz = c->lz[j];
-        const double d2 = lx * lx + ly * ly + lz * lz;
-        const double len = sqrt(d2);
-        const double stretch = len - c->rest[j];
-        /* No force from a zero-length spring or a slack tension-only one:
-         * a 0/1 factor rather than a branch, so the loop vectorises. */
-        const double slack = (double)(stretch < 0) * c->tonly[j];
-        const double on = (double)(len > 0) * (1 - slack);
-        const double inv = on / (len + (1 - on)); /* 1/len, or 0 when off (never 0/0) */
-        const double rate = (c->ux[j] * lx + c->uy[j] * ly + c->uz[j] * lz) * inv; /* d|l|/dt */
-        const double k = c->k[j] * on, kd = c->kd[j];
-        const double mag = k * stretch + kd * rate;
-        c->s[j] = -mag * inv;
-        c->e[j] = 0.5 * k * stretch * stretch;
-        c->p[j] = kd * rate * rate;
-        c->g[j] = fabs(mag);
-    }
-    for (uint32_t j = 0; j < n; j++) {
-        const double sj = c->s[j];
-        fs[j].x = sj * c->lx[j], fs[j].y = sj * c->ly[j], fs[j].z = sj * c->lz[j];
-    }
-}
-
-/* Adds the chunk's sums to out[0..2], four independent partial sums each
- * (a fixed order, whatever the vector width of the loop above). */
-static inline void chunk_sums(const chunk *restrict c, uint32_t n, double *out)
-{
-    double e0 = 0, e1 = 0, e2 = 0, e3 = 0, p0 = 0, p1 = 0, p2 = 0, p3 = 0, g0 = 0, g1 = 0, g2 = 0, g3 = 0;
-    uint32_t j = 0;
-    for (; j + 4 <= n; j += 4) {
-        e0 += c->e[j], e1 += c->e[j + 1], e2 += c->e[j + 2], e3 += c->e[j + 3];
-        p0 += c->p[j], p1 += c->p[j + 1], p2 += c->p[j + 2], p3 += c->p[j + 3];
-        g0 += c->g[j], g1 += c->g[j + 1], g2 += c->g[j + 2], g3 += c->g[j + 3];
-    }
-    for (; j < n; j++) e0 += c->e[j], p0 += c->p[j], g0 += c->g[j];
-    out[0] += (e0 + e1) + (e2 + e3);
-    out[1] += (p0 + p1) + (p2 + p3);
-    out[2] += (g0 + g1) + (g2 + g3);
-}
 
 double spn_cylinder_drag_coefficient(double re)
 {
@@ -190,7 +115,7 @@ SPN__KERNEL static void spring_range(const spn__spring *restrict hs, uint32_t lo
     chunk c;
     for (uint32_t s0 = lo; s0 < hi; s0 += SPN_CHUNK) {
         const uint32_t n = hi - s0 < SPN_CHUNK ? hi - s0 : SPN_CHUNK;
-        chunk_load(&c, hs + s0, n, x, v);
+        chunk_load(&c, hs + s0, n, x, v, UINT32_MAX);
         chunk_forces(&c, n, fs + s0);
         chunk_sums(&c, n, sums);
     }

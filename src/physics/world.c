@@ -420,6 +420,9 @@ spn_world *spn_world_clone(const spn_world *w)
     c->sdiam = c->cair = c->partial = c->pinv = NULL;
     c->jac = NULL;
     c->npartial = 0;
+    c->sweep_block = 0;
+    c->xout_start = c->xout = c->xin_start = c->xin = NULL;
+    c->facc = NULL;
     for (int i = 0; i < SPN_TMP_COUNT; i++) c->tmp[i] = NULL;
     /* Nothing may alias w's arrays if a copy below fails and c is destroyed. */
     c->x = c->v = NULL;

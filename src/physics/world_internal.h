@@ -116,6 +116,11 @@ struct spn_world {
     spn_vec3 *f, *fext;   /* per-particle total and external force */
     spn_vec3 *x0, *v0;    /* state before the step (restored on blow-up) */
     bool no_backup;       /* explicit and RK4 steps leave x0, v0 alone (spn_world_advance) */
+    /* the fused explicit sweep (sweep.c), built on first use */
+    uint32_t sweep_block;            /* particles per block (0: not built) */
+    uint32_t *xout_start, *xout;     /* per block: springs whose end b is in a later block */
+    uint32_t *xin_start, *xin;       /* per block: springs whose end b is in it, end a before it */
+    spn_vec3 *facc;                  /* per-particle spring force accumulator */
     spn_vec3 *tmp[SPN_TMP_COUNT]; /* per-particle scratch, allocated on demand */
     spn_vec3 *fair;       /* per-spring air force (on demand) */
     spn_vec3 *wind;       /* per-spring air velocity at the midpoint (on demand) */
@@ -245,6 +250,13 @@ typedef struct spn__step_result {
     double kinetic;    /* kinetic energy after the step (NaN/inf: blown up) */
     double elastic;    /* elastic energy before the step */
 } spn__step_result;
+
+/* ---- sweep.c ---- */
+
+/* The fused Euler / symplectic Euler step, for worlds with no force callback
+ * and no air; false (nothing done) when out of memory for its buffers. */
+bool spn__step_sweep(spn_world *w, double dt, bool symplectic, spn__step_result *r);
+void spn__sweep_free(spn_world *w);
 
 /* ---- integrators (explicit.c, adaptive.c, implicit.c) ---- */
 
