@@ -15,3 +15,5 @@ for b in "$build"/bench_*; do
 done
 mv "$tmp" "bench/results/$machine.json"
 echo "written bench/results/$machine.json" >&2
+# The README's speed tables come from this file (between its bench-table markers).
+scripts/bench-table.py "bench/results/$machine.json" --readme README.md && echo "updated README.md" >&2

@@ -138,8 +138,16 @@ static void generic_measures(cJSON *info, spn_world *w)
  * text and the --json output pick it up. */
 static void web_measures(cJSON *info, spn_world *w)
 {
-    (void)info;
-    (void)w;
+    spn_web_measures m;
+    if (spn_web_measure(w, &m) != SPN_OK) return;
+    if (!m.springs_per_kind[SPN_THREAD_RADIUS] && !m.springs_per_kind[SPN_THREAD_CAPTURE]) return;
+    spn_buffer buf = {0};
+    spn_sink sink = spn_sink_buffer(&buf);
+    if (spn_web_measures_write(&m, true, &sink) == SPN_OK && buf.data) {
+        cJSON *web = cJSON_Parse(buf.data);
+        if (web) cJSON_AddItemToObject(info, "web", web);
+    }
+    spn_buffer_free(&buf);
 }
 
 typedef void (*measure_fn)(cJSON *info, spn_world *w);

@@ -1,9 +1,12 @@
 /* spinneret settle FILE -o OUT: step a web until it is at rest (or out of
  * time) with spn_world_settle and write the result as a web file. The report
- * goes to stderr; a run that blows up writes nothing and exits 1. */
+ * goes to stderr; a run that blows up writes nothing and exits 1.
+ * --method equilibrium solves for the rest state directly instead
+ * (spn_world_equilibrium: Newton on the potential; docs/physics-equilibrium.md). */
 #include "cli.h"
 
 #include <getopt.h>
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -12,6 +15,7 @@ static const char *const CMD = "settle";
 static void usage(FILE *out)
 {
     spn_settle_def d = spn_settle_def_default();
+    spn_equilibrium_def e = spn_equilibrium_def_default();
     fprintf(out,
             "usage: spinneret settle FILE -o OUT [options]\n"
             "Step the web in FILE until it is at rest, then write it to OUT (a web file).\n"
@@ -19,6 +23,13 @@ static void usage(FILE *out)
             "particle <= --tol. Exits 0 when converged or timed out (the report on stderr\n"
             "says which), 1 when the simulation blew up (nothing written).\n\n"
             "  -o, --output OUT      the settled web file (required; may be FILE itself)\n"
+            "      --method NAME     dynamic (step in time, the default) or equilibrium (solve\n"
+            "                        for the static rest state directly: springs, gravity, --load;\n"
+            "                        no damping or time, velocities set to 0)\n"
+            "      --rel-tol X       equilibrium: largest net force <= X times the largest spring\n"
+            "                        tension at the start, in [0, 1]; default %g (or --tol, in N)\n"
+            "      --load FX,FY,FZ   equilibrium: constant force on every free particle [N]; default 0\n"
+            "      --preconditioner NAME  equilibrium: auto, block-jacobi, jacobi, sgs or multigrid\n"
             "      --solver NAME     euler, symplectic, rk4, adaptive or implicit (kept in OUT)\n"
             "                        (default: the integrator named in FILE)\n"
             "      --dt S            time step [s], in [1e-9, 1]; default %g\n"
@@ -26,24 +37,31 @@ static void usage(FILE *out)
             "      --max-time S      give up after this much simulated time [s], in [1e-9, 1e7]; default %g\n"
             "      --max-kinetic J   kinetic energy threshold [J], in [0, 1e6]; default %g\n"
             "  -h, --help            this text\n",
-            d.dt, d.max_residual, d.max_time, d.max_kinetic);
+            e.tolerance, d.dt, d.max_residual, d.max_time, d.max_kinetic);
 }
 
 typedef struct settle_options {
     const char *input, *output, *solver;
     spn_settle_def def;
+    bool equilibrium, tol_given;
+    spn_equilibrium_def eq;
 } settle_options;
 
 /* Fills `o` from argv; returns -1 to go on, else the exit code. */
 static int parse_options(int argc, char **argv, settle_options *o)
 {
-    enum { OPT_SOLVER = 256, OPT_DT, OPT_TOL, OPT_MAX_TIME, OPT_MAX_KINETIC };
+    enum { OPT_SOLVER = 256, OPT_DT, OPT_TOL, OPT_MAX_TIME, OPT_MAX_KINETIC, OPT_METHOD, OPT_REL_TOL, OPT_LOAD,
+           OPT_PRECOND };
     static const struct option options[] = {{"output", required_argument, NULL, 'o'},
                                             {"solver", required_argument, NULL, OPT_SOLVER},
                                             {"dt", required_argument, NULL, OPT_DT},
                                             {"tol", required_argument, NULL, OPT_TOL},
                                             {"max-time", required_argument, NULL, OPT_MAX_TIME},
                                             {"max-kinetic", required_argument, NULL, OPT_MAX_KINETIC},
+                                            {"method", required_argument, NULL, OPT_METHOD},
+                                            {"rel-tol", required_argument, NULL, OPT_REL_TOL},
+                                            {"load", required_argument, NULL, OPT_LOAD},
+                                            {"preconditioner", required_argument, NULL, OPT_PRECOND},
                                             {"help", no_argument, NULL, 'h'},
                                             {NULL, 0, NULL, 0}};
     opterr = 0;
@@ -53,9 +71,23 @@ static int parse_options(int argc, char **argv, settle_options *o)
         case 'o': o->output = optarg; break;
         case OPT_SOLVER: o->solver = optarg; break;
         case OPT_DT: ok = cli_double(CMD, "--dt", optarg, 1e-9, 1, &o->def.dt); break;
-        case OPT_TOL: ok = cli_double(CMD, "--tol", optarg, 0, 1e6, &o->def.max_residual); break;
+        case OPT_TOL:
+            ok = cli_double(CMD, "--tol", optarg, 0, 1e6, &o->def.max_residual);
+            o->tol_given = true;
+            break;
         case OPT_MAX_TIME: ok = cli_double(CMD, "--max-time", optarg, 1e-9, 1e7, &o->def.max_time); break;
         case OPT_MAX_KINETIC: ok = cli_double(CMD, "--max-kinetic", optarg, 0, 1e6, &o->def.max_kinetic); break;
+        case OPT_METHOD:
+            if (strcmp(optarg, "equilibrium") == 0 || strcmp(optarg, "static") == 0) o->equilibrium = true;
+            else if (strcmp(optarg, "dynamic") == 0) o->equilibrium = false;
+            else return cli_usage(CMD, "--method: '%s' is not dynamic or equilibrium", optarg);
+            break;
+        case OPT_REL_TOL: ok = cli_double(CMD, "--rel-tol", optarg, 0, 1, &o->eq.tolerance); break;
+        case OPT_LOAD: ok = cli_vec3(CMD, "--load", optarg, false, &o->eq.load); break;
+        case OPT_PRECOND:
+            if (spn_precond_parse(optarg, &o->eq.preconditioner) != SPN_OK)
+                return cli_usage(CMD, "--preconditioner: %s", spn_last_error());
+            break;
         case 'h': usage(stdout); return 0;
         case ':': return cli_usage(CMD, "%s: missing value", argv[optind - 1]);
         default: return cli_usage(CMD, "unknown option '%s'", argv[optind - 1]);
@@ -85,9 +117,38 @@ static void print_report(const spn_settle_report *r, const spn_settle_def *d, co
     fprintf(stderr, "  final energy (kinetic + elastic + gravitational) %.9g J\n", r->total_energy);
 }
 
+static void print_equilibrium(const spn_equilibrium_report *r, const spn_equilibrium_def *d)
+{
+    if (r->reason == SPN_EQUILIBRIUM_CONVERGED)
+        fprintf(stderr, "settle: static equilibrium after %d Newton steps (%d CG iterations, %s)\n", r->iterations,
+                r->cg_iterations, spn_precond_name(r->preconditioner));
+    else
+        fprintf(stderr, "settle: no static equilibrium (%s) after %d Newton steps: not at rest\n",
+                spn_equilibrium_reason_name(r->reason), r->iterations);
+    double target = fmax(d->abs_tolerance, d->tolerance * r->force_scale);
+    fprintf(stderr, "  largest residual force %.6g N at particle %u (threshold %g; started at %.6g)\n", r->residual,
+            r->worst, target, r->residual_start);
+    fprintf(stderr, "  force scale %.6g N, energy change %.9g J, largest move %.6g m\n", r->force_scale,
+            r->energy_change, r->max_displacement);
+}
+
+/* --method equilibrium: solve, report; returns 0 or the exit code of a failure. */
+static int settle_static(spn_world *w, settle_options *o)
+{
+    if (o->tol_given) {
+        o->eq.abs_tolerance = o->def.max_residual;
+        o->eq.tolerance = 0;
+    }
+    spn_equilibrium_report report;
+    spn_status st = spn_world_equilibrium(w, &o->eq, &report);
+    if (st != SPN_OK) return cli_fail(CMD, "%s: %s; nothing written", o->input, spn_last_error());
+    print_equilibrium(&report, &o->eq);
+    return 0;
+}
+
 int cmd_settle(int argc, char **argv)
 {
-    settle_options o = {NULL, NULL, NULL, spn_settle_def_default()};
+    settle_options o = {NULL, NULL, NULL, spn_settle_def_default(), false, false, spn_equilibrium_def_default()};
     int code = parse_options(argc, argv, &o);
     if (code >= 0) return code;
 
@@ -98,13 +159,22 @@ int cmd_settle(int argc, char **argv)
         spn_integrator_parse(o.solver, &integ);
         spn_world_set_integrator(w, integ);
     }
-    spn_settle_report report;
-    spn_status st = spn_world_settle(w, &o.def, &report);
-    if (st != SPN_OK) {
-        spn_world_destroy(w);
-        return cli_fail(CMD, "%s: %s; nothing written", o.input, spn_last_error());
+    spn_status st = SPN_OK;
+    if (o.equilibrium) {
+        code = settle_static(w, &o);
+        if (code) {
+            spn_world_destroy(w);
+            return code;
+        }
+    } else {
+        spn_settle_report report;
+        st = spn_world_settle(w, &o.def, &report);
+        if (st != SPN_OK) {
+            spn_world_destroy(w);
+            return cli_fail(CMD, "%s: %s; nothing written", o.input, spn_last_error());
+        }
+        print_report(&report, &o.def, spn_integrator_name(spn_world_get_def(w)->integrator));
     }
-    print_report(&report, &o.def, spn_integrator_name(spn_world_get_def(w)->integrator));
     st = spn_web_save(w, o.output);
     spn_world_destroy(w);
     if (st != SPN_OK) return cli_fail(CMD, "%s", spn_last_error());

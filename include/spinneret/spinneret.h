@@ -8,9 +8,12 @@
 #include "web.h"
 #include "io.h"
 #include "scenes.h"
+#include "equilibrium.h"
 #include "render.h"
+#include "anim.h"
 #include "export.h"
 #include "mesh.h"
 #include "shoot.h"
+#include "inscribe.h"
 
 #endif

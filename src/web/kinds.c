@@ -33,3 +33,7 @@ spn_status spn_thread_kind_parse(const char *name, uint32_t *tag)
         }
     return spn_error(SPN_ERR_INVALID, "unknown thread kind '%s'", name);
 }
+
+static const char *stage_names[SPN_STAGE_COUNT] = {"frame", "radii", "aux-spiral", "capture", "decoration"};
+
+const char *spn_web_stage_name(uint32_t stage) { return stage < SPN_STAGE_COUNT ? stage_names[stage] : NULL; }

@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
-"""Markdown tables for README's Speed section from a bench results file
+"""Compact tables for README's Speed section from a bench results file
 (JSON lines, as written by scripts/bench.sh): bench_step per integrator and
 size, and the Bullet peer.
 
-    scripts/bench_table.py bench/results/<machine>.json
+    scripts/step-table.py bench/results/<machine>.json
 """
 import json
 import sys
@@ -62,7 +62,7 @@ def peer_table(rows):
 
 def main():
     if len(sys.argv) != 2:
-        sys.exit("usage: bench_table.py RESULTS.json")
+        sys.exit("usage: step-table.py RESULTS.json")
     rows = load(sys.argv[1])
     print(step_table(rows))
     print()

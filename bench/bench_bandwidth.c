@@ -1,0 +1,67 @@
+/* Memory bandwidth probe (STREAM-style copy and triad) so that other figures
+ * can be stated as a fraction of what this machine can move. Arrays of 32 Mi
+ * doubles (256 MiB each) are far larger than any cache; bytes counted as
+ * STREAM does (copy: 16 B per element, triad: 24 B; write-allocate traffic
+ * not counted). Best of several repetitions, for 1 thread and for all.
+ * One JSON line per figure. */
+#include "common/bench_common.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#define N (32u << 20)
+#define REPEAT 6
+
+static double best_of(int kernel, int threads, double *a, const double *b, const double *c)
+{
+    (void)threads; /* without OpenMP every loop runs on one thread */
+    double best = 1e30;
+    for (int r = 0; r < REPEAT; r++) {
+        double t0 = bench_now();
+        if (kernel == 0) {
+#pragma omp parallel for schedule(static) num_threads(threads)
+            for (uint32_t i = 0; i < N; i++) a[i] = b[i];
+        } else {
+#pragma omp parallel for schedule(static) num_threads(threads)
+            for (uint32_t i = 0; i < N; i++) a[i] = b[i] + 3.0 * c[i];
+        }
+        double t = bench_now() - t0;
+        if (t < best) best = t;
+    }
+    return best;
+}
+
+int main(int argc, char **argv)
+{
+    (void)argv;
+    int max_threads = 1;
+#ifdef _OPENMP
+    max_threads = omp_get_max_threads();
+#endif
+    double *a = malloc(N * sizeof *a), *b = malloc(N * sizeof *b), *c = malloc(N * sizeof *c);
+    if (!a || !b || !c) {
+        fprintf(stderr, "bench_bandwidth: out of memory\n");
+        return 1;
+    }
+    /* first touch in parallel, so pages land where the threads run */
+#pragma omp parallel for schedule(static) num_threads(max_threads)
+    for (uint32_t i = 0; i < N; i++) a[i] = 0, b[i] = 1, c[i] = 2;
+    const char *names[2] = {"copy", "triad"};
+    const double bytes[2] = {16.0 * N, 24.0 * N};
+    int counts[2] = {1, max_threads};
+    for (int t = 0; t < (max_threads > 1 && argc < 2 ? 2 : 1); t++)
+        for (int k = 0; k < 2; k++) {
+            double s = best_of(k, counts[t], a, b, c);
+            printf("{\"bench\":\"bandwidth\",\"kernel\":\"%s\",\"threads\":%d,\"mib_per_array\":%u,"
+                   "\"gb_per_s\":%.2f}\n",
+                   names[k], counts[t], (unsigned)(N * sizeof(double) >> 20), bytes[k] / s * 1e-9);
+            fflush(stdout);
+        }
+    free(a);
+    free(b);
+    free(c);
+    return 0;
+}

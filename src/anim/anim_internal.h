@@ -1,0 +1,25 @@
+/* Shared between the files of src/anim: web geometry helpers and the world
+ * rebuild that fixes breaking lengths. */
+#ifndef SPN_ANIM_INTERNAL_H
+#define SPN_ANIM_INTERNAL_H
+
+#include "spinneret/anim.h"
+#include "spinneret/web.h"
+
+/* The hub particle: the first tagged SPN_PARTICLE_HUB, else the free particle
+ * nearest the centroid of the free particles (all particles if none is free). */
+uint32_t spn__hub_particle(const spn_world *w);
+/* Largest distance from particle `centre` to a web particle (prey excluded). */
+double spn__web_radius(const spn_world *w, uint32_t centre);
+/* Bounding box of the web particles (prey excluded). */
+void spn__web_bounds(const spn_world *w, spn_vec3 *lo, spn_vec3 *hi);
+/* A copy of `w` (particles, springs, state, settings, metadata; no callbacks)
+ * whose intact springs of a breakable kind get break_max = rest * (1 + strain * scale). */
+spn_status spn__world_with_breaks(const spn_world *w, double scale, spn_world **out);
+
+/* True when this build's world applies aerodynamic drag (probed once on a
+ * single segment in a steady wind), so the energy ledger counts the air's work
+ * only when the air really acts. */
+bool spn__world_applies_air(void);
+
+#endif

@@ -1,0 +1,78 @@
+/* The prey impact's private state, shared by impact.c (prey, contact, glue)
+ * and impact_ledger.c (energy bookkeeping and the report). */
+#ifndef SPN_IMPACT_INTERNAL_H
+#define SPN_IMPACT_INTERNAL_H
+
+#include "anim_internal.h"
+
+#define MAX_TETHERS 256
+
+/* A glue droplet holding prey p to point u of segment s: tension-only, rest
+ * length `rest` from the prey's centre. */
+typedef struct spn__tether {
+    int prey;
+    uint32_t s;
+    double u, rest;
+} spn__tether;
+
+#define MAX_PREY 8
+
+struct spn_impact {
+    spn_impact_def def;
+    int nprey;
+    uint32_t prey[MAX_PREY];
+    double radius[MAX_PREY];
+    spn_vec3 dir0[MAX_PREY];
+    bool touched[MAX_PREY];
+    bool hit_known[MAX_PREY];
+    spn_vec3 hit[MAX_PREY];      /* prey centre at the end of its first step in contact */
+    const spn_world *world;      /* for the break callback */
+    double web_radius;
+    double break_dist_max, break_dist_sum;
+    bool strike_done;             /* every prey arrested or through: snapshot taken */
+    double strike_time;
+    spn_impact_report strike;     /* the ledger at that moment */ /* broken springs' distance from the nearest hit */
+    double kc;
+    /* springs, cached at creation (the graph does not change) */
+    uint32_t ns, np;
+    uint32_t *sa, *sb;
+    double *k, *kd, *rest, *diam;
+    uint8_t *tension_only, *broken, *slot;
+    uint32_t *tag;
+    double *rest0;  /* rest lengths at creation (yield and breaking refer to them) */
+    /* ledger */
+    int nkinds;
+    spn_kind_energy kinds[SPN_KIND_SLOTS];
+    double elastic0[SPN_KIND_SLOTS], elastic[SPN_KIND_SLOTS], damp_prev[SPN_KIND_SLOTS];
+    double viscous, viscous_prev;
+    double air_prev, wind_prev, air_work, wind_work;
+    double total0, prey_ke0, contact;
+    uint32_t breaks;
+    spn_air_fn air_fn;
+    void *air_user;
+    double rho, mu;
+    spn_force_fn wind_fn;
+    void *wind_user;
+    spn_vec3 *fbuf;
+    /* glue */
+    spn__tether tethers[MAX_TETHERS];
+    int ntethers;
+    double glue_lost, glue_energy;
+    uint32_t detached;
+};
+
+/* Closest point of segment s to c: squared distance, parameter u, offset c - q. */
+double spn__impact_closest(const spn_impact *im, uint32_t s, const spn_vec3 *x, spn_vec3 c, double *u, spn_vec3 *r);
+/* Contact and glue forces into f (when not NULL); returns their potential energy. */
+double spn__impact_contact(spn_impact *im, const spn_vec3 *x, spn_vec3 *f);
+/* The ledger's starting point (state of the world at creation). */
+void spn__impact_ledger_start(spn_impact *im, const spn_world *w);
+/* Yielding after a step: a spring stretched past its yield strain lengthens its
+ * rest so its force follows the post-yield line; the elastic energy this
+ * releases is dissipated (silk's hysteresis). */
+void spn__impact_yield(spn_impact *im, spn_world *w);
+/* Glue after a step: new droplets where prey touch capture thread, droplets
+ * that let go. */
+void spn__impact_glue_update(spn_impact *im, const spn_world *w);
+
+#endif

@@ -1,0 +1,237 @@
+/* The animation runner: steps a world frame by frame under a wind model and
+ * prey, and hands the frames in a range to a callback.
+ *
+ * Frame f shows the state at t0 + f / fps; between frames the world takes
+ * `substeps` equal steps. The run always starts from the first frame, whatever
+ * range is asked for, so a frame is the same bits whether it is rendered in a
+ * whole run or in a slice of it (--frame-range for render farms); the run
+ * stops once the last frame of the range is handed over.
+ *
+ * Explicit solvers need dt below 2 / omega_max; omega_max^2 is bounded by
+ * Gershgorin's theorem on M^-1 K: max over particles of 2 sum(k) / m. */
+#include "anim_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct runner {
+    spn_anim_def def;
+    spn_thesis_wind *thesis;
+    spn_air_field *air;
+    spn_impact *impact;
+} runner;
+
+spn_anim_def spn_anim_def_default(void)
+{
+    spn_anim_def d;
+    memset(&d, 0, sizeof d);
+    d.duration = 5;
+    d.fps = 25;
+    d.substeps = 0;
+    d.solver = SPN_INTEGRATOR_COUNT;
+    d.first_frame = 0;
+    d.last_frame = -1;
+    d.wind = SPN_WIND_NONE;
+    d.thesis = spn_thesis_wind_def_default();
+    d.air = spn_air_def_default();
+    d.wind_stop = -1;
+    d.impact = spn_impact_def_default();
+    d.seed = 1;
+    return d;
+}
+
+int spn_anim_frame_count(const spn_anim_def *def) { return (int)lround(def->duration * def->fps) + 1; }
+
+int spn_anim_stable_substeps(const spn_world *w, double fps, spn_integrator solver, double extra_stiffness)
+{
+    double frame = 1 / fps;
+    if (solver == SPN_INTEGRATOR_IMPLICIT) return (int)fmax(1, ceil(frame / 2e-3));
+    if (solver == SPN_INTEGRATOR_ADAPTIVE) return (int)fmax(1, ceil(frame / 5e-3));
+    uint32_t np = spn_world_particle_count(w), ns = spn_world_spring_count(w);
+    double *ksum = calloc(2 * (size_t)np + 1, sizeof *ksum), *csum = ksum + np;
+    if (!ksum) return 1000;
+    for (uint32_t s = 0; s < ns; s++) {
+        spn_spring_info in = spn_world_spring(w, s);
+        if (in.broken) continue;
+        ksum[in.a] += in.k;
+        ksum[in.b] += in.k;
+        csum[in.a] += in.kd;
+        csum[in.b] += in.kd;
+    }
+    /* Per particle: omega^2 <= 2 sum(k) / m and damping rate c <= 2 sum(kd) / m
+     * (Gershgorin); a damped oscillator stays stable under symplectic Euler for
+     * dt < 2 / (c / 2 + sqrt(c^2 / 4 + omega^2)). */
+    double dt = frame;
+    double reach = solver == SPN_INTEGRATOR_RK4 ? 1.4 : 0.8; /* margin on 2 (2.8 for RK4) */
+    for (uint32_t i = 0; i < np; i++) {
+        double m = spn_world_mass(w, i);
+        if (spn_world_is_fixed(w, i) || !(m > 0)) continue;
+        double om2 = 2 * (ksum[i] + extra_stiffness) / m, c = 2 * csum[i] / m;
+        double rate = 0.5 * c + sqrt(0.25 * c * c + om2);
+        if (rate > 0) dt = fmin(dt, 2 * reach / rate);
+    }
+    free(ksum);
+    double n = ceil(frame / dt);
+    return n > 1e7 ? 10000000 : (int)fmax(1, n);
+}
+
+static void runner_force(void *user, const spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v, spn_vec3 *f)
+{
+    runner *r = user;
+    if (r->thesis) spn_thesis_wind_force(r->thesis, w, t, x, v, f);
+    if (r->impact) spn_impact_force(r->impact, w, t, x, v, f);
+}
+
+static void thesis_only(void *user, const spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v, spn_vec3 *f)
+{
+    runner *r = user;
+    spn_thesis_wind_force(r->thesis, w, t, x, v, f);
+}
+
+static spn_vec3 runner_air(void *user, double t, spn_vec3 p)
+{
+    runner *r = user;
+    if (r->def.wind_stop >= 0 && t >= r->def.wind_stop) return spn_v3(0, 0, 0);
+    return spn_air_sample(r->air, t, p);
+}
+
+static spn_status check_def(const spn_anim_def *d)
+{
+    if (!(d->duration >= 0) || !(d->duration <= 1e5)) return spn_error(SPN_ERR_INVALID, "duration must be in [0, 1e5] s");
+    if (!(d->fps > 0) || !(d->fps <= 10000)) return spn_error(SPN_ERR_INVALID, "fps must be in (0, 10000]");
+    if (d->substeps < 0) return spn_error(SPN_ERR_INVALID, "substeps must be >= 0");
+    int frames = spn_anim_frame_count(d);
+    if (d->first_frame < 0 || d->first_frame >= frames)
+        return spn_error(SPN_ERR_INVALID, "frame range starts at %d, outside 0..%d", d->first_frame, frames - 1);
+    if (d->last_frame >= frames)
+        return spn_error(SPN_ERR_INVALID, "frame range ends at %d, outside 0..%d", d->last_frame, frames - 1);
+    if (d->last_frame >= 0 && d->last_frame < d->first_frame)
+        return spn_error(SPN_ERR_INVALID, "frame range %d-%d is empty", d->first_frame, d->last_frame);
+    if (d->nprey < 0 || (d->nprey > 0 && !d->prey)) return spn_error(SPN_ERR_INVALID, "prey list missing");
+    return SPN_OK;
+}
+
+/* The air field cached over the web's box, grown to leave room for billowing. */
+static spn_status make_air(runner *r, spn_world *w)
+{
+    spn_air_def ad = r->def.air;
+    ad.seed = r->def.seed;
+    if (r->def.wind != SPN_WIND_AIR) { /* still air for the prey */
+        ad.speed = 0;
+        ad.turbulence = 0;
+        ad.gust = 0;
+    }
+    spn_status st = spn_air_create(&ad, &r->air);
+    if (st != SPN_OK) return st;
+    spn_vec3 lo, hi;
+    spn__web_bounds(w, &lo, &hi);
+    double size = fmax(fmax(hi.x - lo.x, hi.y - lo.y), fmax(hi.z - lo.z, 1e-3)), pad = 0.5 * size;
+    lo = spn_v3_sub(lo, spn_v3(pad, pad, pad));
+    hi = spn_v3_add(hi, spn_v3(pad, pad, pad));
+    /* Five nodes per smallest eddy keep the interpolation within ~10% of it. */
+    if (ad.turbulence > 0) {
+        double h = ad.small_scale / 5;
+        int n[3];
+        double ext[3] = {hi.x - lo.x, hi.y - lo.y, hi.z - lo.z};
+        for (int a = 0; a < 3; a++) n[a] = (int)fmin(48, fmax(3, ceil(ext[a] / h) + 1));
+        st = spn_air_set_grid(r->air, lo, hi, n[0], n[1], n[2], 5e-3);
+    }
+    if (st != SPN_OK) return st;
+    spn_air_attach(r->air, w);
+    spn_world_set_air(w, runner_air, r, ad.rho, ad.mu);
+    if (r->impact && spn__world_applies_air()) spn_impact_track_air(r->impact, runner_air, r, ad.rho, ad.mu);
+    return SPN_OK;
+}
+
+static spn_status setup(runner *r, spn_world **w)
+{
+    spn_status st = SPN_OK;
+    if (r->def.solver != SPN_INTEGRATOR_COUNT) spn_world_set_integrator(*w, r->def.solver);
+    if (r->def.nprey > 0) st = spn_impact_create(w, r->def.prey, r->def.nprey, &r->def.impact, &r->impact);
+    if (st == SPN_OK && r->def.wind == SPN_WIND_THESIS) {
+        spn_thesis_wind_def td = r->def.thesis;
+        td.seed = r->def.seed;
+        st = spn_thesis_wind_create(&td, *w, &r->thesis);
+        if (st == SPN_OK && r->impact) spn_impact_track_wind(r->impact, thesis_only, r);
+    }
+    if (st == SPN_OK && (r->def.wind == SPN_WIND_AIR || r->impact)) st = make_air(r, *w);
+    if (st == SPN_OK && (r->thesis || r->impact)) spn_world_set_force_callback(*w, runner_force, r);
+    return st;
+}
+
+static void teardown(runner *r, spn_world *w)
+{
+    spn_world_set_force_callback(w, NULL, NULL);
+    spn_world_set_break_callback(w, NULL, NULL);
+    if (r->air) spn_world_set_air(w, NULL, NULL, r->def.air.rho, r->def.air.mu);
+    spn_thesis_wind_destroy(r->thesis);
+    spn_air_destroy(r->air);
+    spn_impact_destroy(r->impact);
+}
+
+static spn_status advance_frame(runner *r, spn_world *w, int substeps, double dt, uint64_t *steps, bool *stopped)
+{
+    for (int s = 0; s < substeps; s++) {
+        double t = spn_world_time(w);
+        if (r->air) spn_air_prepare(r->air, t, t + dt);
+        spn_status st = spn_world_step(w, dt);
+        if (st != SPN_OK) return st;
+        (*steps)++;
+        if (r->impact) spn_impact_after_step(r->impact, w, dt);
+        if (r->def.stop && *r->def.stop) {
+            *stopped = true;
+            return SPN_OK;
+        }
+    }
+    return SPN_OK;
+}
+
+spn_status spn_animate(spn_world **w, const spn_anim_def *def, spn_anim_frame_fn fn, void *user,
+                       spn_anim_report *report)
+{
+    spn_anim_report rep;
+    memset(&rep, 0, sizeof rep);
+    spn_status st = check_def(def);
+    if (st != SPN_OK) return st;
+    runner r;
+    memset(&r, 0, sizeof r);
+    r.def = *def;
+    st = setup(&r, w);
+    int frames = spn_anim_frame_count(def), last = def->last_frame < 0 ? frames - 1 : def->last_frame;
+    double kc = r.impact ? spn_impact_contact_stiffness(r.impact) : 0;
+    spn_integrator solver = spn_world_get_def(*w)->integrator;
+    rep.substeps = def->substeps > 0 ? def->substeps : spn_anim_stable_substeps(*w, def->fps, solver, kc);
+    /* Any solver: contact forces are explicit (a callback), so they need the
+     * explicit step; and a prey moves at most a tenth of its radius per step. */
+    if (r.impact && def->substeps == 0 && (solver == SPN_INTEGRATOR_IMPLICIT || solver == SPN_INTEGRATOR_ADAPTIVE)) {
+        int n = spn_anim_stable_substeps(*w, def->fps, SPN_INTEGRATOR_SYMPLECTIC, kc);
+        if (n > rep.substeps) rep.substeps = n;
+    }
+    for (int i = 0; i < def->nprey && def->substeps == 0; i++) {
+        double v = spn_v3_len(def->prey[i].velocity), n = ceil(10 * v / (def->fps * def->prey[i].radius));
+        if (n > rep.substeps && n < 1e7) rep.substeps = (int)n;
+    }
+    rep.dt = 1 / (def->fps * rep.substeps);
+    double t0 = spn_world_time(*w);
+    for (int f = 0; f <= last && st == SPN_OK; f++) {
+        if (f > 0) {
+            /* Land each frame on its exact time so rounding does not drift. */
+            st = advance_frame(&r, *w, rep.substeps, rep.dt, &rep.steps, &rep.interrupted);
+            if (st != SPN_OK || rep.interrupted) break;
+            spn_world_set_time(*w, t0 + f / def->fps);
+        }
+        if (f >= def->first_frame && fn) {
+            st = fn(user, f, *w);
+            rep.frames++;
+        }
+        if (def->progress) def->progress(def->progress_user, f, last + 1);
+    }
+    if (r.impact) {
+        rep.has_impact = true;
+        spn_impact_report_get(r.impact, *w, &rep.impact);
+    }
+    teardown(&r, *w);
+    if (report) *report = rep;
+    return st;
+}

@@ -1,0 +1,319 @@
+/* A turbulent air velocity field U(x, t) for aerodynamic drag on threads.
+ *
+ *   U(x, t) = s(t) d + u'(x - d X(t), t)
+ *
+ * Mean wind: speed s(t) = S (1 + gust G(t)) along d, where G is a sum of six
+ * sines of random phase and periods spread around `gust_period` (zero mean,
+ * unit variance, smooth), and X(t) = integral of s, known in closed form.
+ * Turbulence u': random Fourier modes (Kraichnan's method),
+ *   u' = sum_n a_n xi_n cos(k_n . y + w_n t + phi_n),
+ * with |k_n| log-spaced between 2 pi / integral_scale and 2 pi / small_scale,
+ * random directions, xi_n a unit vector normal to k_n (so div u' = 0), and
+ * a_n^2 proportional to E(k) dk = k^(-5/3) k dln k: the Kolmogorov inertial
+ * range. The amplitudes are scaled so each component has rms turbulence * S.
+ * The field is carried along by the mean wind (Taylor's frozen turbulence)
+ * and each mode also decorrelates at the eddy turnover rate
+ * w_n = sigma k_n^(2/3) L^(-1/3). Chosen over moving noise octaves because
+ * its spectrum and divergence are exact and it needs no lattice.
+ *
+ * Cost: the exact sum is `modes` cosines per point. For a web of thousands of
+ * segments per step the turbulent part is cached on a coarse grid at time
+ * slices and interpolated (trilinear, then linear in time); the mean wind is
+ * always exact. spn_air_prepare fills slices before a step, sampling only
+ * reads, so the world may sample from several threads. */
+#include "anim_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define GUST_SINES 6
+#define MAX_SLICES 8
+
+typedef struct air_mode {
+    spn_vec3 k, xi;   /* wave vector [1/m], amplitude vector [m/s] */
+    double omega, phi;
+} air_mode;
+
+typedef struct air_slice {
+    int64_t index;    /* time = index * slice_dt; INT64_MIN when empty */
+    spn_vec3 *u;      /* turbulent velocity at the grid nodes */
+} air_slice;
+
+struct spn_air_field {
+    spn_air_def def;
+    spn_vec3 dir;
+    air_mode *modes;
+    int nmodes;
+    double gust_amp[GUST_SINES], gust_omega[GUST_SINES], gust_phase[GUST_SINES];
+    /* grid cache */
+    bool grid;
+    spn_vec3 lo, hi;
+    int n[3];
+    double slice_dt;
+    air_slice slices[MAX_SLICES];
+};
+
+spn_air_def spn_air_def_default(void)
+{
+    spn_air_def d;
+    d.speed = 1;
+    d.direction = spn_v3(0, 0, -1);
+    d.gust = 0.3;
+    d.gust_period = 4;
+    d.turbulence = 0.15;
+    d.integral_scale = 1;
+    d.small_scale = 0.15;
+    d.modes = 64;
+    d.rho = 1.204;
+    d.mu = 1.81e-5;
+    d.seed = 1;
+    return d;
+}
+
+static spn_status check_def(const spn_air_def *d)
+{
+    if (!(d->speed >= 0) || !isfinite(d->speed)) return spn_error(SPN_ERR_INVALID, "air: wind speed must be >= 0");
+    if (!spn_v3_finite(d->direction) || !(spn_v3_len(d->direction) > 0))
+        return spn_error(SPN_ERR_INVALID, "air: wind direction must be a non-zero vector");
+    if (!(d->gust >= 0) || !(d->gust <= 1)) return spn_error(SPN_ERR_INVALID, "air: gust must be in [0, 1]");
+    if (!(d->gust_period > 0) || !isfinite(d->gust_period))
+        return spn_error(SPN_ERR_INVALID, "air: gust period must be > 0");
+    if (!(d->turbulence >= 0) || !(d->turbulence <= 2))
+        return spn_error(SPN_ERR_INVALID, "air: turbulence must be in [0, 2]");
+    if (!(d->small_scale > 0) || !(d->integral_scale >= d->small_scale) || !isfinite(d->integral_scale))
+        return spn_error(SPN_ERR_INVALID, "air: need 0 < small scale <= integral scale");
+    if (d->modes < 1 || d->modes > 4096) return spn_error(SPN_ERR_INVALID, "air: modes must be in [1, 4096]");
+    if (!(d->rho > 0) || !(d->mu > 0) || !isfinite(d->rho) || !isfinite(d->mu))
+        return spn_error(SPN_ERR_INVALID, "air: density and viscosity must be > 0");
+    return SPN_OK;
+}
+
+static spn_vec3 random_unit(spn_rng *rng)
+{
+    double z = spn_rng_range(rng, -1, 1), a = spn_rng_range(rng, 0, 2 * SPN_PI);
+    double r = sqrt(fmax(0, 1 - z * z));
+    return spn_v3(r * cos(a), r * sin(a), z);
+}
+
+static void make_modes(spn_air_field *air, spn_rng *rng)
+{
+    const spn_air_def *d = &air->def;
+    double kmin = 2 * SPN_PI / d->integral_scale, kmax = 2 * SPN_PI / d->small_scale;
+    double sigma = d->turbulence * d->speed, sum = 0;
+    for (int n = 0; n < air->nmodes; n++) {
+        double f = air->nmodes > 1 ? (double)n / (air->nmodes - 1) : 0;
+        double kn = kmin * pow(kmax / kmin, f);
+        spn_vec3 khat = random_unit(rng), xi;
+        do {
+            xi = spn_v3_cross(khat, random_unit(rng));
+        } while (spn_v3_len(xi) < 1e-3);
+        air_mode *m = &air->modes[n];
+        m->k = spn_v3_scale(khat, kn);
+        m->xi = spn_v3_scale(spn_v3_norm(xi), pow(kn, -1.0 / 3));
+        m->omega = sigma * pow(kn, 2.0 / 3) * pow(d->integral_scale, -1.0 / 3);
+        m->phi = spn_rng_range(rng, 0, 2 * SPN_PI);
+        sum += pow(kn, -2.0 / 3);
+    }
+    /* Each mode gives each component a variance of |a|^2 / 6 on average. */
+    double c = sum > 0 ? sigma * sqrt(6 / sum) : 0;
+    for (int n = 0; n < air->nmodes; n++) air->modes[n].xi = spn_v3_scale(air->modes[n].xi, c);
+}
+
+static void make_gusts(spn_air_field *air, spn_rng *rng)
+{
+    for (int j = 0; j < GUST_SINES; j++) {
+        double period = air->def.gust_period * exp(spn_rng_range(rng, -0.7, 0.7));
+        air->gust_omega[j] = 2 * SPN_PI / period;
+        air->gust_phase[j] = spn_rng_range(rng, 0, 2 * SPN_PI);
+        air->gust_amp[j] = sqrt(2.0 / GUST_SINES);
+    }
+}
+
+spn_status spn_air_create(const spn_air_def *def, spn_air_field **out)
+{
+    *out = NULL;
+    spn_air_def d = def ? *def : spn_air_def_default();
+    spn_status st = check_def(&d);
+    if (st != SPN_OK) return st;
+    spn_air_field *air = calloc(1, sizeof *air);
+    if (air) air->modes = calloc((size_t)d.modes, sizeof *air->modes);
+    if (!air || !air->modes) {
+        free(air);
+        return spn_error(SPN_ERR_NOMEM, "out of memory");
+    }
+    air->def = d;
+    air->dir = spn_v3_norm(d.direction);
+    air->nmodes = d.modes;
+    spn_rng rng;
+    spn_rng_seed(&rng, d.seed);
+    make_gusts(air, &rng);
+    make_modes(air, &rng);
+    for (int i = 0; i < MAX_SLICES; i++) air->slices[i].index = INT64_MIN;
+    *out = air;
+    return SPN_OK;
+}
+
+void spn_air_destroy(spn_air_field *air)
+{
+    if (!air) return;
+    for (int i = 0; i < MAX_SLICES; i++) free(air->slices[i].u);
+    free(air->modes);
+    free(air);
+}
+
+static double gust_factor(const spn_air_field *air, double t)
+{
+    if (air->def.gust == 0) return 1;
+    double g = 0;
+    for (int j = 0; j < GUST_SINES; j++) g += air->gust_amp[j] * sin(air->gust_omega[j] * t + air->gust_phase[j]);
+    return 1 + air->def.gust * g;
+}
+
+/* X(t) = integral from 0 to t of the mean speed. */
+static double advection(const spn_air_field *air, double t)
+{
+    double x = t;
+    for (int j = 0; j < GUST_SINES; j++) {
+        double w = air->gust_omega[j], p = air->gust_phase[j];
+        x += air->def.gust * air->gust_amp[j] * (cos(p) - cos(w * t + p)) / w;
+    }
+    return air->def.speed * x;
+}
+
+spn_vec3 spn_air_mean(const spn_air_field *air, double t)
+{
+    return spn_v3_scale(air->dir, air->def.speed * gust_factor(air, t));
+}
+
+static spn_vec3 turbulence_at(const spn_air_field *air, double t, double shift, spn_vec3 p)
+{
+    spn_vec3 y = spn_v3_sub(p, spn_v3_scale(air->dir, shift)), u = spn_v3(0, 0, 0);
+    if (air->def.turbulence == 0) return u;
+    for (int n = 0; n < air->nmodes; n++) {
+        const air_mode *m = &air->modes[n];
+        u = spn_v3_add(u, spn_v3_scale(m->xi, cos(spn_v3_dot(m->k, y) + m->omega * t + m->phi)));
+    }
+    return u;
+}
+
+spn_vec3 spn_air_velocity(const spn_air_field *air, double t, spn_vec3 p)
+{
+    spn_vec3 mean = spn_air_mean(air, t);
+    if (air->def.turbulence == 0 || air->def.speed == 0) return mean;
+    return spn_v3_add(mean, turbulence_at(air, t, advection(air, t), p));
+}
+
+spn_status spn_air_set_grid(spn_air_field *air, spn_vec3 lo, spn_vec3 hi, int nx, int ny, int nz, double slice_dt)
+{
+    if (nx < 2 || ny < 2 || nz < 2 || (int64_t)nx * ny * nz > 1 << 22)
+        return spn_error(SPN_ERR_INVALID, "air grid: need 2..4M nodes with at least 2 per axis");
+    if (!(slice_dt > 0) || !spn_v3_finite(lo) || !spn_v3_finite(hi) || !(hi.x > lo.x) || !(hi.y > lo.y) ||
+        !(hi.z > lo.z))
+        return spn_error(SPN_ERR_INVALID, "air grid: need a non-empty box and slice_dt > 0");
+    size_t nodes = (size_t)nx * ny * nz;
+    for (int i = 0; i < MAX_SLICES; i++) {
+        spn_vec3 *u = realloc(air->slices[i].u, nodes * sizeof *u);
+        if (!u) return spn_error(SPN_ERR_NOMEM, "out of memory");
+        air->slices[i].u = u;
+        air->slices[i].index = INT64_MIN;
+    }
+    air->grid = true;
+    air->lo = lo;
+    air->hi = hi;
+    air->n[0] = nx;
+    air->n[1] = ny;
+    air->n[2] = nz;
+    air->slice_dt = slice_dt;
+    return SPN_OK;
+}
+
+static spn_vec3 node_position(const spn_air_field *air, int i, int j, int k)
+{
+    return spn_v3(air->lo.x + (air->hi.x - air->lo.x) * i / (air->n[0] - 1),
+                  air->lo.y + (air->hi.y - air->lo.y) * j / (air->n[1] - 1),
+                  air->lo.z + (air->hi.z - air->lo.z) * k / (air->n[2] - 1));
+}
+
+static void fill_slice(spn_air_field *air, air_slice *s, int64_t index)
+{
+    double t = (double)index * air->slice_dt, shift = advection(air, t);
+    size_t q = 0;
+    for (int k = 0; k < air->n[2]; k++)
+        for (int j = 0; j < air->n[1]; j++)
+            for (int i = 0; i < air->n[0]; i++) s->u[q++] = turbulence_at(air, t, shift, node_position(air, i, j, k));
+    s->index = index;
+}
+
+static const air_slice *find_slice(const spn_air_field *air, int64_t index)
+{
+    for (int i = 0; i < MAX_SLICES; i++)
+        if (air->slices[i].index == index) return &air->slices[i];
+    return NULL;
+}
+
+spn_status spn_air_prepare(spn_air_field *air, double t0, double t1)
+{
+    if (!air->grid) return SPN_OK;
+    int64_t a = (int64_t)floor(t0 / air->slice_dt), b = (int64_t)floor(t1 / air->slice_dt) + 1;
+    if (b - a + 1 > MAX_SLICES) b = a + MAX_SLICES - 1;
+    for (int64_t idx = a; idx <= b; idx++) {
+        if (find_slice(air, idx)) continue;
+        /* Evict a slice outside [a, b], the oldest first. */
+        air_slice *victim = NULL;
+        for (int i = 0; i < MAX_SLICES; i++) {
+            air_slice *s = &air->slices[i];
+            if (s->index >= a && s->index <= b) continue;
+            if (!victim || s->index < victim->index) victim = s;
+        }
+        if (victim) fill_slice(air, victim, idx);
+    }
+    return SPN_OK;
+}
+
+static spn_vec3 lerp3(spn_vec3 a, spn_vec3 b, double f) { return spn_v3_add(a, spn_v3_scale(spn_v3_sub(b, a), f)); }
+
+/* Trilinear interpolation of a slice at p (clamped to the box). */
+static spn_vec3 interpolate(const spn_air_field *air, const air_slice *s, spn_vec3 p)
+{
+    double c[3] = {p.x, p.y, p.z}, lo[3] = {air->lo.x, air->lo.y, air->lo.z}, hi[3] = {air->hi.x, air->hi.y, air->hi.z};
+    int i0[3];
+    double fr[3];
+    for (int a = 0; a < 3; a++) {
+        double g = (c[a] - lo[a]) / (hi[a] - lo[a]) * (air->n[a] - 1);
+        g = fmin(fmax(g, 0), air->n[a] - 1);
+        i0[a] = (int)g;
+        if (i0[a] > air->n[a] - 2) i0[a] = air->n[a] - 2;
+        fr[a] = g - i0[a];
+    }
+    size_t sx = 1, sy = (size_t)air->n[0], sz = sy * (size_t)air->n[1];
+    size_t base = (size_t)i0[0] * sx + (size_t)i0[1] * sy + (size_t)i0[2] * sz;
+    const spn_vec3 *u = s->u + base;
+    spn_vec3 x00 = lerp3(u[0], u[sx], fr[0]), x10 = lerp3(u[sy], u[sy + sx], fr[0]);
+    spn_vec3 x01 = lerp3(u[sz], u[sz + sx], fr[0]), x11 = lerp3(u[sz + sy], u[sz + sy + sx], fr[0]);
+    return lerp3(lerp3(x00, x10, fr[1]), lerp3(x01, x11, fr[1]), fr[2]);
+}
+
+spn_vec3 spn_air_sample(void *user, double t, spn_vec3 p)
+{
+    const spn_air_field *air = user;
+    if (air->grid) {
+        double g = t / air->slice_dt;
+        int64_t idx = (int64_t)floor(g);
+        const air_slice *a = find_slice(air, idx), *b = find_slice(air, idx + 1);
+        if (a && b) {
+            spn_vec3 u = lerp3(interpolate(air, a, p), interpolate(air, b, p), g - (double)idx);
+            return spn_v3_add(spn_air_mean(air, t), u);
+        }
+    }
+    return spn_air_velocity(air, t, p);
+}
+
+void spn_air_attach(spn_air_field *air, spn_world *w)
+{
+    spn_world_set_air(w, spn_air_sample, air, air->def.rho, air->def.mu);
+    for (uint32_t tag = 0; tag < 64; tag++) {
+        double d = spn_thread_diameter(tag);
+        if (d > 0) spn_world_set_tag_diameter(w, tag, d);
+    }
+}

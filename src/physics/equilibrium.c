@@ -1,0 +1,305 @@
+/* spn_world_equilibrium: Newton's method on the total potential of a spring
+ * world (springs, gravity, a constant load), for webs at rest.
+ *
+ * Each iteration solves (H + lambda K) p = f by preconditioned conjugate
+ * gradients, H the Hessian projected to positive semi-definite per spring
+ * (equilibrium_system.c), K the particles' summed spring stiffness, f the net
+ * force; then a backtracking line search on the energy (Armijo) picks the step.
+ *  - lambda (a Levenberg-Marquardt shift) is 0 on a taut web, so the step is
+ *    the Newton step and convergence is quadratic; it grows when the system is
+ *    singular (slack or compressed threads leave a particle without transverse
+ *    stiffness) or when the line search had to cut the step, and shrinks again
+ *    after full steps.
+ *  - The linear solves are inexact (Eisenstat & Walker 1996, choice 2): the
+ *    relative CG tolerance follows the square of the residual's decrease, and
+ *    is never tighter than what the final tolerance needs.
+ *  - Near the answer the energy change of a step drops under rounding; a step
+ *    whose change is within the rounding estimate is accepted, and the force
+ *    residual (not the energy) decides convergence.
+ * Invariant: the world is written only at the end and only with finite values. */
+#include "equilibrium_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define LAMBDA_FIRST 1e-6 /* first shift when the plain Newton system fails */
+#define LAMBDA_MAX 1e8
+#define ARMIJO 1e-4
+#define AUTO_MULTIGRID 50000u /* free particles from which multigrid beats block Jacobi */
+#define SLACK_CAP 1.0   /* a step may take a taut silk thread (to first order) at most to slack */
+#define SLACK_FLOOR 0.01 /* ... but is never cut below this fraction */
+#define ETA0 0.1         /* the first solve's CG tolerance: a rough first step went slack wholesale */
+#define STALL_LIMIT 5 /* iterations in a row that lower neither energy nor residual */
+
+static const char *const PRECOND_NAMES[SPN_PRECOND_COUNT] = {"jacobi", "block-jacobi", "multigrid", "sgs", "auto"};
+
+const char *spn_precond_name(spn_precond p)
+{
+    return (unsigned)p < SPN_PRECOND_COUNT ? PRECOND_NAMES[p] : "unknown";
+}
+
+spn_status spn_precond_parse(const char *name, spn_precond *out)
+{
+    for (int i = 0; i < SPN_PRECOND_COUNT; i++)
+        if (name && strcmp(name, PRECOND_NAMES[i]) == 0) {
+            *out = (spn_precond)i;
+            return SPN_OK;
+        }
+    return spn_error(SPN_ERR_INVALID, "unknown preconditioner '%s' (jacobi, block-jacobi, multigrid, sgs or auto)",
+                     name ? name : "(null)");
+}
+
+const char *spn_equilibrium_reason_name(spn_equilibrium_reason r)
+{
+    switch (r) {
+    case SPN_EQUILIBRIUM_CONVERGED: return "converged";
+    case SPN_EQUILIBRIUM_MAX_ITERATIONS: return "max-iterations";
+    case SPN_EQUILIBRIUM_STALLED: return "stalled";
+    }
+    return "unknown";
+}
+
+spn_equilibrium_def spn_equilibrium_def_default(void)
+{
+    spn_equilibrium_def d;
+    memset(&d, 0, sizeof d);
+    d.tolerance = 1e-6;
+    d.abs_tolerance = 0;
+    d.force_scale = 0;
+    d.max_iterations = 200;
+    d.max_cg_iterations = 5000;
+    d.preconditioner = SPN_PRECOND_AUTO;
+    d.gravity = true;
+    d.load = spn_v3(0, 0, 0);
+    d.loads = NULL;
+    d.threads = 0;
+    return d;
+}
+
+static spn_status check_def(const spn_world *w, const spn_equilibrium_def *d)
+{
+    if (!(d->tolerance >= 0) || !isfinite(d->tolerance))
+        return spn_error(SPN_ERR_INVALID, "equilibrium: tolerance must be finite and >= 0 (got %g)", d->tolerance);
+    if (!(d->abs_tolerance >= 0) || !isfinite(d->abs_tolerance))
+        return spn_error(SPN_ERR_INVALID, "equilibrium: abs_tolerance must be finite and >= 0 (got %g)",
+                         d->abs_tolerance);
+    if (!isfinite(d->force_scale))
+        return spn_error(SPN_ERR_INVALID, "equilibrium: force_scale must be finite (got %g)", d->force_scale);
+    if (d->max_iterations < 0 || d->max_cg_iterations < 1)
+        return spn_error(SPN_ERR_INVALID, "equilibrium: max_iterations must be >= 0 and max_cg_iterations >= 1");
+    if ((unsigned)d->preconditioner >= SPN_PRECOND_COUNT)
+        return spn_error(SPN_ERR_INVALID, "equilibrium: preconditioner %d is not one of the %d kinds",
+                         (int)d->preconditioner, SPN_PRECOND_COUNT);
+    if (d->threads < 0) return spn_error(SPN_ERR_INVALID, "equilibrium: threads must be >= 0 (got %d)", d->threads);
+    if (!spn_v3_finite(d->load)) return spn_error(SPN_ERR_INVALID, "equilibrium: load is not finite");
+    for (uint32_t i = 0; i < spn_world_particle_count(w); i++) {
+        if (d->loads && !spn_v3_finite(d->loads[i]))
+            return spn_error(SPN_ERR_INVALID, "equilibrium: loads[%u] is not finite", i);
+        if (!spn_v3_finite(spn_world_position(w, i)))
+            return spn_error(SPN_ERR_UNSTABLE, "equilibrium: particle %u has a non-finite position", i);
+    }
+    return SPN_OK;
+}
+
+/* The largest spring tension, else the largest external force, else 1 N. */
+static double auto_force_scale(const spn__eq *e)
+{
+    double t = 0;
+    for (uint32_t s = 0; s < e->m; s++) {
+        const double *a = e->x + 3 * (size_t)e->sa[s], *b = e->x + 3 * (size_t)e->sb[s];
+        double l = sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+        t = fmax(t, e->k[s] * (l - e->rest[s]));
+    }
+    if (t > 0) return t;
+    for (uint32_t i = 0; i < e->n; i++) {
+        const double *f = e->fext + 3 * (size_t)i;
+        t = fmax(t, sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]));
+    }
+    t = fmax(t, e->iso_force);
+    return t > 0 ? t : 1;
+}
+
+typedef struct newton {
+    spn__eq e;
+    spn__precond pc;
+    double *p, *work;
+    double lambda, target, residual, eta, energy_change;
+    uint32_t worst;
+    int max_cg, stalls;
+    spn_status status; /* SPN_OK, or the failure that ended the run */
+    spn_equilibrium_report rep;
+} newton;
+
+static double grow_lambda(double lambda) { return lambda > 0 ? 10 * lambda : LAMBDA_FIRST; }
+
+/* The CG tolerance for the next solve (Eisenstat-Walker choice 2, safeguarded),
+ * never tighter than the target asks for. */
+static double forcing(const newton *nt, double previous_residual)
+{
+    double ratio = nt->residual / previous_residual;
+    double eta = 0.9 * ratio * ratio, safe = 0.9 * nt->eta * nt->eta;
+    if (safe > 0.1) eta = fmax(eta, safe);
+    return fmin(0.5, eta);
+}
+
+/* Take the line-search positions as the current ones (or back): the fixed
+ * particles sit in both arrays, and only free ones are ever written. */
+static void swap_positions(spn__eq *e)
+{
+    double *t = e->x;
+    e->x = e->xtrial;
+    e->xtrial = t;
+}
+
+/* One Newton iteration. Returns 1 to go on, 0 when stalled. */
+static int newton_iteration(newton *nt)
+{
+    spn__eq *e = &nt->e;
+    size_t n3 = 3 * (size_t)e->n;
+    spn_status st = spn__precond_setup(&nt->pc, e);
+    if (st == SPN_ERR_NOMEM) {
+        nt->status = st;
+        return 0;
+    }
+    if (st != SPN_OK) { /* a particle without stiffness, or a coarse level not positive definite */
+        nt->lambda = grow_lambda(nt->lambda);
+        nt->residual = spn__eq_assemble(e, nt->lambda, &nt->worst);
+        return nt->lambda < LAMBDA_MAX;
+    }
+    memset(nt->p, 0, n3 * sizeof *nt->p);
+    /* |r|_inf <= |r|_2: a linear residual under half the target is all the step can use */
+    int cg = spn__eq_pcg(e, &nt->pc, nt->p, nt->eta, 0.5 * nt->target, nt->max_cg, nt->work);
+    nt->rep.cg_iterations += cg > 0 ? cg : 0;
+    double slope = cg < 0 ? 0 : spn__eq_dot(e, e->f, nt->p);
+    if (!(slope > 0)) { /* not a descent direction: the system needs a shift */
+        nt->lambda = grow_lambda(nt->lambda);
+        nt->residual = spn__eq_assemble(e, nt->lambda, &nt->worst);
+        return nt->lambda < LAMBDA_MAX;
+    }
+    /* Along the web's soft in-plane modes a Newton step can be long enough to
+     * leave threads slack, and a slack thread has no stiffness for the next
+     * model: cut the step where the first taut thread would go slack. */
+    double step = fmax(SLACK_FLOOR, spn__eq_slack_limit(e, nt->p, SLACK_CAP));
+    if (step < 1) {
+        for (size_t i = 0; i < n3; i++) nt->p[i] *= step;
+        slope *= step;
+    }
+    /* CG from zero keeps p^T A p = f^T p, so the model predicts a drop of slope (1 - step / 2) */
+    double de = spn__eq_energy_delta(e, nt->p, 1), rho = isfinite(de) ? -de / (slope * (1 - 0.5 * step)) : -1;
+    bool armijo = de <= -ARMIJO * slope, rounding = fabs(de) <= e->noise;
+    if (!armijo && !rounding) { /* the model was wrong: shift and retry */
+        nt->rep.backtracks++;
+        nt->lambda = fmax(LAMBDA_FIRST, 4 * nt->lambda);
+        nt->residual = spn__eq_assemble(e, nt->lambda, &nt->worst);
+        return nt->lambda < LAMBDA_MAX;
+    }
+    if (!armijo) rho = 1; /* the energy cannot tell: the residual decides below */
+    double previous = nt->residual, lambda = nt->lambda;
+    if (rho > 0.75) nt->lambda = nt->lambda > 1e-9 ? nt->lambda / 3 : 0;
+    else if (rho < 0.25) nt->lambda = fmax(LAMBDA_FIRST, 2 * nt->lambda);
+    swap_positions(e);
+    nt->residual = spn__eq_assemble(e, nt->lambda, &nt->worst);
+    if (!armijo && !(nt->residual < previous)) { /* a step lost in rounding that did not help: undo */
+        swap_positions(e);
+        nt->lambda = lambda;
+        nt->residual = spn__eq_assemble(e, nt->lambda, &nt->worst);
+        return ++nt->stalls < STALL_LIMIT;
+    }
+    nt->energy_change += de;
+    nt->stalls = 0;
+    nt->eta = forcing(nt, previous);
+    return 1;
+}
+
+static void run(newton *nt, const spn_equilibrium_def *d)
+{
+    spn__eq *e = &nt->e;
+    nt->rep.force_scale = d->force_scale > 0 ? d->force_scale : auto_force_scale(e);
+    nt->target = fmax(d->abs_tolerance, d->tolerance * nt->rep.force_scale);
+    nt->max_cg = d->max_cg_iterations;
+    nt->eta = ETA0;
+    nt->residual = spn__eq_assemble(e, 0, &nt->worst);
+    nt->rep.residual_start = fmax(nt->residual, e->iso_force);
+    nt->rep.reason = SPN_EQUILIBRIUM_MAX_ITERATIONS;
+    while (isfinite(nt->residual)) {
+        if (nt->residual <= nt->target && nt->lambda == 0) {
+            nt->rep.reason = SPN_EQUILIBRIUM_CONVERGED;
+            break;
+        }
+        if (nt->residual <= nt->target) { /* measured with a shifted diagonal: drop the shift */
+            nt->lambda = 0;
+            nt->residual = spn__eq_assemble(e, 0, &nt->worst);
+            continue;
+        }
+        if (nt->rep.iterations >= d->max_iterations) break;
+        nt->rep.iterations++;
+        if (!newton_iteration(nt)) {
+            nt->rep.reason = SPN_EQUILIBRIUM_STALLED;
+            break;
+        }
+        if (nt->status != SPN_OK) break;
+    }
+    if (e->iso_force > nt->residual || e->n == 0) {
+        nt->residual = fmax(nt->residual, e->iso_force);
+        if (e->iso_force > nt->target) nt->rep.reason = SPN_EQUILIBRIUM_STALLED;
+        nt->worst = UINT32_MAX;
+    }
+}
+
+/* Copy the result into the world, if it is finite; fill the report. */
+static spn_status write_back(newton *nt, spn_world *w, spn_equilibrium_report *report)
+{
+    spn__eq *e = &nt->e;
+    for (size_t c = 0; c < 3 * (size_t)e->n; c++)
+        if (!isfinite(e->x[c]))
+            return spn_error(SPN_ERR_UNSTABLE, "equilibrium: particle %u reached a non-finite position",
+                             e->world_id[c / 3]);
+    if (!isfinite(nt->residual))
+        return spn_error(SPN_ERR_UNSTABLE, "equilibrium: the residual force became non-finite");
+    double moved = 0;
+    for (uint32_t i = 0; i < e->n; i++) {
+        uint32_t id = e->world_id[i];
+        spn_vec3 x = spn_v3(e->x[3 * i], e->x[3 * i + 1], e->x[3 * i + 2]);
+        moved = fmax(moved, spn_v3_len(spn_v3_sub(x, spn_world_position(w, id))));
+        spn_world_set_position(w, id, x);
+        spn_world_set_velocity(w, id, spn_v3(0, 0, 0));
+    }
+    nt->rep.residual = nt->residual;
+    nt->rep.energy_change = nt->energy_change;
+    nt->rep.max_displacement = moved;
+    nt->rep.worst = nt->worst == UINT32_MAX ? e->iso_worst : (e->n ? e->world_id[nt->worst] : 0);
+    if (report) *report = nt->rep;
+    return SPN_OK;
+}
+
+spn_status spn_world_equilibrium(spn_world *w, const spn_equilibrium_def *def, spn_equilibrium_report *report)
+{
+    spn_equilibrium_def d = def ? *def : spn_equilibrium_def_default();
+    if (report) memset(report, 0, sizeof *report);
+    if (!w) return spn_error(SPN_ERR_INVALID, "equilibrium: world is NULL");
+    spn_status st = check_def(w, &d);
+    if (st != SPN_OK) return st;
+    newton nt;
+    memset(&nt, 0, sizeof nt);
+    nt.pc.kind = d.preconditioner;
+    st = spn__eq_init(&nt.e, w, &d);
+    if (st != SPN_OK) return st;
+    if (nt.pc.kind == SPN_PRECOND_AUTO) /* the crossover measured on the standard web (bench_equilibrium) */
+        nt.pc.kind = nt.e.n < AUTO_MULTIGRID ? SPN_PRECOND_BLOCK_JACOBI : SPN_PRECOND_MULTIGRID;
+    nt.rep.preconditioner = nt.pc.kind;
+    size_t n3 = 3 * (size_t)(nt.e.n ? nt.e.n : 1);
+    nt.p = malloc(n3 * sizeof *nt.p);
+    nt.work = malloc(4 * n3 * sizeof *nt.work);
+    if (!nt.p || !nt.work) {
+        st = spn_error(SPN_ERR_NOMEM, "equilibrium: out of memory");
+    } else {
+        run(&nt, &d);
+        st = nt.status != SPN_OK ? nt.status : write_back(&nt, w, report);
+    }
+    free(nt.p);
+    free(nt.work);
+    spn__precond_free(&nt.pc);
+    spn__eq_free(&nt.e);
+    return st;
+}

@@ -1,0 +1,109 @@
+/* Shared between the equilibrium files: the static problem extracted from a
+ * world (free particles first, fixed ones after), the per-spring Hessian
+ * blocks, the PCG solver and the preconditioners.
+ *
+ * Vectors over free particles are double[3 n] (x, y, z interleaved). A
+ * symmetric 3x3 block is stored as 6 doubles: xx, yy, zz, xy, xz, yz.
+ * Reductions go through fixed blocks of particles (SPN__EQ_CHUNK) summed in
+ * order, so every result is the same bits for any thread count. */
+#ifndef SPN_EQUILIBRIUM_INTERNAL_H
+#define SPN_EQUILIBRIUM_INTERNAL_H
+
+#include "spinneret/equilibrium.h"
+
+#define SPN__EQ_CHUNK 512u
+
+typedef struct spn__mg spn__mg;
+
+typedef struct spn__eq {
+    uint32_t n;        /* free particles: local ids 0..n-1 */
+    uint32_t nl;       /* local particles: free, then fixed ones touched by a spring */
+    uint32_t *world_id; /* nl: local -> world particle id */
+    double *x;         /* 3 nl: positions (fixed ones never change) */
+    double *fext;      /* 3 n: gravity + load */
+    double *xtrial;    /* 3 n: line-search positions */
+
+    uint32_t m;        /* springs with a free end, not broken */
+    uint32_t m_free;   /* the first m_free join two free particles; the rest have a (free) and b fixed */
+    uint32_t *sa, *sb; /* local ids */
+    double *k, *rest;
+    uint8_t *tonly;
+
+    /* free particle -> incident springs, in spring order: spring id << 1 | (1 if end b) */
+    uint32_t *adj_start, *adj;
+    int32_t *adj_other; /* the other end's local free id, or -1 when fixed */
+    int32_t *adj_col;   /* the same, but the row itself when fixed (its block is zero) */
+
+    /* per Newton iteration */
+    double *hs;   /* 6 m: projected Hessian block of each spring */
+    double *fs;   /* 3 m: force on end a */
+    double *diag; /* 6 n: diagonal blocks (springs + shift) */
+    double *offd; /* 6 per adjacency entry: -H_s of the row's spring (0 to a fixed end) */
+    double *kscale; /* n: sum of incident k, the scale of the Levenberg shift */
+    double lambda;  /* the shift of the last assembly */
+    double *f;    /* 3 n: net force = -gradient */
+    double noise; /* rounding scale of an energy difference [J] */
+    double xmax;  /* largest |coordinate| at the start [m] */
+    double iso_force;   /* largest external force on a free particle without springs [N] */
+    uint32_t iso_worst; /* ... its world id */
+
+    int threads;
+    uint32_t nchunks;
+    double *partial; /* nchunks * 4 */
+} spn__eq;
+
+/* Build the problem from the world; SPN_ERR_NOMEM or SPN_OK. */
+spn_status spn__eq_init(spn__eq *e, const spn_world *w, const spn_equilibrium_def *def);
+void spn__eq_free(spn__eq *e);
+
+/* Forces and Hessian blocks at e->x, diagonal shifted by lambda * kscale.
+ * Returns the largest |f_i| and its local id in *worst. */
+double spn__eq_assemble(spn__eq *e, double lambda, uint32_t *worst);
+/* Energy change of moving the free particles from x to x + alpha p; the
+ * trial positions are left in e->xtrial. */
+double spn__eq_energy_delta(spn__eq *e, const double *p, double alpha);
+/* The largest step along p (<= 1) that shortens no taut tension-only spring,
+ * to first order, by more than cap times its stretch. */
+double spn__eq_slack_limit(const spn__eq *e, const double *p, double cap);
+/* y = A p over free particles; the _dot form also returns p . y. */
+void spn__eq_matvec(const spn__eq *e, const double *p, double *y);
+double spn__eq_matvec_dot(const spn__eq *e, const double *p, double *y);
+/* p += alpha d, r -= alpha q; returns r . r. */
+double spn__eq_update(const spn__eq *e, double alpha, const double *d, const double *q, double *p, double *r);
+/* Fixed-order sum of a . b over 3 n entries. */
+double spn__eq_dot(const spn__eq *e, const double *a, const double *b);
+
+/* Preconditioner: z = M^-1 r. */
+typedef struct spn__precond {
+    spn_precond kind;
+    double *inv; /* 6 n: inverted diagonal blocks (or the diagonal) */
+    spn__mg *mg;
+} spn__precond;
+
+spn_status spn__precond_setup(spn__precond *pc, const spn__eq *e);
+void spn__precond_apply(const spn__precond *pc, const spn__eq *e, const double *r, double *z);
+void spn__precond_free(spn__precond *pc);
+/* Symmetric block Gauss-Seidel with the inverted diagonal blocks inv. */
+void spn__sgs_apply(const spn__eq *e, const double *inv, const double *r, double *z);
+
+/* Solve A p = f until |A p - f|_2 <= max(eta |f|_2, floor), p the first guess.
+ * Returns the iterations used, or -1 when A showed non-positive curvature. */
+int spn__eq_pcg(const spn__eq *e, const spn__precond *pc, double *p, double eta, double floor, int max_iter,
+                double *work);
+
+/* Symmetric 3x3 block helpers (6-double layout). */
+static inline void spn__sym_mul(const double *h, const double *v, double *out)
+{
+    out[0] = h[0] * v[0] + h[3] * v[1] + h[4] * v[2];
+    out[1] = h[3] * v[0] + h[1] * v[1] + h[5] * v[2];
+    out[2] = h[4] * v[0] + h[5] * v[1] + h[2] * v[2];
+}
+/* Inverse of a symmetric 3x3 block; false when it is not positive definite. */
+bool spn__sym_inverse(const double *h, double *inv);
+
+/* Multigrid (equilibrium_mg.c): built from the assembled system. */
+spn_status spn__mg_setup(spn__mg **mg, const spn__eq *e, const double *inv0);
+void spn__mg_apply(const spn__mg *mg, const spn__eq *e, const double *r, double *z);
+void spn__mg_free(spn__mg *mg);
+
+#endif

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# spinneret build: species and methods write web files that info reads back
+# with web measures; the same seed gives the same file; bad anchors and
+# out-of-range options fail with a message naming them and leave no file.
+set -u
+SPN=$1
+fail() { echo "FAIL: $*"; exit 1; }
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+
+"$SPN" build --species zygiella --seed 4 -o "$T/a.json" || fail "species build"
+"$SPN" build --species zygiella --seed 4 -o "$T/b.json" || fail "species build again"
+cmp -s "$T/a.json" "$T/b.json" || fail "same seed should give the same file"
+"$SPN" build --species zygiella --seed 5 -o "$T/c.json" || fail "species build seed 5"
+cmp -s "$T/a.json" "$T/c.json" && fail "another seed should give another web"
+"$SPN" info --json "$T/a.json" | grep -q '"radii"' || fail "info --json should carry the web measures"
+"$SPN" info "$T/a.json" | grep -q 'turns_below' || fail "info text should carry the web measures"
+
+"$SPN" build --method geometric --anchors "0,0.5;-0.45,0.2;-0.4,-0.3;0.4,-0.3;0.45,0.2" --k 20 --m 0.4 \
+    -o "$T/g.json" || fail "geometric build"
+"$SPN" build --method physical --anchors "-0.2,0.2;0.2,0.2;0.2,-0.2;-0.2,-0.2" --move-outer 0.03 \
+    --frame-placement 0.04 --frame-rest 0.035 -o "$T/p.json" || fail "physical build"
+grep -q '"builder": *"physical"' "$T/p.json" || grep -q 'physical' "$T/p.json" || fail "metadata names the builder"
+
+# A building animation: N frames, the web file without the auxiliary spiral.
+"$SPN" build --species araneus --seed 2 --frames "$T/frames" --frame-count 6 -o "$T/f.json" || fail "build --frames"
+[ "$(ls "$T/frames" | grep -c '\.png$')" -eq 6 ] || fail "6 frames expected, got $(ls "$T/frames")"
+"$SPN" info --json "$T/f.json" | grep -Eq '"aux-spiral":[[:space:]]*[0-9]' && fail "the auxiliary spiral should be gone from the file"
+# Frames grow: the last frame has more ink than the first (bigger PNG of the same size).
+first=$(stat -c %s "$T/frames/$(ls "$T/frames" | head -1)")
+last=$(stat -c %s "$T/frames/$(ls "$T/frames" | tail -1)")
+[ "$last" -gt "$first" ] || fail "the last frame ($last bytes) should hold more web than the first ($first)"
+
+check_bad() { # expected-text args...
+    local want=$1; shift
+    "$SPN" build "$@" -o "$T/bad.json" 2>"$T/err" && fail "should fail: $*"
+    grep -q "$want" "$T/err" || fail "message for '$*' should mention '$want': $(cat "$T/err")"
+    [ -e "$T/bad.json" ] && fail "no file after a failure: $*"
+    return 0
+}
+check_bad "at least 3" --method geometric --anchors "0,0;1,0"
+check_bad "same point" --method geometric --anchors "0,0;1,0;1,0"
+check_bad "one line" --method geometric --anchors "0,0;1,1;2,2"
+check_bad "anchor 2" --method geometric --anchors "0,0;nan,1;1,0"
+check_bad "crosses" --method geometric --anchors "0,0;1,1;1,0;0,1"
+check_bad "\-\-m" --method geometric --anchors "0,0;1,0;0,1" --m 0.7
+check_bad "\-\-k" --method geometric --anchors "0,0;1,0;0,1" --k 46
+check_bad "\-\-t" --method geometric --anchors "0,0;1,0;0,1" --t 0.3
+check_bad "species" --species spidey
+echo "web build ok"

@@ -1,0 +1,192 @@
+/* Air on threads: the drag on one straight segment is 1/2 rho C_d d L |u_n| u_n
+ * from the normal component of the wind only (none when the wind runs along
+ * it); a web in steady air settles to a deflected shape whose deflection grows
+ * with wind speed, and comes back to rest when the wind stops; the turbulent
+ * field has the rms and the zero divergence it is built with. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <spinneret/spinneret.h>
+
+static spn_air_field *steady(double speed, spn_vec3 dir)
+{
+    spn_air_def d = spn_air_def_default();
+    d.speed = speed;
+    d.direction = dir;
+    d.gust = 0;
+    d.turbulence = 0;
+    spn_air_field *air;
+    assert_int_equal(spn_air_create(&d, &air), SPN_OK);
+    return air;
+}
+
+/* One step from rest of a free segment along x in wind `u`: the velocity each
+ * end gains, divided by dt and multiplied by its mass, is the force on it. */
+static spn_vec3 force_on_end(spn_vec3 wind_dir, double speed)
+{
+    spn_world_def wd = spn_world_def_default();
+    wd.gravity = spn_v3(0, 0, 0);
+    spn_world *w = spn_world_create(&wd);
+    spn_particle_def p = spn_particle_def_default();
+    p.mass = 1e-3;
+    spn_spring_def s = spn_spring_def_default();
+    p.position = spn_v3(0, 0, 0);
+    assert_int_equal(spn_world_add_particle(w, &p, &s.a), SPN_OK);
+    p.position = spn_v3(0.02, 0, 0);
+    assert_int_equal(spn_world_add_particle(w, &p, &s.b), SPN_OK);
+    s.k = 1;
+    s.tag = SPN_THREAD_RADIUS;
+    assert_int_equal(spn_world_add_spring(w, &s, NULL), SPN_OK);
+    spn_air_field *air = steady(speed, wind_dir);
+    spn_air_attach(air, w);
+    const double dt = 1e-6;
+    assert_int_equal(spn_world_step(w, dt), SPN_OK);
+    spn_vec3 f = spn_v3_scale(spn_world_velocity(w, 0), p.mass / dt);
+    spn_world_destroy(w);
+    spn_air_destroy(air);
+    return f;
+}
+
+static void test_segment_drag_formula(void **state)
+{
+    (void)state;
+    const double rho = 1.204, mu = 1.81e-5, d = spn_thread_diameter(SPN_THREAD_RADIUS), L = 0.02, speed = 2;
+    /* Wind at 30 degrees to the segment: only the normal part, speed sin 30. */
+    double a = SPN_PI / 6;
+    spn_vec3 dir = spn_v3(cos(a), 0, sin(a));
+    spn_vec3 f = force_on_end(dir, speed);
+    double un = speed * sin(a), re = rho * un * d / mu;
+    double expect = 0.5 * 0.5 * rho * spn_cylinder_drag_coefficient(re) * d * L * un * un; /* half per end */
+    printf("# drag per end %.6g N, formula %.6g N (Re %.3g)\n", f.z, expect, re);
+    assert_true(fabs(f.z - expect) <= 1e-6 * expect);
+    assert_true(fabs(f.x) <= 1e-9 * expect); /* nothing along the segment */
+    assert_true(fabs(f.y) <= 1e-9 * expect);
+    /* Along the segment: no force at all. */
+    spn_vec3 g = force_on_end(spn_v3(1, 0, 0), speed);
+    assert_true(spn_v3_len(g) == 0);
+}
+
+/* The hub's deflection along the wind after `wind_time` of steady wind, and
+ * after a further `calm_time` without it. */
+static void deflect(double speed, double *during, double *after)
+{
+    spn_world *w = NULL;
+    assert_int_equal(spn_web_load(SPN_TEST_DATA "/anim/orb.json", &w), SPN_OK);
+    spn_world_set_drag(w, 30); /* settle faster; the equilibrium does not depend on it */
+    spn_anim_def ad = spn_anim_def_default();
+    ad.wind = SPN_WIND_AIR;
+    ad.air.speed = speed;
+    ad.air.direction = spn_v3(0, 0, -1);
+    ad.air.gust = 0;
+    ad.air.turbulence = 0;
+    ad.fps = 20;
+    ad.duration = 0.6;
+    ad.wind_stop = after ? 0.6 : -1;
+    spn_anim_report rep;
+    assert_int_equal(spn_animate(&w, &ad, NULL, NULL, &rep), SPN_OK);
+    *during = -spn_world_position(w, 0).z;
+    if (after) {
+        ad.wind = SPN_WIND_NONE;
+        assert_int_equal(spn_animate(&w, &ad, NULL, NULL, &rep), SPN_OK);
+        *after = -spn_world_position(w, 0).z;
+    }
+    spn_world_destroy(w);
+}
+
+static void test_web_billows_with_speed(void **state)
+{
+    (void)state;
+    double d1, d2, d4, back;
+    deflect(1, &d1, NULL);
+    deflect(2, &d2, NULL);
+    deflect(4, &d4, &back);
+    printf("# hub deflection: %.3g mm at 1 m/s, %.3g mm at 2 m/s, %.3g mm at 4 m/s, %.3g mm after the wind\n",
+           d1 * 1e3, d2 * 1e3, d4 * 1e3, back * 1e3);
+    assert_true(d1 > 1e-4);
+    assert_true(d2 > 1.3 * d1);
+    assert_true(d4 > 1.3 * d2);
+    assert_true(fabs(back) < 0.05 * d4);
+}
+
+static void test_turbulence_statistics(void **state)
+{
+    (void)state;
+    spn_air_def d = spn_air_def_default();
+    d.speed = 3;
+    d.turbulence = 0.2;
+    d.gust = 0;
+    spn_air_field *air;
+    assert_int_equal(spn_air_create(&d, &air), SPN_OK);
+    /* rms of each component over many points and times ~ 0.2 * 3 = 0.6 m/s. */
+    spn_rng rng;
+    spn_rng_seed(&rng, 7);
+    double sum2[3] = {0, 0, 0}, div = 0, h = 1e-5;
+    const int n = 4000;
+    for (int i = 0; i < n; i++) {
+        spn_vec3 p = spn_v3(spn_rng_range(&rng, -5, 5), spn_rng_range(&rng, -5, 5), spn_rng_range(&rng, -5, 5));
+        double t = spn_rng_range(&rng, 0, 100);
+        spn_vec3 u = spn_v3_sub(spn_air_velocity(air, t, p), spn_air_mean(air, t));
+        sum2[0] += u.x * u.x, sum2[1] += u.y * u.y, sum2[2] += u.z * u.z;
+        /* central differences: the truncation error stays far below the gradients (~k u ~ 10 1/s) */
+        double dudx = (spn_air_velocity(air, t, spn_v3(p.x + h, p.y, p.z)).x -
+                       spn_air_velocity(air, t, spn_v3(p.x - h, p.y, p.z)).x) / (2 * h);
+        double dvdy = (spn_air_velocity(air, t, spn_v3(p.x, p.y + h, p.z)).y -
+                       spn_air_velocity(air, t, spn_v3(p.x, p.y - h, p.z)).y) / (2 * h);
+        double dwdz = (spn_air_velocity(air, t, spn_v3(p.x, p.y, p.z + h)).z -
+                       spn_air_velocity(air, t, spn_v3(p.x, p.y, p.z - h)).z) / (2 * h);
+        div = fmax(div, fabs(dudx + dvdy + dwdz));
+    }
+    double rms = sqrt((sum2[0] + sum2[1] + sum2[2]) / (3.0 * n));
+    printf("# turbulence rms %.3f m/s (target 0.6), largest divergence %.2g 1/s\n", rms, div);
+    assert_true(fabs(rms - 0.6) < 0.15);
+    assert_true(div < 1e-2);
+    /* The cached grid (five nodes per smallest eddy, as the runner makes it)
+     * interpolates the exact field closely. */
+    assert_int_equal(spn_air_set_grid(air, spn_v3(-0.2, -0.2, -0.1), spn_v3(0.2, 0.2, 0.1), 15, 15, 8, 5e-3), SPN_OK);
+    assert_int_equal(spn_air_prepare(air, 1.0, 1.001), SPN_OK);
+    double err = 0;
+    for (int i = 0; i < 200; i++) {
+        spn_vec3 p = spn_v3(spn_rng_range(&rng, -0.2, 0.2), spn_rng_range(&rng, -0.2, 0.2), spn_rng_range(&rng, -0.1, 0.1));
+        double t = spn_rng_range(&rng, 1.0, 1.005);
+        spn_vec3 e = spn_v3_sub(spn_air_sample(air, t, p), spn_air_velocity(air, t, p));
+        err += spn_v3_dot(e, e) / 200;
+    }
+    err = sqrt(err / 3);
+    printf("# grid interpolation error %.3g m/s rms per component\n", err);
+    assert_true(err < 0.1 * 0.6);
+    spn_air_destroy(air);
+}
+
+static void test_rejects_bad_air(void **state)
+{
+    (void)state;
+    spn_air_def d = spn_air_def_default();
+    spn_air_field *air = NULL;
+    d.direction = spn_v3(0, 0, 0);
+    assert_int_equal(spn_air_create(&d, &air), SPN_ERR_INVALID);
+    assert_non_null(strstr(spn_last_error(), "direction"));
+    d = spn_air_def_default();
+    d.speed = -1;
+    assert_int_equal(spn_air_create(&d, &air), SPN_ERR_INVALID);
+    d = spn_air_def_default();
+    d.small_scale = 2;
+    assert_int_equal(spn_air_create(&d, &air), SPN_ERR_INVALID);
+    assert_null(air);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_segment_drag_formula),
+        cmocka_unit_test(test_web_billows_with_speed),
+        cmocka_unit_test(test_turbulence_statistics),
+        cmocka_unit_test(test_rejects_bad_air),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,391 @@
+/* Static equilibrium (spn_world_equilibrium) against answers known
+ * independently: a spring stretched F/k, the catenary, a dense Newton
+ * reference on a small orb web, a residual computed here from the positions,
+ * slack and compressed threads, the same bits twice and with two threads, and
+ * bad definitions named. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <spinneret/spinneret.h>
+
+/* Largest net static force on a free particle: springs, gravity (if asked)
+ * and a uniform load, from the positions alone (not the solver's code). */
+static double residual_here(const spn_world *w, bool gravity, spn_vec3 load)
+{
+    uint32_t np = spn_world_particle_count(w);
+    spn_vec3 g = gravity ? spn_world_get_def(w)->gravity : spn_v3(0, 0, 0);
+    spn_vec3 *f = calloc(np, sizeof *f);
+    assert_non_null(f);
+    for (uint32_t i = 0; i < np; i++) f[i] = spn_v3_add(spn_v3_scale(g, spn_world_mass(w, i)), load);
+    for (uint32_t s = 0; s < spn_world_spring_count(w); s++) {
+        spn_spring_info si = spn_world_spring(w, s);
+        spn_vec3 l = spn_v3_sub(spn_world_position(w, si.a), spn_world_position(w, si.b));
+        double len = spn_v3_len(l), t = si.k * (len - si.rest);
+        if (si.broken || (si.tension_only && t < 0)) continue;
+        f[si.a] = spn_v3_sub(f[si.a], spn_v3_scale(l, t / len));
+        f[si.b] = spn_v3_add(f[si.b], spn_v3_scale(l, t / len));
+    }
+    double worst = 0;
+    for (uint32_t i = 0; i < np; i++)
+        if (!spn_world_is_fixed(w, i)) worst = fmax(worst, spn_v3_len(f[i]));
+    free(f);
+    return worst;
+}
+
+static spn_world *small_orb(int rings, int radials, double prestrain, int threads)
+{
+    spn_world_def wd = spn_world_def_default();
+    wd.threads = threads;
+    spn_orb_scene_def d = spn_orb_scene_def_default();
+    d.rings = rings;
+    d.radials = radials;
+    d.prestrain = prestrain;
+    spn_world *w = NULL;
+    assert_int_equal(spn_scene_orb(&wd, &d, &w), SPN_OK);
+    return w;
+}
+
+static void test_single_spring_stretches_f_over_k(void **state)
+{
+    (void)state;
+    const double k = 50, rest = 0.1, force = 0.5;
+    spn_world_def wd = spn_world_def_default();
+    spn_world *w = spn_world_create(&wd);
+    spn_particle_def p = spn_particle_def_default();
+    p.fixed = true;
+    assert_int_equal(spn_world_add_particle(w, &p, NULL), SPN_OK);
+    p.fixed = false;
+    p.mass = 0.01;
+    p.position = spn_v3(rest, 0, 0);
+    assert_int_equal(spn_world_add_particle(w, &p, NULL), SPN_OK);
+    spn_spring_def s = spn_spring_def_default();
+    s.a = 0;
+    s.b = 1;
+    s.k = k;
+    s.rest = rest;
+    assert_int_equal(spn_world_add_spring(w, &s, NULL), SPN_OK);
+
+    for (int kind = 0; kind < SPN_PRECOND_COUNT; kind++) {
+        spn_world_set_position(w, 1, spn_v3(rest, 0, 0));
+        spn_equilibrium_def d = spn_equilibrium_def_default();
+        d.gravity = false;
+        d.load = spn_v3(force, 0, 0);
+        d.abs_tolerance = 1e-12;
+        d.tolerance = 0;
+        d.preconditioner = (spn_precond)kind;
+        spn_equilibrium_report r;
+        assert_int_equal(spn_world_equilibrium(w, &d, &r), SPN_OK);
+        assert_int_equal(r.reason, SPN_EQUILIBRIUM_CONVERGED);
+        spn_vec3 x = spn_world_position(w, 1);
+        assert_true(fabs(x.x - (rest + force / k)) < 1e-12);
+        assert_true(fabs(x.y) < 1e-15 && fabs(x.z) < 1e-15);
+        assert_true(r.energy_change < 0);
+    }
+    /* hanging under gravity: stretch m g / k, straight down */
+    spn_world_set_position(w, 1, spn_v3(0, -rest, 0));
+    spn_equilibrium_def d = spn_equilibrium_def_default();
+    d.tolerance = 1e-10; /* of the weight, the force scale of a world without tension */
+    spn_equilibrium_report r;
+    assert_int_equal(spn_world_equilibrium(w, &d, &r), SPN_OK);
+    assert_true(fabs(r.force_scale - 0.01 * 9.81) < 1e-12);
+    assert_int_equal(r.reason, SPN_EQUILIBRIUM_CONVERGED);
+    assert_true(fabs(spn_world_position(w, 1).y - -(rest + 0.01 * 9.81 / k)) < 1e-12);
+    spn_world_destroy(w);
+}
+
+/* The catenary through (+-h, 0) of length L: y = a cosh(x/a) - a cosh(h/a),
+ * a from 2 a sinh(h/a) = L (bisection). */
+static double catenary_a(double h, double len)
+{
+    double lo = 1e-3, hi = 1e3;
+    for (int i = 0; i < 200; i++) {
+        double mid = sqrt(lo * hi);
+        if (2 * mid * sinh(h / mid) > len) lo = mid;
+        else hi = mid;
+    }
+    return sqrt(lo * hi);
+}
+
+static void test_hanging_chain_is_a_catenary(void **state)
+{
+    (void)state;
+    const double span = 1.0, len = 1.3, mass = 0.1, k = 1e5;
+    const int segments = 80;
+    spn_world *w = NULL;
+    assert_int_equal(spn_scene_chain(NULL, spn_v3(-span / 2, 0, 0), spn_v3(span / 2, 0, 0), segments, len, mass, k,
+                                     0, &w),
+                     SPN_OK);
+    /* laid straight, every segment compressed: the solver has to find the sag */
+    spn_equilibrium_def d = spn_equilibrium_def_default();
+    d.tolerance = 1e-9;
+    spn_equilibrium_report r;
+    assert_int_equal(spn_world_equilibrium(w, &d, &r), SPN_OK);
+    assert_int_equal(r.reason, SPN_EQUILIBRIUM_CONVERGED);
+    assert_true(residual_here(w, true, spn_v3(0, 0, 0)) <= 1e-9 * r.force_scale * 1.0001);
+    /* stretched length, for the reference catenary */
+    double stretched = 0;
+    for (uint32_t s = 0; s < spn_world_spring_count(w); s++) stretched += spn_world_spring(w, s).length;
+    double a = catenary_a(span / 2, stretched), worst = 0;
+    for (uint32_t i = 0; i < spn_world_particle_count(w); i++) {
+        spn_vec3 x = spn_world_position(w, i);
+        double y = a * cosh(x.x / a) - a * cosh(span / 2 / a);
+        worst = fmax(worst, fabs(x.y - y));
+        assert_true(fabs(x.z) < 1e-12);
+    }
+    assert_true(worst < 0.01 * span);
+    assert_true(spn_world_position(w, segments / 2).y < -0.2); /* it did sag */
+    spn_world_destroy(w);
+}
+
+/* Dense Newton with the exact Hessian and Cholesky, for a small web: the
+ * reference the iterative solver must agree with. Every spring stays taut. */
+static void dense_newton(spn_world *w, spn_vec3 load)
+{
+    uint32_t np = spn_world_particle_count(w), n3 = 3 * np;
+    double *A = malloc(sizeof(double) * n3 * n3), *b = malloc(sizeof(double) * n3);
+    assert_non_null(A);
+    assert_non_null(b);
+    spn_vec3 g = spn_world_get_def(w)->gravity;
+    for (int it = 0; it < 30; it++) {
+        memset(A, 0, sizeof(double) * n3 * n3);
+        for (uint32_t i = 0; i < np; i++) {
+            spn_vec3 f = spn_v3_add(spn_v3_scale(g, spn_world_mass(w, i)), load);
+            b[3 * i] = f.x, b[3 * i + 1] = f.y, b[3 * i + 2] = f.z;
+        }
+        for (uint32_t s = 0; s < spn_world_spring_count(w); s++) {
+            spn_spring_info si = spn_world_spring(w, s);
+            spn_vec3 l = spn_v3_sub(spn_world_position(w, si.a), spn_world_position(w, si.b));
+            double len = spn_v3_len(l), t = si.k * (len - si.rest), u[3] = {l.x / len, l.y / len, l.z / len};
+            assert_true(t > 0);
+            uint32_t ends[2] = {si.a, si.b};
+            for (int c = 0; c < 3; c++) b[3 * si.a + c] -= t * u[c], b[3 * si.b + c] += t * u[c];
+            for (int r = 0; r < 3; r++)
+                for (int c = 0; c < 3; c++) {
+                    double h = (si.k - t / len) * u[r] * u[c] + (r == c ? t / len : 0);
+                    for (int p = 0; p < 2; p++)
+                        for (int q = 0; q < 2; q++) A[(3 * ends[p] + r) * n3 + 3 * ends[q] + c] += p == q ? h : -h;
+                }
+        }
+        for (uint32_t i = 0; i < np; i++) /* fixed particles: identity rows, no move */
+            if (spn_world_is_fixed(w, i))
+                for (int r = 0; r < 3; r++) {
+                    for (uint32_t c = 0; c < n3; c++) A[(3 * i + r) * n3 + c] = A[c * n3 + 3 * i + r] = 0;
+                    A[(3 * i + r) * n3 + 3 * i + r] = 1;
+                    b[3 * i + r] = 0;
+                }
+        for (uint32_t k = 0; k < n3; k++) { /* Cholesky in place, then solve A p = b */
+            double d = A[k * n3 + k];
+            for (uint32_t p = 0; p < k; p++) d -= A[k * n3 + p] * A[k * n3 + p];
+            assert_true(d > 0);
+            A[k * n3 + k] = sqrt(d);
+            for (uint32_t i = k + 1; i < n3; i++) {
+                double s = A[i * n3 + k];
+                for (uint32_t p = 0; p < k; p++) s -= A[i * n3 + p] * A[k * n3 + p];
+                A[i * n3 + k] = s / A[k * n3 + k];
+            }
+        }
+        for (uint32_t i = 0; i < n3; i++) {
+            for (uint32_t p = 0; p < i; p++) b[i] -= A[i * n3 + p] * b[p];
+            b[i] /= A[i * n3 + i];
+        }
+        for (uint32_t i = n3; i-- > 0;) {
+            for (uint32_t p = i + 1; p < n3; p++) b[i] -= A[p * n3 + i] * b[p];
+            b[i] /= A[i * n3 + i];
+        }
+        for (uint32_t i = 0; i < np; i++)
+            spn_world_set_position(w, i, spn_v3_add(spn_world_position(w, i), spn_v3(b[3 * i], b[3 * i + 1], b[3 * i + 2])));
+    }
+    free(A);
+    free(b);
+}
+
+static void test_orb_web_matches_dense_newton(void **state)
+{
+    (void)state;
+    spn_orb_scene_def od = spn_orb_scene_def_default();
+    double t0 = od.ea * od.prestrain;
+    spn_world *ref = small_orb(6, 10, od.prestrain, 1);
+    uint32_t nfree = 0;
+    for (uint32_t i = 0; i < spn_world_particle_count(ref); i++) nfree += !spn_world_is_fixed(ref, i);
+    spn_vec3 load = spn_v3(0, 0, 2 * t0 / nfree); /* out of plane, twice the pretension in all */
+    dense_newton(ref, load);
+    assert_true(residual_here(ref, true, load) < 1e-12 * t0);
+    double sag = spn_world_position(ref, 0).z;
+    assert_true(sag > 1e-3); /* a real deflection, not a rounding */
+    for (int kind = 0; kind < SPN_PRECOND_COUNT; kind++) {
+        spn_world *w = small_orb(6, 10, od.prestrain, 1);
+        spn_equilibrium_def d = spn_equilibrium_def_default();
+        d.load = load;
+        d.tolerance = 1e-10;
+        d.force_scale = t0;
+        d.preconditioner = (spn_precond)kind;
+        spn_equilibrium_report r;
+        assert_int_equal(spn_world_equilibrium(w, &d, &r), SPN_OK);
+        assert_int_equal(r.reason, SPN_EQUILIBRIUM_CONVERGED);
+        for (uint32_t i = 0; i < spn_world_particle_count(w); i++) {
+            spn_vec3 dx = spn_v3_sub(spn_world_position(w, i), spn_world_position(ref, i));
+            assert_true(spn_v3_len(dx) < 1e-6 * sag);
+        }
+        spn_world_destroy(w);
+    }
+    spn_world_destroy(ref);
+}
+
+static void test_residual_meets_the_request(void **state)
+{
+    (void)state;
+    spn_orb_scene_def od = spn_orb_scene_def_default();
+    double t0 = od.ea * od.prestrain, tols[2] = {1e-6, 1e-9};
+    for (int kind = 0; kind < SPN_PRECOND_COUNT; kind++)
+        for (int k = 0; k < 2; k++) {
+            spn_world *w = small_orb(20, 24, od.prestrain, 1);
+            spn_equilibrium_def d = spn_equilibrium_def_default();
+            d.load = spn_v3(0, 0, 1e-6);
+            d.tolerance = tols[k];
+            d.preconditioner = (spn_precond)kind;
+            spn_equilibrium_report r;
+            assert_int_equal(spn_world_equilibrium(w, &d, &r), SPN_OK);
+            assert_int_equal(r.reason, SPN_EQUILIBRIUM_CONVERGED);
+            assert_true(fabs(r.force_scale - t0) < 1e-9 * t0); /* the pretension, found by itself */
+            double res = residual_here(w, true, d.load);
+            assert_true(res <= tols[k] * t0 * 1.001);
+            assert_true(fabs(res - r.residual) <= 1e-3 * tols[k] * t0);
+            spn_world_destroy(w);
+        }
+}
+
+static void test_slack_and_compressed_stay_stable(void **state)
+{
+    (void)state;
+    /* a web built slack (every thread 2% too long, tension-only): nothing holds
+     * the particles until the threads draw taut under the load */
+    spn_world *w = small_orb(10, 12, -0.02, 1);
+    spn_equilibrium_def d = spn_equilibrium_def_default();
+    d.load = spn_v3(0, 0, 1e-5);
+    d.force_scale = 1e-3;
+    spn_equilibrium_report r;
+    assert_int_equal(spn_world_equilibrium(w, &d, &r), SPN_OK);
+    assert_int_equal(r.reason, SPN_EQUILIBRIUM_CONVERGED);
+    assert_true(residual_here(w, true, d.load) <= 1e-6 * 1e-3 * 1.001);
+    assert_true(spn_world_position(w, 0).z > 0.005); /* bellied out along the load */
+    spn_world_destroy(w);
+
+    /* compressed springs that push (not tension-only), nothing pulling across:
+     * a two-spring strut pressed between anchors stays straight and finite */
+    spn_world *s = spn_world_create(NULL);
+    spn_particle_def p = spn_particle_def_default();
+    p.fixed = true;
+    spn_world_add_particle(s, &p, NULL);
+    p.position = spn_v3(1, 0, 0);
+    spn_world_add_particle(s, &p, NULL);
+    p.fixed = false;
+    p.mass = 0.001;
+    p.position = spn_v3(0.3, 0, 0);
+    spn_world_add_particle(s, &p, NULL);
+    spn_spring_def sd = spn_spring_def_default();
+    sd.k = 100;
+    sd.rest = 0.6;
+    sd.a = 0, sd.b = 2;
+    spn_world_add_spring(s, &sd, NULL);
+    sd.a = 2, sd.b = 1;
+    spn_world_add_spring(s, &sd, NULL);
+    d = spn_equilibrium_def_default();
+    d.gravity = false;
+    d.abs_tolerance = 1e-12;
+    assert_int_equal(spn_world_equilibrium(s, &d, &r), SPN_OK);
+    assert_int_equal(r.reason, SPN_EQUILIBRIUM_CONVERGED);
+    assert_true(fabs(spn_world_position(s, 2).x - 0.5) < 1e-12);
+    spn_world_destroy(s);
+}
+
+/* Solve the standard web (rings x radials) with `threads` and precond; a copy of the positions. */
+static spn_vec3 *solve_copy(int rings, int radials, int threads, spn_precond pc, int max_iterations)
+{
+    spn_world *w = small_orb(rings, radials, 0.02, threads);
+    spn_equilibrium_def d = spn_equilibrium_def_default();
+    d.load = spn_v3(0, 0, 3e-7);
+    d.max_iterations = max_iterations;
+    d.preconditioner = pc;
+    spn_equilibrium_report r;
+    assert_int_equal(spn_world_equilibrium(w, &d, &r), SPN_OK);
+    assert_int_equal(r.iterations, r.reason == SPN_EQUILIBRIUM_CONVERGED ? r.iterations : max_iterations);
+    uint32_t np = spn_world_particle_count(w);
+    spn_vec3 *x = malloc(np * sizeof *x);
+    assert_non_null(x);
+    memcpy(x, spn_world_positions(w), np * sizeof *x);
+    spn_world_destroy(w);
+    return x;
+}
+
+static void test_same_bits_twice_and_with_two_threads(void **state)
+{
+    (void)state;
+    /* 5k particles: the spring-wise product; 33k: past the size where the
+     * loops split across threads (32,768 free particles) */
+    const int sizes[2][2] = {{40, 125}, {150, 220}};
+    for (int k = 0; k < 2; k++) {
+        int rings = sizes[k][0], radials = sizes[k][1];
+        uint32_t np = spn_orb_scene_particles(rings, radials);
+        spn_precond pcs[2] = {SPN_PRECOND_BLOCK_JACOBI, SPN_PRECOND_MULTIGRID};
+        for (int p = 0; p < 2; p++) {
+            int steps = k ? 2 : 200; /* the large one: two Newton steps are enough to compare */
+            spn_vec3 *a = solve_copy(rings, radials, 1, pcs[p], steps);
+            spn_vec3 *b = solve_copy(rings, radials, k ? 2 : 1, pcs[p], steps);
+            spn_vec3 *c = solve_copy(rings, radials, 2, pcs[p], steps);
+            assert_memory_equal(a, b, np * sizeof *a);
+            assert_memory_equal(a, c, np * sizeof *a);
+            free(a), free(b), free(c);
+        }
+    }
+}
+
+static void test_bad_definitions_are_named(void **state)
+{
+    (void)state;
+    spn_world *w = small_orb(3, 6, 0.02, 1);
+    spn_equilibrium_def d = spn_equilibrium_def_default();
+    d.tolerance = -1;
+    assert_int_equal(spn_world_equilibrium(w, &d, NULL), SPN_ERR_INVALID);
+    assert_non_null(strstr(spn_last_error(), "tolerance"));
+    d = spn_equilibrium_def_default();
+    d.load = spn_v3(0, NAN, 0);
+    assert_int_equal(spn_world_equilibrium(w, &d, NULL), SPN_ERR_INVALID);
+    assert_non_null(strstr(spn_last_error(), "load"));
+    d = spn_equilibrium_def_default();
+    d.preconditioner = SPN_PRECOND_COUNT;
+    assert_int_equal(spn_world_equilibrium(w, &d, NULL), SPN_ERR_INVALID);
+    assert_non_null(strstr(spn_last_error(), "preconditioner"));
+    d = spn_equilibrium_def_default();
+    d.max_cg_iterations = 0;
+    assert_int_equal(spn_world_equilibrium(w, &d, NULL), SPN_ERR_INVALID);
+    assert_non_null(strstr(spn_last_error(), "max_cg_iterations"));
+    spn_world_set_position(w, 3, spn_v3(INFINITY, 0, 0));
+    assert_int_equal(spn_world_equilibrium(w, NULL, NULL), SPN_ERR_UNSTABLE);
+    assert_non_null(strstr(spn_last_error(), "particle 3"));
+    spn_precond pc;
+    assert_int_equal(spn_precond_parse("multigrid", &pc), SPN_OK);
+    assert_int_equal(pc, SPN_PRECOND_MULTIGRID);
+    assert_int_equal(spn_precond_parse("cholesky", &pc), SPN_ERR_INVALID);
+    assert_non_null(strstr(spn_last_error(), "cholesky"));
+    spn_world_destroy(w);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_single_spring_stretches_f_over_k),
+        cmocka_unit_test(test_hanging_chain_is_a_catenary),
+        cmocka_unit_test(test_orb_web_matches_dense_newton),
+        cmocka_unit_test(test_residual_meets_the_request),
+        cmocka_unit_test(test_slack_and_compressed_stay_stable),
+        cmocka_unit_test(test_same_bits_twice_and_with_two_threads),
+        cmocka_unit_test(test_bad_definitions_are_named),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,161 @@
+/* An inscribed web is still a web: settled again (largest residual under the
+ * tolerance), every particle connected to an anchor, no dangling thread; and
+ * capture threads subdivided into several springs are taken out whole, their
+ * inner particles with them. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <spinneret/spinneret.h>
+
+static spn_world *orb(void)
+{
+    spn_world_def wd = spn_world_def_default();
+    wd.integrator = SPN_INTEGRATOR_SYMPLECTIC;
+    wd.drag = 200;
+    spn_world *w = NULL;
+    assert_int_equal(spn_scene_orb(&wd, NULL, &w), SPN_OK);
+    return w;
+}
+
+/* Every particle reaches a fixed one; every free particle has >= 2 threads. */
+static void check_hangs_whole(const spn_world *w)
+{
+    uint32_t np = spn_world_particle_count(w), ns = spn_world_spring_count(w);
+    uint32_t *label = malloc(np * sizeof *label), *deg = calloc(np, sizeof *deg);
+    for (uint32_t i = 0; i < np; i++) label[i] = spn_world_is_fixed(w, i);
+    for (uint32_t s = 0; s < ns; s++) {
+        spn_spring_info si = spn_world_spring(w, s);
+        deg[si.a]++, deg[si.b]++;
+    }
+    for (bool changed = true; changed;) { /* relax reachability to a fixed point */
+        changed = false;
+        for (uint32_t s = 0; s < ns; s++) {
+            spn_spring_info si = spn_world_spring(w, s);
+            if (label[si.a] != label[si.b]) label[si.a] = label[si.b] = 1, changed = true;
+        }
+    }
+    for (uint32_t i = 0; i < np; i++) {
+        assert_int_equal(label[i], 1);
+        if (!spn_world_is_fixed(w, i)) assert_true(deg[i] >= 2);
+    }
+    free(label), free(deg);
+}
+
+static void test_inscribed_web_is_settled_and_whole(void **state)
+{
+    (void)state;
+    /* Fill adds the most (new masses, split threads); outline doubles threads. */
+    const spn_emphasis modes[] = {SPN_EMPHASIS_FILL, SPN_EMPHASIS_OUTLINE};
+    for (int m = 0; m < 2; m++) {
+        spn_world *w = orb();
+        spn_target *t = NULL;
+        assert_int_equal(spn_target_create(w, 600, &t), SPN_OK);
+        spn_text_def td = spn_text_def_default();
+        td.text = "PIG";
+        td.fit = 0.5; /* a quarter of the area: fewer fill threads, a quicker test */
+        assert_int_equal(spn_target_text(t, w, &td), SPN_OK);
+        spn_inscribe_def d = spn_inscribe_def_default();
+        d.emphasis = modes[m];
+        d.gaps = 5;
+        d.settle_def.dt = 1e-3;
+        d.settle_def.max_time = 5;
+        spn_world_set_integrator(w, SPN_INTEGRATOR_IMPLICIT); /* silk is stiff */
+        spn_inscribe_report rep;
+        assert_int_equal(spn_inscribe(&w, t, &d, &rep), SPN_OK);
+        assert_int_equal(rep.after.reason, SPN_SETTLE_CONVERGED);
+        assert_true(spn_world_max_residual(w, NULL) <= d.settle_def.max_residual);
+        assert_int_equal(rep.gaps, 5);
+        check_hangs_whole(w);
+        spn_target_destroy(t);
+        spn_world_destroy(w);
+    }
+}
+
+/* Replace every capture spring by two, through a new particle at its middle. */
+static uint32_t subdivide_capture(spn_world **wp)
+{
+    spn_world *w = *wp;
+    uint32_t ns = spn_world_spring_count(w), added = 0;
+    bool *remove = calloc(ns * 3 + 1, sizeof *remove);
+    for (uint32_t s = 0; s < ns; s++) {
+        spn_spring_info si = spn_world_spring(w, s);
+        if (si.tag != SPN_THREAD_CAPTURE) continue;
+        spn_particle_def p = spn_particle_def_default();
+        p.position = spn_v3_scale(spn_v3_add(spn_world_position(w, si.a), spn_world_position(w, si.b)), 0.5);
+        p.mass = 1e-9;
+        uint32_t mid;
+        assert_int_equal(spn_world_add_particle(w, &p, &mid), SPN_OK);
+        spn_spring_def d = {si.a, mid, 2 * si.k, 2 * si.kd, si.rest / 2, 0, INFINITY, true, si.tag, 0, 0};
+        assert_int_equal(spn_world_add_spring(w, &d, NULL), SPN_OK);
+        d.a = mid, d.b = si.b;
+        assert_int_equal(spn_world_add_spring(w, &d, NULL), SPN_OK);
+        remove[s] = true;
+        added++;
+    }
+    assert_int_equal(spn_world_remove_springs(w, remove), SPN_OK);
+    free(remove);
+    return added;
+}
+
+static double left_third(void *user, double x, double y) { return (void)user, (void)y, x < -0.05 ? 1 : 0; }
+
+static void test_subdivided_segments_go_whole(void **state)
+{
+    (void)state;
+    spn_world *w = orb();
+    uint32_t mids = subdivide_capture(&w), np = spn_world_particle_count(w);
+    spn_target *t = NULL;
+    assert_int_equal(spn_target_create(w, 1200, &t), SPN_OK);
+    spn_target_paint(t, left_third, NULL);
+    spn_inscribe_def d = spn_inscribe_def_default();
+    d.settle = false;
+    spn_inscribe_report rep;
+    assert_int_equal(spn_inscribe(&w, t, &d, &rep), SPN_OK);
+    assert_int_equal(rep.segments, mids); /* one segment per pair of springs */
+    assert_true(rep.removed > 20);
+    assert_int_equal(rep.particles_removed, rep.removed); /* each middle particle went with its segment */
+    assert_int_equal(spn_world_particle_count(w), np - rep.removed);
+    check_hangs_whole(w);
+    spn_target_destroy(t);
+    spn_world_destroy(w);
+}
+
+static void test_failure_leaves_the_web_alone(void **state)
+{
+    (void)state;
+    spn_world *w = orb(), *before = w;
+    spn_target *t = NULL;
+    assert_int_equal(spn_target_create(w, 200, &t), SPN_OK);
+    spn_inscribe_def d = spn_inscribe_def_default();
+    d.threshold = 11;
+    assert_int_equal(spn_inscribe(&w, t, &d, NULL), SPN_ERR_INVALID);
+    assert_non_null(strstr(spn_last_error(), "threshold"));
+    assert_ptr_equal(w, before);
+    /* A world with no capture spiral has nothing to inscribe. */
+    spn_world *chain = NULL;
+    assert_int_equal(spn_scene_chain(NULL, spn_v3(0, 0, 0), spn_v3(1, 0, 0), 4, 1, 0.1, 10, 0, &chain), SPN_OK);
+    d = spn_inscribe_def_default();
+    assert_int_equal(spn_inscribe(&chain, t, &d, NULL), SPN_ERR_INVALID);
+    assert_non_null(strstr(spn_last_error(), "capture"));
+    spn_world_destroy(chain);
+    spn_target_destroy(t);
+    spn_world_destroy(w);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_inscribed_web_is_settled_and_whole),
+        cmocka_unit_test(test_subdivided_segments_go_whole),
+        cmocka_unit_test(test_failure_leaves_the_web_alone),
+    };
+    int failed = cmocka_run_group_tests(tests, NULL, NULL);
+    spn_render_release_caches(); /* cairo's and fontconfig's font caches */
+    return failed;
+}
