@@ -58,7 +58,7 @@ static void assemble(const spn_world *w, double mdiag, bsr *a)
                 d[c] += b[c];
                 a->blocks[6 * (size_t)k + c] = -b[c];
             }
-            a->col[k] = (e & 1u) ? w->hs[s].a : w->hs[s].b;
+            a->col[k] = (e & 1u) ? w->hs[s].a : spn__end_b(w->hs[s]);
         }
     }
 }
@@ -78,7 +78,7 @@ static void free_apply(spn_world *w, double mdiag, const spn_vec3 *p, spn_vec3 *
 {
     for (uint32_t s = 0; s < w->ns; s++) {
         const spn__jac *j = &w->jac[s];
-        const spn_vec3 d = spn_v3_sub(p[w->hs[s].a], p[w->hs[s].b]);
+        const spn_vec3 d = spn_v3_sub(p[w->hs[s].a], p[spn__end_b(w->hs[s])]);
         w->fs[s] = spn_v3_add(spn_v3_scale(d, j->iso), spn_v3_scale(j->u, j->axial * spn_v3_dot(j->u, d)));
     }
     for (uint32_t i = 0; i < w->np; i++) {

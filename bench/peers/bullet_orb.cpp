@@ -26,11 +26,21 @@ extern "C" {
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <vector>
 
 static double seconds_now()
 {
     return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// CPU time of the process: on a shared machine the wall clock also measures
+// the neighbours (both runs here are single-threaded).
+static double cpu_now()
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 static spn_world *make_web(int rings, int radials)
@@ -73,6 +83,7 @@ static std::vector<double> strains(const spn_world *w)
 
 struct bullet_run {
     double ns_per_spring_step;
+    double cpu_ns_per_spring_step;
     double strain_error;
 };
 
@@ -118,45 +129,52 @@ static bullet_run run_bullet(const spn_world *w, double dt, int steps, const std
         l.m_c1 = l.m_rl * l.m_rl;
         l.m_c0 = (l.m_n[0]->m_im + l.m_n[1]->m_im) / l.m_material->m_kLST;
     }
-    double t0 = seconds_now();
+    double t0 = seconds_now(), c0 = cpu_now();
     for (int k = 0; k < steps; k++) {
         sb->predictMotion(dt);
         sb->solveConstraints();
         sb->integrateMotion();
     }
-    double t1 = seconds_now();
+    double t1 = seconds_now(), c1 = cpu_now();
     // Strain error of Bullet's end state, measured with our springs' rest lengths.
     spn_world *copy = spn_world_clone(w);
     for (uint32_t i = 0; i < np; i++) {
         const btVector3 &p = sb->m_nodes[(int)i].m_x;
         spn_world_set_position(copy, i, spn_v3(p.x(), p.y(), p.z()));
     }
-    bullet_run r = {(t1 - t0) * 1e9 / ((double)ns * steps), strain_error(copy, ref)};
+    bullet_run r = {(t1 - t0) * 1e9 / ((double)ns * steps), (c1 - c0) * 1e9 / ((double)ns * steps),
+                    strain_error(copy, ref)};
     spn_world_destroy(copy);
     delete sb;
     return r;
 }
 
-static double run_spinneret(spn_world *w, double dt, int steps)
+// Wall and CPU ns per spring-step of our symplectic Euler (one advance call).
+static void run_spinneret(spn_world *w, double dt, int steps, double *wall, double *cpu)
 {
     spn_world_set_integrator(w, SPN_INTEGRATOR_SYMPLECTIC);
     spn_world_compile(w);
-    double t0 = seconds_now();
-    for (int k = 0; k < steps; k++)
-        if (spn_world_step(w, dt) != SPN_OK) {
-            std::fprintf(stderr, "bullet_orb: %s\n", spn_last_error());
-            std::exit(1);
-        }
-    return (seconds_now() - t0) * 1e9 / ((double)spn_world_spring_count(w) * steps);
+    double t0 = seconds_now(), c0 = cpu_now();
+    if (spn_world_advance(w, dt, steps) != SPN_OK) {
+        std::fprintf(stderr, "bullet_orb: %s\n", spn_last_error());
+        std::exit(1);
+    }
+    double per = 1e9 / ((double)spn_world_spring_count(w) * steps);
+    *wall = (seconds_now() - t0) * per;
+    *cpu = (cpu_now() - c0) * per;
 }
 
 int main(int argc, char **argv)
 {
-    struct size { int rings, radials, steps; } sizes[] = {{40, 125, 2000}, {250, 400, 100}, {1000, 1000, 10}};
+    // dt inside the explicit stability limit of each web's stiffest (innermost,
+    // shortest) segments: at 1e-6 s the 100k web grows without bound (slowly
+    // enough that no single step trips the blow-up check) and the 1M web blows up.
+    struct size { int rings, radials, steps; double dt; } sizes[] = {
+        {40, 125, 2000, 1e-6}, {250, 400, 100, 1e-7}, {1000, 1000, 10, 1e-7}};
     int nsizes = argc > 1 && std::strcmp(argv[1], "--small") == 0 ? 1 : 3;
-    const double dt = 1e-6; // explicit stability at the stiff inner rings of the standard web
     for (int k = 0; k < nsizes; k++) {
         const size &sz = sizes[k];
+        const double dt = sz.dt;
         spn_world *reference = make_web(sz.rings, sz.radials);
         for (int i = 0; i < sz.steps * 10; i++) spn_world_step(reference, dt / 10);
         std::vector<double> ref = strains(reference);
@@ -164,12 +182,15 @@ int main(int argc, char **argv)
 
         spn_world *w = make_web(sz.rings, sz.radials);
         bullet_run b = run_bullet(w, dt, sz.steps, ref);
-        double ours = run_spinneret(w, dt, sz.steps);
+        double ours, ours_cpu;
+        run_spinneret(w, dt, sz.steps, &ours, &ours_cpu);
         std::printf("{\"bench\":\"peer_bullet_softbody\",\"particles\":%u,\"springs\":%u,\"dt\":%g,\"steps\":%d,"
                     "\"threads\":1,\"bullet_ns_per_spring_step\":%.3f,\"spinneret_ns_per_spring_step\":%.3f,"
-                    "\"ratio\":%.2f,\"bullet_strain_error\":%.3g,\"spinneret_strain_error\":%.3g}\n",
+                    "\"ratio\":%.2f,\"bullet_cpu_ns_per_spring_step\":%.3f,\"spinneret_cpu_ns_per_spring_step\":%.3f,"
+                    "\"cpu_ratio\":%.2f,\"bullet_strain_error\":%.3g,\"spinneret_strain_error\":%.3g}\n",
                     spn_world_particle_count(w), spn_world_spring_count(w), dt, sz.steps, b.ns_per_spring_step, ours,
-                    b.ns_per_spring_step / ours, b.strain_error, strain_error(w, ref));
+                    b.ns_per_spring_step / ours, b.cpu_ns_per_spring_step, ours_cpu,
+                    b.cpu_ns_per_spring_step / ours_cpu, b.strain_error, strain_error(w, ref));
         std::fflush(stdout);
         spn_world_destroy(w);
     }

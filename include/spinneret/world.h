@@ -203,7 +203,18 @@ typedef struct spn_step_report {
 /// Advance by dt seconds. On SPN_ERR_UNSTABLE the world keeps its state from
 /// before the step and the message names the step and the particle.
 SPN_API spn_status spn_world_step(spn_world *w, double dt);
+/// Take n steps of dt (n >= 1) in one call, the per-call work paid once: the
+/// same states, bit for bit, as n calls of spn_world_step. Explicit and RK4
+/// runs without callbacks, colliders, Provot limits or breakable springs keep
+/// one copy of the state per call instead of one per step. Stops at the first
+/// failing step: on SPN_ERR_UNSTABLE the steps before it stand and the world
+/// has its state from before it, the message naming it as spn_world_step
+/// does. spn_world_last_step() then sums the report over the steps taken.
+SPN_API spn_status spn_world_advance(spn_world *w, double dt, int n);
 SPN_API spn_step_report spn_world_last_step(const spn_world *w);
+/// The implicit solver's CG stop, changeable between steps (an interactive
+/// viewer wants a looser one): relative residual in (0, 1), iteration cap >= 1.
+SPN_API spn_status spn_world_set_solver_tolerance(spn_world *w, double cg_tolerance, int cg_max_iterations);
 
 /* ---- energy and equilibrium ------------------------------------------ */
 

@@ -12,8 +12,12 @@
 
 void spn__free_compiled(spn_world *w)
 {
+    spn__sweep_free(w);
     free(w->adj_start);
     free(w->adj);
+    free(w->a_start);
+    free(w->b_start);
+    free(w->b_adj);
     free(w->hs);
     free(w->hflags);
     free(w->perm);
@@ -34,7 +38,7 @@ void spn__free_compiled(spn_world *w)
     free(w->jac);
     free(w->pinv);
     free(w->partial);
-    w->adj_start = w->adj = w->perm = w->iperm = NULL;
+    w->adj_start = w->adj = w->perm = w->iperm = w->a_start = w->b_start = w->b_adj = NULL;
     w->hs = NULL;
     w->hflags = NULL;
     w->fs = w->f = w->fext = w->x0 = w->v0 = w->fair = w->wind = NULL;
@@ -42,6 +46,15 @@ void spn__free_compiled(spn_world *w)
     w->jac = NULL;
     w->npartial = 0;
     w->compiled = false;
+}
+
+spn__spring spn__hot_spring(const spn_world *w, uint32_t s)
+{
+    const bool broken = (w->sflags[s] & SPN_SPRING_BROKEN) != 0;
+    const uint32_t tonly = (w->sflags[s] & SPN_SPRING_TENSION_ONLY) ? 1u << 31 : 0;
+    /* Internal end a is the lower id (a spring's law is symmetric in its ends). */
+    const uint32_t a = w->sa[s] < w->sb[s] ? w->sa[s] : w->sb[s], b = w->sa[s] < w->sb[s] ? w->sb[s] : w->sa[s];
+    return (spn__spring){a, b | tonly, broken ? 0 : w->k[s], broken ? 0 : w->kd[s], w->rest[s]};
 }
 
 static double tag_diameter(const spn_world *w, uint32_t tag)
@@ -59,6 +72,9 @@ static bool alloc_compiled(spn_world *w)
     w->npartial = nb ? nb : 1;
     w->adj_start = calloc(np + 1, sizeof *w->adj_start);
     w->adj = malloc(2 * ns * sizeof *w->adj);
+    w->a_start = calloc(np + 1, sizeof *w->a_start);
+    w->b_start = calloc(np + 1, sizeof *w->b_start);
+    w->b_adj = malloc(ns * sizeof *w->b_adj);
     w->hs = malloc(ns * sizeof *w->hs);
     w->hflags = malloc(ns * sizeof *w->hflags);
     w->perm = malloc(ns * sizeof *w->perm);
@@ -70,7 +86,7 @@ static bool alloc_compiled(spn_world *w)
     w->x0 = malloc(np * sizeof *w->x0);
     w->v0 = malloc(np * sizeof *w->v0);
     w->partial = calloc((size_t)w->npartial * SPN_NSUMS, sizeof *w->partial);
-    return w->adj_start && w->adj && w->hs && w->hflags && w->perm && w->iperm && w->fs && w->sdiam && w->f && w->fext && w->x0 && w->v0 && w->partial;
+    return w->adj_start && w->adj && w->a_start && w->b_start && w->b_adj && w->hs && w->hflags && w->perm && w->iperm && w->fs && w->sdiam && w->f && w->fext && w->x0 && w->v0 && w->partial;
 }
 
 /* Air buffers, only for worlds with threads that have a diameter. */
@@ -98,21 +114,35 @@ static void order_springs(spn_world *w, uint32_t *count)
     for (uint32_t k = 0; k < w->ns; k++) {
         uint32_t s = w->perm[k];
         w->iperm[s] = k;
-        w->hs[k] = (spn__spring){w->sa[s], w->sb[s], w->k[s], w->kd[s], w->rest[s]};
         w->hflags[k] = w->sflags[s];
+        w->hs[k] = spn__hot_spring(w, s);
     }
 }
 
-/* CSR adjacency by counting sort: each particle's springs in internal order. */
+/* CSR adjacency by counting sort: each particle's springs in internal order;
+ * also the runs of springs by end a and the list by end b the gather reads. */
 static void build_adjacency(spn_world *w, uint32_t *fill)
 {
     for (uint32_t k = 0; k < w->ns; k++) {
+        w->a_start[w->hs[k].a + 1]++;
+        w->b_start[spn__end_b(w->hs[k]) + 1]++;
+    }
+    for (uint32_t i = 0; i < w->np; i++) {
+        w->a_start[i + 1] += w->a_start[i];
+        w->b_start[i + 1] += w->b_start[i];
+    }
+    for (uint32_t k = 0; k < w->ns; k++) {
+        const uint32_t b = spn__end_b(w->hs[k]);
+        w->b_adj[w->b_start[b] + fill[b]++] = k;
+    }
+    memset(fill, 0, ((size_t)w->np + 1) * sizeof *fill);
+    for (uint32_t k = 0; k < w->ns; k++) {
         w->adj_start[w->hs[k].a + 1]++;
-        w->adj_start[w->hs[k].b + 1]++;
+        w->adj_start[spn__end_b(w->hs[k]) + 1]++;
     }
     for (uint32_t i = 0; i < w->np; i++) w->adj_start[i + 1] += w->adj_start[i];
     for (uint32_t k = 0; k < w->ns; k++) {
-        uint32_t a = w->hs[k].a, b = w->hs[k].b;
+        uint32_t a = w->hs[k].a, b = spn__end_b(w->hs[k]);
         w->adj[w->adj_start[a] + fill[a]++] = k << 1;
         w->adj[w->adj_start[b] + fill[b]++] = (k << 1) | 1u;
     }
@@ -122,6 +152,8 @@ spn_status spn_world_compile(spn_world *w)
 {
     if (w->compiled) return SPN_OK;
     spn__free_compiled(w);
+    if (w->np > SPN__END_MASK)
+        return spn_error(SPN_ERR_INVALID, "a world steps at most %u particles, not %u", SPN__END_MASK, w->np);
     uint32_t *count = calloc((size_t)w->np + 1, sizeof *count);
     if (!count || !alloc_compiled(w)) {
         free(count);

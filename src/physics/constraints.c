@@ -31,7 +31,7 @@ static double particle_energy(const spn_world *w, uint32_t i)
         uint32_t s = w->adj[j] >> 1; /* internal order */
         if (w->hflags[s] & SPN_SPRING_BROKEN) continue;
         const spn__spring *sp = &w->hs[s];
-        double d = spn_v3_len(spn_v3_sub(w->x[sp->a], w->x[sp->b])) - sp->rest;
+        double d = spn_v3_len(spn_v3_sub(w->x[sp->a], w->x[spn__end_b(*sp)])) - sp->rest;
         if (d < 0 && (w->hflags[s] & SPN_SPRING_TENSION_ONLY)) continue;
         e += 0.5 * sp->k * d * d;
     }
@@ -138,6 +138,7 @@ int spn__check_breakage(spn_world *w)
         if (len >= w->bmin[s] && len <= w->bmax[s]) continue;
         w->sflags[s] |= SPN_SPRING_BROKEN;
         w->hflags[w->iperm[s]] |= SPN_SPRING_BROKEN;
+        w->hs[w->iperm[s]] = spn__hot_spring(w, s);
         breaks++;
         if (w->break_fn) w->break_fn(w->break_user, s, w->t, len);
     }

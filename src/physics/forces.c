@@ -15,6 +15,7 @@
  * half of F on each end. The air callback is called serially in a fixed
  * order, so it may keep state (a seeded gust generator, say). */
 #include "world_internal.h"
+#include "chunk.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -52,31 +53,6 @@ void spn__sum_partials(const spn_world *w, uint32_t blocks, double *out)
 
 bool spn__air_active(const spn_world *w) { return w->air_fn && w->any_diam && w->fair; }
 
-/* Spring s's force on end a at (x, v); its elastic energy and damping power. */
-static inline spn_vec3 spring_force(const spn__spring *restrict hs, const uint8_t *restrict hflags, uint32_t s,
-                                    const spn_vec3 *restrict x, const spn_vec3 *restrict v, double *energy,
-                                    double *power, double *gross)
-{
-    const spn_vec3 zero = {0, 0, 0};
-    const uint8_t flags = hflags[s];
-    if (flags & SPN_SPRING_BROKEN) return zero;
-    const spn__spring sp = hs[s];
-    const uint32_t a = sp.a, b = sp.b;
-    const spn_vec3 l = spn_v3_sub(x[a], x[b]);
-    const double len = sqrt(spn_v3_dot(l, l));
-    if (!(len > 0)) return zero;
-    const double stretch = len - sp.rest;
-    if (stretch < 0 && (flags & SPN_SPRING_TENSION_ONLY)) return zero;
-    const double inv = 1 / len;
-    const double rate = spn_v3_dot(spn_v3_sub(v[a], v[b]), l) * inv; /* d|l|/dt */
-    const double k = sp.k, kd = sp.kd;
-    *energy += 0.5 * k * stretch * stretch;
-    *power += kd * rate * rate;
-    const double mag = k * stretch + kd * rate;
-    *gross += fabs(mag);
-    return spn_v3_scale(l, -mag * inv);
-}
-
 double spn_cylinder_drag_coefficient(double re)
 {
     /* Re <= 0.5: Lamb's (1911) Oseen solution, C_d = 8 pi / (Re (2.002 - ln Re)).
@@ -104,7 +80,7 @@ static spn_vec3 air_force(const spn_world *w, uint32_t s, const spn_vec3 *x, con
     *c = 0;
     const double d = w->sdiam[s];
     if (!(d > 0) || (w->hflags[s] & SPN_SPRING_BROKEN)) return zero;
-    const uint32_t a = w->hs[s].a, b = w->hs[s].b;
+    const uint32_t a = w->hs[s].a, b = spn__end_b(w->hs[s]);
     const spn_vec3 l = spn_v3_sub(x[a], x[b]);
     const double len = spn_v3_len(l);
     if (!(len > 0)) return zero;
@@ -125,8 +101,23 @@ static void sample_air(spn_world *w, double t, const spn_vec3 *x)
 {
     for (uint32_t s = 0; s < w->ns; s++) {
         if (!(w->sdiam[s] > 0)) continue;
-        spn_vec3 mid = spn_v3_scale(spn_v3_add(x[w->hs[s].a], x[w->hs[s].b]), 0.5);
+        spn_vec3 mid = spn_v3_scale(spn_v3_add(x[w->hs[s].a], x[spn__end_b(w->hs[s])]), 0.5);
         w->wind[s] = w->air_fn(w->air_user, t, mid);
+    }
+}
+
+/* Springs [lo, hi): forces into fs, sums added to sums[0..2]. Compiled for
+ * AVX2 too where the compiler can pick at load time (same bits: no FMA). */
+SPN__KERNEL static void spring_range(const spn__spring *restrict hs, uint32_t lo, uint32_t hi,
+                                      const spn_vec3 *restrict x, const spn_vec3 *restrict v,
+                                      spn_vec3 *restrict fs, double *sums)
+{
+    chunk c;
+    for (uint32_t s0 = lo; s0 < hi; s0 += SPN_CHUNK) {
+        const uint32_t n = hi - s0 < SPN_CHUNK ? hi - s0 : SPN_CHUNK;
+        chunk_load(&c, hs + s0, n, x, v, UINT32_MAX);
+        chunk_forces(&c, n, fs + s0);
+        chunk_sums(&c, n, sums);
     }
 }
 
@@ -137,13 +128,13 @@ void spn__spring_pass(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 
     if (air) sample_air(w, t, x);
     spn_vec3 *restrict fs = w->fs;
     const spn__spring *restrict hs = w->hs;
-    const uint8_t *restrict hflags = w->hflags;
     double *partial = w->partial;
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, ns))
     for (uint32_t blk = 0; blk < nb; blk++) {
         const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < ns ? lo + SPN_BLOCK : ns;
-        double energy = 0, power = 0, gross = 0;
-        for (uint32_t s = lo; s < hi; s++) fs[s] = spring_force(hs, hflags, s, x, v, &energy, &power, &gross);
+        double sums[3] = {0, 0, 0};
+        spring_range(hs, lo, hi, x, v, fs, sums);
+        const double energy = sums[0], power = sums[1], gross = sums[2];
         if (air)
             for (uint32_t s = lo; s < hi; s++) w->fair[s] = air_force(w, s, x, v, &w->cair[s]);
         partial[(size_t)blk * SPN_NSUMS + 0] = energy;

@@ -48,7 +48,7 @@ static void build_jacobian(spn_world *w, double h)
         spn__jac j = {{0, 0, 0}, 0, 0, 0};
         spn_vec3 g = {0, 0, 0};
         const spn__spring sp = w->hs[s];
-        const uint32_t a = sp.a, b = sp.b;
+        const uint32_t a = sp.a, b = spn__end_b(sp);
         const spn_vec3 l = spn_v3_sub(x[a], x[b]);
         const double len = spn_v3_len(l);
         if (len > 0 && !(w->hflags[s] & SPN_SPRING_BROKEN)) {
@@ -116,41 +116,68 @@ static void build_rhs(spn_world *w, double h)
     }
 }
 
-/* Ap = A p (fixed rows zero); returns p . Ap summed in block order. */
-static double apply(spn_world *w, double h, const spn_vec3 *p, spn_vec3 *ap)
+/* Per-spring product into fs (and fair with air): the force of the spring's
+ * Jacobian on end a for the relative move d = p_a - p_b. */
+static void apply_springs(spn_world *w, const spn_vec3 *restrict p, bool air)
 {
-    const uint32_t ns = w->ns, np = w->np, nb = spn__blocks(np);
-    const bool air = spn__air_active(w);
+    const uint32_t ns = w->ns;
+    const spn__jac *restrict jac = w->jac;
+    const spn__spring *restrict hs = w->hs;
+    spn_vec3 *restrict fs = w->fs, *restrict fair = w->fair;
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, ns))
     for (uint32_t s = 0; s < ns; s++) {
-        const spn__jac *j = &w->jac[s];
-        const spn_vec3 pa = p[w->hs[s].a], pb = p[w->hs[s].b];
+        const spn__jac j = jac[s];
+        const spn_vec3 pa = p[hs[s].a], pb = p[spn__end_b(hs[s])];
         const spn_vec3 d = spn_v3_sub(pa, pb);
-        w->fs[s] = spn_v3_add(spn_v3_scale(d, j->iso), spn_v3_scale(j->u, j->axial * spn_v3_dot(j->u, d)));
+        fs[s] = spn_v3_add(spn_v3_scale(d, j.iso), spn_v3_scale(j.u, j.axial * spn_v3_dot(j.u, d)));
         if (air) {
             const spn_vec3 q = spn_v3_add(pa, pb);
-            w->fair[s] = spn_v3_scale(spn_v3_sub(q, spn_v3_scale(j->u, spn_v3_dot(j->u, q))), j->air);
+            fair[s] = spn_v3_scale(spn_v3_sub(q, spn_v3_scale(j.u, spn_v3_dot(j.u, q))), j.air);
         }
     }
+}
+
+/* Ap = A p (fixed rows zero); returns p . Ap summed in block order. Without
+ * air the gather reads a particle's springs as end a as one contiguous run
+ * (added) and those as end b through b_adj (subtracted); air drag couples
+ * both ends with the same sign and goes through the signed adjacency. */
+static double apply(spn_world *w, double h, const spn_vec3 *restrict p, spn_vec3 *restrict ap)
+{
+    const uint32_t np = w->np, nb = spn__blocks(np);
+    const bool air = spn__air_active(w);
+    apply_springs(w, p, air);
     const double diag = 1 + h * w->def.drag;
+    const spn__gather_ctx c = spn__gather_ctx_of(w);
+    const uint32_t *restrict adj_start = w->adj_start, *restrict adj = w->adj;
+    const spn_vec3 *restrict fs = w->fs, *restrict fair = w->fair;
     double *partial = w->partial;
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
     for (uint32_t blk = 0; blk < nb; blk++) {
         const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < np ? lo + SPN_BLOCK : np;
         double dot = 0;
         for (uint32_t i = lo; i < hi; i++) {
-            if (w->inv_mass[i] == 0) {
+            if (c.inv_mass[i] == 0) {
                 ap[i] = spn_v3(0, 0, 0);
                 continue;
             }
-            spn_vec3 y = spn_v3_scale(p[i], w->mass[i] * diag);
-            for (uint32_t k = w->adj_start[i]; k < w->adj_start[i + 1]; k++) {
-                const uint32_t e = w->adj[k], s = e >> 1;
-                y = (e & 1u) ? spn_v3_sub(y, w->fs[s]) : spn_v3_add(y, w->fs[s]);
-                if (air) y = spn_v3_add(y, w->fair[s]);
+            const spn_vec3 pi = p[i];
+            spn_vec3 y = spn_v3_scale(pi, c.mass[i] * diag);
+            if (!air) {
+                for (uint32_t s = c.a_start[i], end = c.a_start[i + 1]; s < end; s++)
+                    y.x += fs[s].x, y.y += fs[s].y, y.z += fs[s].z;
+                for (uint32_t k = c.b_start[i], end = c.b_start[i + 1]; k < end; k++) {
+                    const spn_vec3 fe = fs[c.b_adj[k]];
+                    y.x -= fe.x, y.y -= fe.y, y.z -= fe.z;
+                }
+            } else {
+                for (uint32_t k = adj_start[i]; k < adj_start[i + 1]; k++) {
+                    const uint32_t e = adj[k], s = e >> 1;
+                    y = (e & 1u) ? spn_v3_sub(y, fs[s]) : spn_v3_add(y, fs[s]);
+                    y = spn_v3_add(y, fair[s]);
+                }
             }
             ap[i] = y;
-            dot += spn_v3_dot(p[i], y);
+            dot += spn_v3_dot(pi, y);
         }
         partial[(size_t)blk * SPN_NSUMS] = dot;
     }
@@ -263,7 +290,7 @@ static void finish(spn_world *w, double h, bool ext, spn__step_result *r)
     double spring_damp = 0; /* axial damping power at the new velocities */
     for (uint32_t s = 0; s < w->ns; s++) {
         const spn__spring *sp = &w->hs[s];
-        const double rate = spn_v3_dot(w->jac[s].u, spn_v3_sub(w->v[sp->a], w->v[sp->b]));
+        const double rate = spn_v3_dot(w->jac[s].u, spn_v3_sub(w->v[sp->a], w->v[spn__end_b(*sp)]));
         spring_damp += sp->kd * rate * rate;
     }
     r->gain_kp = sum[0];

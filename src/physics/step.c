@@ -73,17 +73,17 @@ static spn_status integrate(spn_world *w, double dt, spn__step_result *r)
     }
 }
 
-spn_status spn_world_step(spn_world *w, double dt)
+/* One step of a compiled world. Without a backup (w->no_backup) a blow-up
+ * leaves the broken state in place and returns SPN_ERR_UNSTABLE with no
+ * message: spn_world_advance restores and replays. */
+static spn_status step_once(spn_world *w, double dt)
 {
-    if (!(dt > 0) || !isfinite(dt)) return spn_error(SPN_ERR_INVALID, "time step must be positive and finite, not %g", dt);
-    spn_status st = spn_world_compile(w);
-    if (st != SPN_OK) return st;
     memset(&w->last, 0, sizeof w->last);
     w->last.dt = dt;
     w->last.substeps = 1;
     spn__step_result r;
     memset(&r, 0, sizeof r);
-    st = integrate(w, dt, &r);
+    spn_status st = integrate(w, dt, &r);
     if (st != SPN_OK) return st;
     double gain = r.gain_kp - r.elastic - r.work;
     /* Energy in play; gravity alone gives m g^2 dt^2 per step (forward
@@ -91,7 +91,7 @@ spn_status spn_world_step(spn_world *w, double dt)
     double g2 = spn_v3_dot(w->def.gravity, w->def.gravity);
     double scale = r.e_before + fabs(r.work) + w->free_mass * g2 * dt * dt;
     if (!isfinite(r.kinetic) || !isfinite(r.gain_kp) || gain > w->def.energy_jump * scale + 1e-300)
-        return blew_up(w, dt, gain);
+        return w->no_backup ? SPN_ERR_UNSTABLE : blew_up(w, dt, gain);
     double lost = 0;
     if (w->ncolliders || w->collide_fn) lost += spn__collide(w, dt);
     if (w->def.provot_max_strain > 0) lost += spn__provot(w, dt);
@@ -101,6 +101,73 @@ spn_status spn_world_step(spn_world *w, double dt)
     w->steps++;
     w->last.breaks = spn__check_breakage(w);
     return SPN_OK;
+}
+
+static spn_status check_dt(double dt)
+{
+    if (!(dt > 0) || !isfinite(dt)) return spn_error(SPN_ERR_INVALID, "time step must be positive and finite, not %g", dt);
+    return SPN_OK;
+}
+
+spn_status spn_world_step(spn_world *w, double dt)
+{
+    spn_status st = check_dt(dt);
+    if (st == SPN_OK) st = spn_world_compile(w);
+    if (st != SPN_OK) return st;
+    return step_once(w, dt);
+}
+
+/* Steps that a replay from a saved state reproduces exactly, with nothing
+ * outside x and v touched: explicit and RK4 steps with no callbacks, no
+ * colliders, no Provot limits and no spring that can break. */
+static bool replayable(const spn_world *w)
+{
+    const spn_integrator in = w->def.integrator;
+    if (in != SPN_INTEGRATOR_EULER && in != SPN_INTEGRATOR_SYMPLECTIC && in != SPN_INTEGRATOR_RK4) return false;
+    if (w->force_fn || (w->air_fn && w->any_diam) || w->collide_fn || w->ncolliders) return false;
+    return !(w->def.provot_max_strain > 0) && !(w->def.breakage && w->any_limits);
+}
+
+/* Replayable runs keep one copy of the state per call, in x0 and v0, instead
+ * of one per step. On a blow-up at step j the world goes back to that copy,
+ * replays the j good steps (bit-identical: same world, same calls) and takes
+ * step j again with a backup, which fails as before and restores the state
+ * from before it, with the usual message. */
+spn_status spn_world_advance(spn_world *w, double dt, int n)
+{
+    spn_status st = check_dt(dt);
+    if (st != SPN_OK) return st;
+    if (n < 1) return spn_error(SPN_ERR_INVALID, "spn_world_advance: step count must be at least 1, not %d", n);
+    st = spn_world_compile(w);
+    if (st != SPN_OK) return st;
+    spn_step_report total = {dt, 0, 0, 0, 0};
+    const bool replay = n > 1 && replayable(w);
+    const double t0 = w->t, work0 = w->external_work, diss0 = w->dissipated;
+    const uint64_t steps0 = w->steps;
+    if (replay) {
+        memcpy(w->x0, w->x, w->np * sizeof *w->x);
+        memcpy(w->v0, w->v, w->np * sizeof *w->v);
+        w->no_backup = true;
+    }
+    for (int j = 0; j < n; j++) {
+        st = step_once(w, dt);
+        if (st == SPN_ERR_UNSTABLE && w->no_backup) {
+            memcpy(w->x, w->x0, w->np * sizeof *w->x);
+            memcpy(w->v, w->v0, w->np * sizeof *w->v);
+            w->t = t0, w->external_work = work0, w->dissipated = diss0, w->steps = steps0;
+            for (int q = 0; q < j; q++) step_once(w, dt);
+            w->no_backup = false;
+            st = step_once(w, dt);
+        }
+        if (st != SPN_OK) break;
+        total.substeps += w->last.substeps;
+        total.halvings += w->last.halvings;
+        total.cg_iterations += w->last.cg_iterations;
+        total.breaks += w->last.breaks;
+    }
+    w->no_backup = false;
+    w->last = total;
+    return st;
 }
 
 spn_energy spn_world_energy(const spn_world *w)

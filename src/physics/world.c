@@ -279,10 +279,7 @@ void spn_world_set_spring_stiffness(spn_world *w, uint32_t s, double k, double k
 {
     w->k[s] = k;
     w->kd[s] = kd;
-    if (w->compiled) {
-        w->hs[w->iperm[s]].k = k;
-        w->hs[w->iperm[s]].kd = kd;
-    }
+    if (w->compiled) w->hs[w->iperm[s]] = spn__hot_spring(w, s);
 }
 void spn_world_set_spring_tag(spn_world *w, uint32_t s, uint32_t tag)
 {
@@ -292,10 +289,24 @@ void spn_world_set_spring_tag(spn_world *w, uint32_t s, uint32_t tag)
 void spn_world_break_spring(spn_world *w, uint32_t s)
 {
     w->sflags[s] |= SPN_SPRING_BROKEN;
-    if (w->compiled) w->hflags[w->iperm[s]] |= SPN_SPRING_BROKEN;
+    if (w->compiled) {
+        w->hflags[w->iperm[s]] |= SPN_SPRING_BROKEN;
+        w->hs[w->iperm[s]] = spn__hot_spring(w, s);
+    }
 }
 
 void spn_world_set_integrator(spn_world *w, spn_integrator integrator) { w->def.integrator = integrator; }
+
+spn_status spn_world_set_solver_tolerance(spn_world *w, double cg_tolerance, int cg_max_iterations)
+{
+    if (!(cg_tolerance > 0 && cg_tolerance < 1))
+        return spn_error(SPN_ERR_INVALID, "cg_tolerance must be in (0, 1), not %g", cg_tolerance);
+    if (cg_max_iterations < 1)
+        return spn_error(SPN_ERR_INVALID, "cg_max_iterations must be at least 1, not %d", cg_max_iterations);
+    w->def.cg_tolerance = cg_tolerance;
+    w->def.cg_max_iterations = cg_max_iterations;
+    return SPN_OK;
+}
 void spn_world_set_gravity(spn_world *w, spn_vec3 g) { w->def.gravity = g; }
 void spn_world_set_drag(spn_world *w, double drag) { w->def.drag = drag; }
 double spn_world_time(const spn_world *w) { return w->t; }
@@ -406,13 +417,16 @@ spn_world *spn_world_clone(const spn_world *w)
     if (!c) return NULL;
     *c = *w;
     c->compiled = false;
-    c->adj_start = c->adj = c->perm = c->iperm = NULL;
+    c->adj_start = c->adj = c->perm = c->iperm = c->a_start = c->b_start = c->b_adj = NULL;
     c->hs = NULL;
     c->hflags = NULL;
     c->fs = c->f = c->fext = c->x0 = c->v0 = c->fair = c->wind = NULL;
     c->sdiam = c->cair = c->partial = c->pinv = NULL;
     c->jac = NULL;
     c->npartial = 0;
+    c->sweep_block = 0;
+    c->xout_start = c->xout = c->xin_start = c->xin = NULL;
+    c->facc = NULL;
     for (int i = 0; i < SPN_TMP_COUNT; i++) c->tmp[i] = NULL;
     /* Nothing may alias w's arrays if a copy below fails and c is destroyed. */
     c->x = c->v = NULL;

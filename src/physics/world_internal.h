@@ -43,11 +43,20 @@ typedef struct spn_tag_diameter {
     double diameter;
 } spn_tag_diameter;
 
-/* The hot fields of one spring, in the compiled (internal) order. */
+/* The hot fields of one spring, in the compiled (internal) order: 32 bytes.
+ * The top bit of `bt` is the tension-only flag (read it with spn__end_b /
+ * spn__tension_only), and a broken spring has k = kd = 0 here (its public k
+ * and kd are kept), so the force loop needs no flag array. Particles are
+ * therefore limited to 2^31 - 1. */
 typedef struct spn__spring {
-    uint32_t a, b;
+    uint32_t a;
+    uint32_t bt; /* end b | tension-only << 31 (named apart so a plain `.b` does not compile) */
     double k, kd, rest;
 } spn__spring;
+
+#define SPN__END_MASK 0x7fffffffu
+static inline uint32_t spn__end_b(spn__spring s) { return s.bt & SPN__END_MASK; }
+static inline bool spn__tension_only(spn__spring s) { return (s.bt >> 31) != 0; }
 
 /* What one force evaluation measured at its state (x, v). */
 typedef struct spn__eval {
@@ -95,6 +104,10 @@ struct spn_world {
     uint32_t *iperm;      /* public -> internal spring id */
     uint32_t *adj_start;  /* np + 1 */
     uint32_t *adj;        /* spring id << 1 | (1 if the particle is end b) */
+    uint32_t *a_start;    /* np + 1: internal end a is the lower particle id, so particle i's
+                           * springs as end a are the contiguous run [a_start[i], a_start[i+1]) */
+    uint32_t *b_start;    /* np + 1, into b_adj */
+    uint32_t *b_adj;      /* springs with the particle as end b, internal order */
     spn_vec3 *fs;         /* per-spring force on end a (scratch) */
     double *sdiam;        /* per-spring diameter for air drag */
     bool any_diam;        /* some spring has a diameter */
@@ -102,6 +115,12 @@ struct spn_world {
     double free_mass;     /* total mass of the free particles */
     spn_vec3 *f, *fext;   /* per-particle total and external force */
     spn_vec3 *x0, *v0;    /* state before the step (restored on blow-up) */
+    bool no_backup;       /* explicit and RK4 steps leave x0, v0 alone (spn_world_advance) */
+    /* the fused explicit sweep (sweep.c), built on first use */
+    uint32_t sweep_block;            /* particles per block (0: not built) */
+    uint32_t *xout_start, *xout;     /* per block: springs whose end b is in a later block */
+    uint32_t *xin_start, *xin;       /* per block: springs whose end b is in it, end a before it */
+    spn_vec3 *facc;                  /* per-particle spring force accumulator */
     spn_vec3 *tmp[SPN_TMP_COUNT]; /* per-particle scratch, allocated on demand */
     spn_vec3 *fair;       /* per-spring air force (on demand) */
     spn_vec3 *wind;       /* per-spring air velocity at the midpoint (on demand) */
@@ -137,10 +156,22 @@ struct spn_world {
     char *metadata;
 };
 
+/* A kernel also compiled for AVX2, chosen when the program loads (GCC on
+ * x86-64 with ifunc support). -ffp-contract=off keeps FMA out, and every
+ * operation is correctly rounded at any vector width, so both versions give
+ * the same bits. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && !defined(SPN_NO_CLONES)
+#define SPN__KERNEL __attribute__((target_clones("avx2", "default")))
+#else
+#define SPN__KERNEL
+#endif
+
 /* ---- compile.c ---- */
 
 /* Free every compiled array (the world goes back to construction mode). */
 void spn__free_compiled(spn_world *w);
+/* Public spring s's hot record (flags folded in, see spn__spring). */
+spn__spring spn__hot_spring(const spn_world *w, uint32_t s);
 
 /* ---- forces.c ---- */
 
@@ -175,7 +206,7 @@ double spn__gravity_energy(const spn_world *w, const spn_vec3 *x);
  * compiler knows stores to positions and velocities cannot change them
  * (otherwise it reloads every pointer from the world on every particle). */
 typedef struct spn__gather_ctx {
-    const uint32_t *restrict adj_start, *restrict adj;
+    const uint32_t *restrict a_start, *restrict b_start, *restrict b_adj;
     const spn_vec3 *restrict fs, *restrict fext;
     const double *restrict mass, *restrict inv_mass;
     spn_vec3 g;
@@ -184,23 +215,24 @@ typedef struct spn__gather_ctx {
 
 static inline spn__gather_ctx spn__gather_ctx_of(const spn_world *w)
 {
-    spn__gather_ctx c = {w->adj_start, w->adj, w->fs, w->fext, w->mass, w->inv_mass, w->def.gravity, w->def.drag};
+    spn__gather_ctx c = {w->a_start, w->b_start, w->b_adj, w->fs, w->fext, w->mass, w->inv_mass, w->def.gravity, w->def.drag};
     return c;
 }
 
-/* Net force on particle i: gravity, viscous drag, its springs (from fs, in
- * adjacency order) and, when `has_ext`, fext[i]. */
+/* Net force on particle i: gravity, viscous drag, its springs (from fs: first
+ * those it is end a of, a contiguous run, then those it is end b of, in
+ * internal order) and, when `has_ext`, fext[i]. */
 static inline spn_vec3 spn__force_on(const spn__gather_ctx *c, uint32_t i, spn_vec3 vi, bool has_ext)
 {
     const double m = c->mass[i], dm = c->drag * m;
     spn_vec3 fi = {m * c->g.x - dm * vi.x, m * c->g.y - dm * vi.y, m * c->g.z - dm * vi.z};
-    const uint32_t end = c->adj_start[i + 1];
-    for (uint32_t j = c->adj_start[i]; j < end; j++) {
-        const uint32_t e = c->adj[j];
-        const spn_vec3 fe = c->fs[e >> 1];
-        /* Branch-free sign: which end a particle is follows no pattern. */
-        const double sg = 1.0 - 2.0 * (double)(e & 1u);
-        fi.x += sg * fe.x, fi.y += sg * fe.y, fi.z += sg * fe.z;
+    for (uint32_t s = c->a_start[i], end = c->a_start[i + 1]; s < end; s++) {
+        const spn_vec3 fe = c->fs[s];
+        fi.x += fe.x, fi.y += fe.y, fi.z += fe.z;
+    }
+    for (uint32_t j = c->b_start[i], end = c->b_start[i + 1]; j < end; j++) {
+        const spn_vec3 fe = c->fs[c->b_adj[j]];
+        fi.x -= fe.x, fi.y -= fe.y, fi.z -= fe.z;
     }
     if (has_ext) fi = spn_v3_add(fi, c->fext[i]);
     return fi;
@@ -218,6 +250,13 @@ typedef struct spn__step_result {
     double kinetic;    /* kinetic energy after the step (NaN/inf: blown up) */
     double elastic;    /* elastic energy before the step */
 } spn__step_result;
+
+/* ---- sweep.c ---- */
+
+/* The fused Euler / symplectic Euler step, for worlds with no force callback
+ * and no air; false (nothing done) when out of memory for its buffers. */
+bool spn__step_sweep(spn_world *w, double dt, bool symplectic, spn__step_result *r);
+void spn__sweep_free(spn_world *w);
 
 /* ---- integrators (explicit.c, adaptive.c, implicit.c) ---- */
 

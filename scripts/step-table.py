@@ -1,0 +1,73 @@
+#!/usr/bin/env python3
+"""Compact tables for README's Speed section from a bench results file
+(JSON lines, as written by scripts/bench.sh): bench_step per integrator and
+size, and the Bullet peer.
+
+    scripts/step-table.py bench/results/<machine>.json
+"""
+import json
+import sys
+
+
+def load(path):
+    with open(path) as f:
+        return [json.loads(line) for line in f if line.strip().startswith("{")]
+
+
+def step_table(rows):
+    steps = [r for r in rows if r.get("bench") == "step"]
+    sizes = sorted({r["particles"] for r in steps})
+    integrators = []
+    for r in steps:
+        if r["integrator"] not in integrators:
+            integrators.append(r["integrator"])
+    get = {(r["integrator"], r["particles"], r["threads"]): r for r in steps}
+    head = " | ".join(f"{n:,}" for n in sizes)
+    out = [f"| integrator | {head} | 2 threads, CPU (wall) |",
+           "|---|" + "---:|" * len(sizes) + "---:|"]
+    for integ in integrators:
+        one, two = [], []
+        for n in sizes:
+            r1, r2 = get.get((integ, n, 1)), get.get((integ, n, 2))
+            one.append(f"{r1['cpu_ns_per_spring_step']:.1f} ({r1['ns_per_spring_step']:.0f})" if r1 else "–")
+            two.append(f"{r2['cpu_ns_per_spring_step']:.1f} ({r2['ns_per_spring_step']:.0f})" if r2 else "–")
+        out.append(f"| {integ} | " + " | ".join(one) + " | " + " / ".join(two) + " |")
+    imp = [r for r in steps if r["integrator"] == "implicit" and r["threads"] == 1]
+    if imp:
+        out.append("")
+        out.append("Implicit: CG iterations per step " +
+                   ", ".join(f"{r['cg_iterations_per_step']:.0f}" for r in imp) +
+                   "; CPU ns per spring per CG iteration " +
+                   ", ".join(f"{r.get('cpu_ns_per_spring_cg_iteration', float('nan')):.1f}" for r in imp) + ".")
+    loads = [r["load"] for r in steps if "load" in r]
+    if loads:
+        out.append(f"Load average during the run: {min(loads):.1f}–{max(loads):.1f}.")
+    return "\n".join(out)
+
+
+def peer_table(rows):
+    peer = [r for r in rows if r.get("bench") == "peer_bullet_softbody"]
+    if not peer:
+        return ""
+    out = ["| particles | Bullet CPU (wall) | Spinneret CPU (wall) | ratio CPU (wall) | strain error Bullet / ours |",
+           "|---:|---:|---:|---:|---:|"]
+    for r in peer:
+        out.append(f"| {r['particles']:,} | {r.get('bullet_cpu_ns_per_spring_step', float('nan')):.1f} "
+                   f"({r['bullet_ns_per_spring_step']:.0f}) | "
+                   f"{r.get('spinneret_cpu_ns_per_spring_step', float('nan')):.1f} "
+                   f"({r['spinneret_ns_per_spring_step']:.0f}) | {r.get('cpu_ratio', float('nan')):.1f} "
+                   f"({r['ratio']:.1f}) | {r['bullet_strain_error']:.2g} / {r['spinneret_strain_error']:.2g} |")
+    return "\n".join(out)
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit("usage: step-table.py RESULTS.json")
+    rows = load(sys.argv[1])
+    print(step_table(rows))
+    print()
+    print(peer_table(rows))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,107 @@
+/* Chunks of springs for the force loops (forces.c, sweep.c): a scalar loop
+ * gathers each spring's end differences and constants into small arrays,
+ * a branch-free loop over them computes the forces (vectorised), a third sums
+ * the energy terms in a fixed order. Header-only so both users inline it. */
+#ifndef SPN_PHYSICS_CHUNK_H
+#define SPN_PHYSICS_CHUNK_H
+
+#include "world_internal.h"
+
+#include <math.h>
+
+/* The spring pass works on chunks of SPN_CHUNK springs in three loops: a
+ * gather of each spring's end differences (l = x_a - x_b, u = v_a - v_b) and
+ * constants into small arrays, the force arithmetic over those arrays (no
+ * indirection and no branches, so the compiler vectorises it, square roots
+ * and divisions included), and the sums of the block. Each spring's
+ * arithmetic is the same expression whatever the vector width, so the bits do
+ * not depend on it. Broken springs have k = kd = 0 in the hot records, so they
+ * cost the same as any other and need no flag. */
+#define SPN_CHUNK 128
+
+typedef struct chunk {
+    double lx[SPN_CHUNK], ly[SPN_CHUNK], lz[SPN_CHUNK];
+    double ux[SPN_CHUNK], uy[SPN_CHUNK], uz[SPN_CHUNK];
+    double k[SPN_CHUNK], kd[SPN_CHUNK], rest[SPN_CHUNK], tonly[SPN_CHUNK];
+    double s[SPN_CHUNK], e[SPN_CHUNK], p[SPN_CHUNK], g[SPN_CHUNK];
+} chunk;
+
+/* Springs hs[0..n) into the chunk. A spring whose end b is at or past
+ * b_limit is loaded as if both ends were a (no force; the caller has its
+ * force from elsewhere and must not read b: another thread may be moving it). */
+static inline void chunk_load(chunk *restrict c, const spn__spring *restrict hs, uint32_t n,
+                              const spn_vec3 *restrict x, const spn_vec3 *restrict v, uint32_t b_limit)
+{
+    for (uint32_t j = 0; j < n; j++) {
+        const spn__spring sp = hs[j];
+        const uint32_t a = sp.a, b0 = spn__end_b(sp), b = b0 < b_limit ? b0 : a;
+        const spn_vec3 xa = x[a], xb = x[b], va = v[a], vb = v[b];
+        c->lx[j] = xa.x - xb.x, c->ly[j] = xa.y - xb.y, c->lz[j] = xa.z - xb.z;
+        c->ux[j] = va.x - vb.x, c->uy[j] = va.y - vb.y, c->uz[j] = va.z - vb.z;
+        c->k[j] = sp.k, c->kd[j] = sp.kd, c->rest[j] = sp.rest;
+        c->tonly[j] = (double)spn__tension_only(sp);
+    }
+}
+
+/* Force on end a of each spring of the chunk, into fs; the elastic energy,
+ * damping power and force magnitude of each into c->e, c->p, c->g. */
+static inline void chunk_forces(chunk *restrict c, uint32_t n, spn_vec3 *restrict fs)
+{
+    for (uint32_t j = 0; j < n; j++) {
+        const double lx = c->lx[j], ly = c->ly[j], lz = c->lz[j];
+        const double d2 = lx * lx + ly * ly + lz * lz;
+        const double len = sqrt(d2);
+        const double stretch = len - c->rest[j];
+        /* No force from a zero-length spring or a slack tension-only one:
+         * a 0/1 factor rather than a branch, so the loop vectorises. */
+        const double slack = (double)(stretch < 0) * c->tonly[j];
+        const double on = (double)(len > 0) * (1 - slack);
+        const double inv = on / (len + (1 - on)); /* 1/len, or 0 when off (never 0/0) */
+        const double rate = (c->ux[j] * lx + c->uy[j] * ly + c->uz[j] * lz) * inv; /* d|l|/dt */
+        const double k = c->k[j] * on, kd = c->kd[j];
+        const double mag = k * stretch + kd * rate;
+        c->s[j] = -mag * inv;
+        c->e[j] = 0.5 * k * stretch * stretch;
+        c->p[j] = kd * rate * rate;
+        c->g[j] = fabs(mag);
+    }
+    for (uint32_t j = 0; j < n; j++) {
+        const double sj = c->s[j];
+        fs[j].x = sj * c->lx[j], fs[j].y = sj * c->ly[j], fs[j].z = sj * c->lz[j];
+    }
+}
+
+/* Adds the chunk's sums to out[0..2], four independent partial sums each
+ * (a fixed order, whatever the vector width of the loop above). */
+static inline void chunk_sums(const chunk *restrict c, uint32_t n, double *out)
+{
+    double e0 = 0, e1 = 0, e2 = 0, e3 = 0, p0 = 0, p1 = 0, p2 = 0, p3 = 0, g0 = 0, g1 = 0, g2 = 0, g3 = 0;
+    uint32_t j = 0;
+    for (; j + 4 <= n; j += 4) {
+        e0 += c->e[j], e1 += c->e[j + 1], e2 += c->e[j + 2], e3 += c->e[j + 3];
+        p0 += c->p[j], p1 += c->p[j + 1], p2 += c->p[j + 2], p3 += c->p[j + 3];
+        g0 += c->g[j], g1 += c->g[j + 1], g2 += c->g[j + 2], g3 += c->g[j + 3];
+    }
+    for (; j < n; j++) e0 += c->e[j], p0 += c->p[j], g0 += c->g[j];
+    out[0] += (e0 + e1) + (e2 + e3);
+    out[1] += (p0 + p1) + (p2 + p3);
+    out[2] += (g0 + g1) + (g2 + g3);
+}
+
+
+/* Springs list[0..n) (internal ids) into the chunk. */
+static inline void chunk_load_list(chunk *restrict c, const spn__spring *restrict hs, const uint32_t *restrict list,
+                                   uint32_t n, const spn_vec3 *restrict x, const spn_vec3 *restrict v)
+{
+    for (uint32_t j = 0; j < n; j++) {
+        const spn__spring sp = hs[list[j]];
+        const uint32_t a = sp.a, b = spn__end_b(sp);
+        const spn_vec3 xa = x[a], xb = x[b], va = v[a], vb = v[b];
+        c->lx[j] = xa.x - xb.x, c->ly[j] = xa.y - xb.y, c->lz[j] = xa.z - xb.z;
+        c->ux[j] = va.x - vb.x, c->uy[j] = va.y - vb.y, c->uz[j] = va.z - vb.z;
+        c->k[j] = sp.k, c->kd[j] = sp.kd, c->rest[j] = sp.rest;
+        c->tonly[j] = (double)spn__tension_only(sp);
+    }
+}
+
+#endif
