@@ -29,6 +29,9 @@ void view_set_world(view_state *v, spn_world *w)
     v->base_gravity = spn_world_get_def(w)->gravity;
     if (spn_v3_len(v->base_gravity) == 0) v->base_gravity = spn_v3(0, -9.81, 0);
     spn_world_set_integrator(w, v->opt.solver);
+    /* A live view needs a plausible step each frame, not a converged one:
+     * 1e-3 cuts CG work several-fold (~500 -> tens of iterations in wind). */
+    spn_world_set_solver_tolerance(w, 1e-3, 200);
     v->grabbed = -1;
     if (!v->opt.build_mode) view_frame_camera(v); /* a built web stays where it was clicked */
     view_wind_update(v);
