@@ -132,7 +132,8 @@ SPN_API spn_spring_info spn_world_spring(const spn_world *w, uint32_t s);
 SPN_API void spn_world_set_spring_rest(spn_world *w, uint32_t s, double rest);
 SPN_API void spn_world_set_spring_stiffness(spn_world *w, uint32_t s, double k, double kd);
 SPN_API void spn_world_set_spring_tag(spn_world *w, uint32_t s, uint32_t tag);
-/// Break a spring by hand (k = 0, flagged); no callback.
+/// Break a spring by hand: flagged broken, it exerts no force from now on (its
+/// stiffness is kept in spn_spring_info for the record); no callback.
 SPN_API void spn_world_break_spring(spn_world *w, uint32_t s);
 
 SPN_API void spn_world_set_integrator(spn_world *w, spn_integrator integrator);
