@@ -394,13 +394,16 @@ static int animate_run(animate_options *o)
         sigaction(SIGTERM, &old_term, NULL);
     }
     bool done = st == SPN_OK && !rep.interrupted;
-    spn_status close_st = spn_frames_close(c.frames, done);
+    /* Interrupted, the complete frames are kept (a shorter video), as every
+     * other frame-writing command does; the report needs the whole run. */
+    spn_status close_st = spn_frames_close(c.frames, st == SPN_OK && rep.frames > 0);
     if (st == SPN_OK) st = close_st;
     if (done && st == SPN_OK && o->report) st = write_report(o->report, &rep.impact);
     free(c.rgba);
     spn_world_destroy(w);
     if (rep.interrupted) {
-        fprintf(stderr, "spinneret %s: interrupted; %d frame(s) finished\n", CMD, rep.frames);
+        fprintf(stderr, "spinneret %s: interrupted; %d frame(s) finished and kept%s\n", CMD, rep.frames,
+                o->report ? ", no report written" : "");
         return 130;
     }
     if (st != SPN_OK) return cli_fail_status(CMD, st);
