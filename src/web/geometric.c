@@ -145,14 +145,7 @@ spn_status spn_web_build_geometric(const spn_geometric_def *def, spn_world **out
     int nf = lay_frame(&l, &f, ends);
     lay_radii_and_spiral(&l, def, f.g, ends, nf);
     double pre[SPN_WEB_KINDS];
-    for (int k = 0; k < SPN_WEB_KINDS; k++) pre[k] = def->prestrain;
-    pre[SPN_THREAD_CAPTURE] = def->capture_prestrain;
-    /* Frame and mooring threads carry several times the radii's tension
-     * (Wirth & Barth 1992, forces in the orb web of Araneus diadematus); laid
-     * with the radii's strain, the frame would have to stretch far before the
-     * web could balance, and a stiff-silk solver would crawl there. */
-    pre[SPN_THREAD_FRAME] = 4 * def->prestrain;
-    pre[SPN_THREAD_ANCHOR] = 5 * def->prestrain;
+    spn__web_prestrains(def->prestrain, def->capture_prestrain, pre);
     spn__weaver wv;
     spn_world_def wd = def->world;
     wd.seed = def->seed;

@@ -322,3 +322,15 @@ void spn__site_anchors(spn_rng *rng, int n, double width, double height, spn_vec
         out[i] = spn_v3(r * width * cos(a), r * height * sin(a), 0);
     }
 }
+
+void spn__web_prestrains(double radii, double capture, double pre[SPN_WEB_KINDS])
+{
+    for (int k = 0; k < SPN_WEB_KINDS; k++) pre[k] = radii;
+    pre[SPN_THREAD_CAPTURE] = capture;
+    /* Frame and mooring threads carry several times the radii's tension
+     * (Wirth & Barth 1992, forces in the orb web of Araneus diadematus); laid
+     * with the radii's strain, the frame would have to stretch far before the
+     * web could balance, and a stiff-silk solver would crawl there. */
+    pre[SPN_THREAD_FRAME] = 4 * radii;
+    pre[SPN_THREAD_ANCHOR] = 5 * radii;
+}

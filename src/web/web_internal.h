@@ -53,6 +53,10 @@ void spn__layout_free(spn__layout *l);
 /* Divide every line into springs no longer than `segment`, laid
  * prestrain[kind] beyond rest, in the order the lines were added. Springs of
  * kind SPN_THREAD_AUX_SPIRAL are removed at the end unless keep_aux. */
+/* Pre-strain per thread kind for a web laid with radii at `radii` and the
+ * capture spiral at `capture`: frame and mooring threads get 4x and 5x the
+ * radii's strain (they carry several times the radii's tension). */
+void spn__web_prestrains(double radii, double capture, double pre[SPN_WEB_KINDS]);
 spn_status spn__layout_weave(const spn__layout *l, spn__weaver *wv, double segment,
                              const double prestrain[SPN_WEB_KINDS], bool keep_aux);
 
