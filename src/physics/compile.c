@@ -28,16 +28,18 @@ void spn__free_compiled(spn_world *w)
     free(w->fext);
     free(w->x0);
     free(w->v0);
-    for (int i = 0; i < SPN_TMP_COUNT; i++) {
-        free(w->tmp[i]);
-        w->tmp[i] = NULL;
-    }
+    for (int i = 0; i < SPN_TMP_COUNT; i++) free(w->tmp[i]);
     free(w->fair);
     free(w->wind);
     free(w->cair);
     free(w->jac);
     free(w->pinv);
     free(w->partial);
+    spn__forget_compiled(w);
+}
+
+void spn__forget_compiled(spn_world *w)
+{
     w->adj_start = w->adj = w->perm = w->iperm = w->a_start = w->b_start = w->b_adj = NULL;
     w->hs = NULL;
     w->hflags = NULL;
@@ -45,6 +47,10 @@ void spn__free_compiled(spn_world *w)
     w->sdiam = w->cair = w->partial = w->pinv = NULL;
     w->jac = NULL;
     w->npartial = 0;
+    w->sweep_block = 0;
+    w->xout_start = w->xout = w->xin_start = w->xin = NULL;
+    w->facc = NULL;
+    for (int i = 0; i < SPN_TMP_COUNT; i++) w->tmp[i] = NULL;
     w->compiled = false;
 }
 

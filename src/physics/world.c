@@ -416,18 +416,7 @@ spn_world *spn_world_clone(const spn_world *w)
     spn_world *c = calloc(1, sizeof *c);
     if (!c) return NULL;
     *c = *w;
-    c->compiled = false;
-    c->adj_start = c->adj = c->perm = c->iperm = c->a_start = c->b_start = c->b_adj = NULL;
-    c->hs = NULL;
-    c->hflags = NULL;
-    c->fs = c->f = c->fext = c->x0 = c->v0 = c->fair = c->wind = NULL;
-    c->sdiam = c->cair = c->partial = c->pinv = NULL;
-    c->jac = NULL;
-    c->npartial = 0;
-    c->sweep_block = 0;
-    c->xout_start = c->xout = c->xin_start = c->xin = NULL;
-    c->facc = NULL;
-    for (int i = 0; i < SPN_TMP_COUNT; i++) c->tmp[i] = NULL;
+    spn__forget_compiled(c);
     /* Nothing may alias w's arrays if a copy below fails and c is destroyed. */
     c->x = c->v = NULL;
     c->mass = c->inv_mass = c->k = c->kd = c->rest = c->bmin = c->bmax = NULL;

@@ -170,6 +170,9 @@ struct spn_world {
 
 /* Free every compiled array (the world goes back to construction mode). */
 void spn__free_compiled(spn_world *w);
+/* Clear every compiled-array pointer without freeing (after freeing them, or
+ * in a copy whose pointers still alias the original's). One list for both. */
+void spn__forget_compiled(spn_world *w);
 /* Public spring s's hot record (flags folded in, see spn__spring). */
 spn__spring spn__hot_spring(const spn_world *w, uint32_t s);
 
