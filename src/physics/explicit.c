@@ -52,6 +52,7 @@ static inline __attribute__((always_inline)) void explicit_block(
 
 void spn__step_explicit(spn_world *w, double dt, bool symplectic, spn__step_result *r)
 {
+    if (spn__lattice_explicit(w, dt, symplectic, r)) return;
     if (!w->force_fn && !spn__air_active(w) && spn__step_sweep(w, dt, symplectic, r)) return;
     spn__eval e;
     spn__spring_pass(w, w->t, w->x, w->v, &e);
@@ -155,6 +156,7 @@ static void rk4_last_block(const rk4_ctx *k, spn_vec3 *restrict x, spn_vec3 *res
 
 spn_status spn__step_rk4(spn_world *w, double dt, spn__step_result *r)
 {
+    if (spn__lattice_rk4(w, dt, r)) return SPN_OK;
     spn_status st = spn__scratch(w, 4);
     if (st != SPN_OK) return st;
     static const double weight[4] = {1, 2, 2, 1}, frac[4] = {0, 0.5, 0.5, 1};
