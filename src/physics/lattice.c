@@ -47,6 +47,14 @@
 enum { L_ELASTIC, L_DAMP, L_MV2, L_GAIN, L_MVN2, L_NSUMS };
 #define LANES 8
 #define LAT_INLINE static inline __attribute__((always_inline))
+/* The sweep is also compiled for AVX-512 and AVX2, chosen when the program
+ * loads (as SPN__KERNEL; no FMA, every operation correctly rounded, so all
+ * versions give the same bits). */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && !defined(SPN_NO_CLONES)
+#define LAT_KERNEL __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define LAT_KERNEL
+#endif
 
 /* Arrays of one thread's workspace, each N doubles (see ws_array). */
 enum {
@@ -481,7 +489,7 @@ static void hub(const lat_args *a, double *const *rad, double (*acc)[LANES])
 }
 
 /* Radial springs into band b's first row, from the state before the step. */
-SPN__KERNEL static void cut_pass(const lat_args *a, double *ws, uint32_t b)
+LAT_KERNEL static void cut_pass(const lat_args *a, double *ws, uint32_t b)
 {
     const spn__lattice *L = a->L;
     const uint32_t n = L->radials, j = b * L->band_rows;
@@ -499,7 +507,7 @@ SPN__KERNEL static void cut_pass(const lat_args *a, double *ws, uint32_t b)
 }
 
 /* Sweep band b (see the file comment). */
-SPN__KERNEL static void band_pass(const lat_args *a, double *ws, uint32_t b)
+LAT_KERNEL static void band_pass(const lat_args *a, double *ws, uint32_t b)
 {
     const spn__lattice *L = a->L;
     const uint32_t n = L->radials, lo = b * L->band_rows;
