@@ -32,7 +32,7 @@
  * of the blow-up check are added in another order.
  *
  * Parallel and deterministic. Rows are grouped into bands of at least
- * def.parallel_min particles, fixed whatever the thread count. The radial
+ * def.parallel_min / 8 particles, fixed whatever the thread count. The radial
  * springs between two bands are computed first (from the state before the
  * step) into `cut`, so bands can then be swept by any thread in any order;
  * each band's sums are added in band order. */
@@ -66,7 +66,8 @@ enum {
     WS_E = 27,    /* per-spring elastic energy (scratch) */
     WS_P = 28,    /* per-spring damping power (scratch) */
     WS_Q = 29,    /* a third per-particle sum term (scratch) */
-    WS_COUNT = 30
+    WS_B = 30,    /* 6: RK4's base state x, v of the row being moved, SoA */
+    WS_COUNT = 36
 };
 
 struct spn__lattice {
@@ -175,7 +176,10 @@ void spn__lattice_spring_changed(spn_world *w, uint32_t s)
 static bool prepare(spn_world *w, int threads)
 {
     spn__lattice *L = w->lat;
-    const uint32_t n = L->radials, bsize = w->def.parallel_min > SPN_BLOCK ? w->def.parallel_min : SPN_BLOCK;
+    /* Bands of an eighth of parallel_min (at least SPN_BLOCK) particles:
+     * enough of them for a static schedule to share out evenly, few enough
+     * that the radials computed twice at their edges cost nothing. */
+    const uint32_t n = L->radials, bsize = w->def.parallel_min / 8 > SPN_BLOCK ? w->def.parallel_min / 8 : SPN_BLOCK;
     const uint32_t rows = (bsize + n - 1) / n;
     if (L->band_rows != rows) {
         free(L->cut), free(L->partial);
@@ -352,21 +356,117 @@ LAT_INLINE void update_explicit(uint32_t n, bool sym, bool backup, double dt, sp
     }
 }
 
+/* One particle of an Euler or symplectic Euler row: update_explicit's body,
+ * on values (the loops below do the loads and stores, so they vectorise). */
+typedef struct moved {
+    double x[3], v[3], mv2, gain, mvn2;
+} moved;
+
+LAT_INLINE moved explicit_one(double fx, double fy, double fz, double im, double m, double xx, double xy, double xz,
+                              double vx, double vy, double vz, bool sym, double dt, spn_vec3 g)
+{
+    moved o;
+    const double s = dt * im;
+    const bool fr = im != 0;
+    const double mf = fr ? m : 0;
+    const double nx = vx + fx * s, ny = vy + fy * s, nz = vz + fz * s;
+    const double dx = (sym ? nx : vx) * dt, dy = (sym ? ny : vy) * dt, dz = (sym ? nz : vz) * dt;
+    o.x[0] = fr ? xx + dx : xx, o.x[1] = fr ? xy + dy : xy, o.x[2] = fr ? xz + dz : xz;
+    o.v[0] = fr ? nx : vx, o.v[1] = fr ? ny : vy, o.v[2] = fr ? nz : vz;
+    o.mv2 = mf * (vx * vx + vy * vy + vz * vz);
+    o.mvn2 = mf * (nx * nx + ny * ny + nz * nz);
+    o.gain = mf * (0.5 * ((nx - vx) * (nx + vx) + (ny - vy) * (ny + vy) + (nz - vz) * (nz + vz)) -
+                   (g.x * dx + g.y * dy + g.z * dz));
+    return o;
+}
+
+#define STORE_MOVED(i, o)                                                                                       \
+    do {                                                                                                        \
+        x[i].x = (o).x[0], x[i].y = (o).x[1], x[i].z = (o).x[2];                                                \
+        v[i].x = (o).v[0], v[i].y = (o).v[1], v[i].z = (o).v[2];                                                \
+        t_mv2[i] = (o).mv2, t_gain[i] = (o).gain, t_mvn2[i] = (o).mvn2;                                         \
+    } while (0)
+
+/* An Euler or symplectic Euler row with the force assembled on the fly (as
+ * assemble_c, same order) instead of through F: one pass, not four. */
+LAT_INLINE void explicit_row(uint32_t n, bool sym, bool backup, double dt, spn_vec3 g, double drag,
+                             const double *restrict mass, const double *restrict inv_mass,
+                             const double *restrict Xx, const double *restrict Xy, const double *restrict Xz,
+                             const double *restrict Vx, const double *restrict Vy, const double *restrict Vz,
+                             const double *restrict ix, const double *restrict iy, const double *restrict iz,
+                             const double *restrict rx, const double *restrict ry, const double *restrict rz,
+                             const double *restrict ox, const double *restrict oy, const double *restrict oz,
+                             spn_vec3 *restrict x, spn_vec3 *restrict v, spn_vec3 *restrict x0,
+                             spn_vec3 *restrict v0, double *restrict t_mv2, double *restrict t_gain,
+                             double *restrict t_mvn2)
+{
+    if (backup)
+        for (uint32_t i = 0; i < n; i++) {
+            x0[i].x = Xx[i], x0[i].y = Xy[i], x0[i].z = Xz[i];
+            v0[i].x = Vx[i], v0[i].y = Vy[i], v0[i].z = Vz[i];
+        }
+    const uint32_t l = n - 1;
+    double e0[3], el[3];
+    const double gc[3] = {g.x, g.y, g.z};
+    const double *V[3] = {Vx, Vy, Vz}, *I[3] = {ix, iy, iz}, *R[3] = {rx, ry, rz}, *O[3] = {ox, oy, oz};
+    for (int c = 0; c < 3; c++) {
+        double f0 = mass[0] * gc[c] - (drag * mass[0]) * V[c][0], fl = mass[l] * gc[c] - (drag * mass[l]) * V[c][l];
+        if (ox) f0 += O[c][0], fl += O[c][l];
+        e0[c] = ((f0 + R[c][0]) + R[c][l]) - I[c][0];
+        el[c] = ((fl - I[c][l]) - R[c][l]) - R[c][l - 1];
+    }
+    if (ox)
+        for (uint32_t i = 1; i < l; i++) {
+            const double m = mass[i], dm = drag * m;
+            const double fx = ((((m * g.x - dm * Vx[i]) + ox[i]) + rx[i]) - ix[i]) - rx[i - 1];
+            const double fy = ((((m * g.y - dm * Vy[i]) + oy[i]) + ry[i]) - iy[i]) - ry[i - 1];
+            const double fz = ((((m * g.z - dm * Vz[i]) + oz[i]) + rz[i]) - iz[i]) - rz[i - 1];
+            const moved o = explicit_one(fx, fy, fz, inv_mass[i], m, Xx[i], Xy[i], Xz[i], Vx[i], Vy[i], Vz[i], sym, dt, g);
+            STORE_MOVED(i, o);
+        }
+    else
+        for (uint32_t i = 1; i < l; i++) {
+            const double m = mass[i], dm = drag * m;
+            const double fx = (((m * g.x - dm * Vx[i]) + rx[i]) - ix[i]) - rx[i - 1];
+            const double fy = (((m * g.y - dm * Vy[i]) + ry[i]) - iy[i]) - ry[i - 1];
+            const double fz = (((m * g.z - dm * Vz[i]) + rz[i]) - iz[i]) - rz[i - 1];
+            const moved o = explicit_one(fx, fy, fz, inv_mass[i], m, Xx[i], Xy[i], Xz[i], Vx[i], Vy[i], Vz[i], sym, dt, g);
+            STORE_MOVED(i, o);
+        }
+    const uint32_t ends[2] = {0, l};
+    for (int k = 0; k < 2; k++) {
+        const uint32_t i = ends[k];
+        const double *f = k ? el : e0;
+        const moved o = explicit_one(f[0], f[1], f[2], inv_mass[i], mass[i], Xx[i], Xy[i], Xz[i], Vx[i], Vy[i], Vz[i],
+                                     sym, dt, g);
+        STORE_MOVED(i, o);
+    }
+}
+
+/* RK4 stage sums: m v^2 of the free particles (no gain or new energy yet). */
+LAT_INLINE void rk4_mv2(uint32_t n, const double *restrict mass, const double *restrict inv_mass,
+                        const double *restrict Vx, const double *restrict Vy, const double *restrict Vz,
+                        double *restrict t_mv2, double *restrict t_gain, double *restrict t_mvn2)
+{
+    for (uint32_t i = 0; i < n; i++) {
+        t_mv2[i] = (inv_mass[i] != 0 ? mass[i] : 0) * (Vx[i] * Vx[i] + Vy[i] * Vy[i] + Vz[i] * Vz[i]);
+        t_gain[i] = t_mvn2[i] = 0;
+    }
+}
+
 /* An RK4 stage but the last: the weighted sums ax, av and the next trial
  * state xt = x + h V, vt = v + h F / m (a fixed particle stays at x, v). */
 LAT_INLINE void update_rk4_stage(uint32_t n, bool first, double h, double wgt, const double *restrict mass,
                                  const double *restrict inv_mass, const double *restrict Vc,
-                                 const double *restrict Fc, const spn_vec3 *restrict x, const spn_vec3 *restrict v,
-                                 int c, double *restrict xt, double *restrict vt, double *restrict ax,
-                                 double *restrict av, double *restrict t_mv2)
+                                 const double *restrict Fc, const double *restrict xb, const double *restrict vb,
+                                 double *restrict xt, double *restrict vt, double *restrict ax,
+                                 double *restrict av)
 {
+    (void)mass;
     for (uint32_t i = 0; i < n; i++) {
         const double im = inv_mass[i], s = h * im;
         const bool fr = im != 0;
-        const double vc = Vc[i], fc = Fc[i];
-        const double xc = c == 0 ? x[i].x : c == 1 ? x[i].y : x[i].z;
-        const double wc = c == 0 ? v[i].x : c == 1 ? v[i].y : v[i].z;
-        t_mv2[i] += (fr ? mass[i] : 0) * (vc * vc);
+        const double vc = Vc[i], fc = Fc[i], xc = xb[i], wc = vb[i];
         ax[i] = fr ? (first ? vc : ax[i] + vc * wgt) : ax[i];
         av[i] = fr ? (first ? fc : av[i] + fc * wgt) : av[i];
         xt[i] = fr ? xc + vc * h : xc;
@@ -380,22 +480,23 @@ LAT_INLINE void update_rk4_last(uint32_t n, bool backup, double h6, spn_vec3 g, 
                                 const double *restrict Vy, const double *restrict Vz, const double *restrict Fx,
                                 const double *restrict Fy, const double *restrict Fz, const double *restrict axx,
                                 const double *restrict axy, const double *restrict axz, const double *restrict avx,
-                                const double *restrict avy, const double *restrict avz, spn_vec3 *restrict x,
+                                const double *restrict avy, const double *restrict avz, const double *restrict bxx,
+                                const double *restrict bxy, const double *restrict bxz, const double *restrict bvx,
+                                const double *restrict bvy, const double *restrict bvz, spn_vec3 *restrict x,
                                 spn_vec3 *restrict v,
                                 spn_vec3 *restrict x0, spn_vec3 *restrict v0, double *restrict t_mv2,
                                 double *restrict t_gain, double *restrict t_mvn2)
 {
-    if (backup)
-        for (uint32_t i = 0; i < n; i++) {
-            x0[i].x = x[i].x, x0[i].y = x[i].y, x0[i].z = x[i].z;
-            v0[i].x = v[i].x, v0[i].y = v[i].y, v0[i].z = v[i].z;
-        }
+    if (backup) {
+        memcpy(x0, x, n * sizeof *x);
+        memcpy(v0, v, n * sizeof *v);
+    }
     for (uint32_t i = 0; i < n; i++) {
         const double im = inv_mass[i], s = h6 * im;
         const bool fr = im != 0;
         const double mf = fr ? mass[i] : 0;
         const double vx = Vx[i], vy = Vy[i], vz = Vz[i];
-        const double xx = x[i].x, xy = x[i].y, xz = x[i].z, wx = v[i].x, wy = v[i].y, wz = v[i].z;
+        const double xx = bxx[i], xy = bxy[i], xz = bxz[i], wx = bvx[i], wy = bvy[i], wz = bvz[i];
         const double dx = (axx[i] + vx) * h6, dy = (axy[i] + vy) * h6, dz = (axz[i] + vz) * h6;
         const double nx = wx + (avx[i] + Fx[i]) * s, ny = wy + (avy[i] + Fy[i]) * s, nz = wz + (avz[i] + Fz[i]) * s;
         x[i].x = fr ? xx + dx : xx, x[i].y = fr ? xy + dy : xy, x[i].z = fr ? xz + dz : xz;
@@ -409,9 +510,13 @@ LAT_INLINE void update_rk4_last(uint32_t n, bool backup, double h6, spn_vec3 g, 
 
 /* Update particles p0 .. p0+n-1 as the mode says; sums into acc. */
 LAT_INLINE void update(const lat_args *a, size_t p0, uint32_t n, double *const *X, double *const *V,
-                       double *const *F, double *const *t, double (*acc)[LANES])
+                       double *const *F, double *const *t, double *const *B, double (*acc)[LANES])
 {
     const double *mass = a->mass + p0, *inv_mass = a->inv_mass + p0;
+    /* RK4 reads the base state x, v: as SoA first (GCC 12 does not vectorise
+     * a loop that both reads and writes the interleaved arrays). */
+    if (a->mode == MODE_RK4_STAGE || a->mode == MODE_RK4_LAST)
+        deinterleave(n, a->x + p0, a->v + p0, B[0], B[1], B[2], B[3], B[4], B[5]);
     switch (a->mode) {
     case MODE_EULER:
     case MODE_SYMPLECTIC:
@@ -420,17 +525,22 @@ LAT_INLINE void update(const lat_args *a, size_t p0, uint32_t n, double *const *
                         t[1], t[2]);
         break;
     case MODE_RK4_STAGE:
-        /* One component at a time: three simple streams instead of one
-         * loop over a dozen, which GCC does not vectorise. */
-        for (uint32_t i = 0; i < n; i++) t[0][i] = t[1][i] = t[2][i] = 0;
-        for (int c = 0; c < 3; c++)
-            update_rk4_stage(n, a->stage == 0, a->h_next, a->weight, mass, inv_mass, V[c], F[c], a->x + p0,
-                             a->v + p0, c, a->xt[c] + p0, a->vt[c] + p0, a->ax[c] + p0, a->av[c] + p0, t[0]);
+        /* One component at a time, and the sum term apart: GCC 12 does not
+         * vectorise one loop over all those arrays. */
+        rk4_mv2(n, mass, inv_mass, V[0], V[1], V[2], t[0], t[1], t[2]);
+        /* (three calls, not a loop: GCC 12 does not vectorise an inlined
+         * function with restrict parameters inside a loop) */
+        update_rk4_stage(n, a->stage == 0, a->h_next, a->weight, mass, inv_mass, V[0], F[0], B[0], B[3],
+                         a->xt[0] + p0, a->vt[0] + p0, a->ax[0] + p0, a->av[0] + p0);
+        update_rk4_stage(n, a->stage == 0, a->h_next, a->weight, mass, inv_mass, V[1], F[1], B[1], B[4],
+                         a->xt[1] + p0, a->vt[1] + p0, a->ax[1] + p0, a->av[1] + p0);
+        update_rk4_stage(n, a->stage == 0, a->h_next, a->weight, mass, inv_mass, V[2], F[2], B[2], B[5],
+                         a->xt[2] + p0, a->vt[2] + p0, a->ax[2] + p0, a->av[2] + p0);
         break;
     default:
         update_rk4_last(n, a->backup, a->dt / 6, a->g, mass, inv_mass, V[0], V[1], V[2], F[0], F[1], F[2],
                         a->ax[0] + p0, a->ax[1] + p0, a->ax[2] + p0, a->av[0] + p0, a->av[1] + p0, a->av[2] + p0,
-                        a->x + p0, a->v + p0, a->x0 + p0, a->v0 + p0, t[0], t[1], t[2]);
+                        B[0], B[1], B[2], B[3], B[4], B[5], a->x + p0, a->v + p0, a->x0 + p0, a->v0 + p0, t[0], t[1], t[2]);
     }
     lane_add(acc[L_MV2], t[0], n);
     lane_add(acc[L_GAIN], t[1], n);
@@ -466,6 +576,25 @@ LAT_INLINE void assemble(const lat_args *a, size_t p0, uint32_t n, double *const
         assemble_c(n, g[c], a->drag, a->mass + p0, V[c], ri[c], rg[c], ro ? ro[c] : NULL, F[c]);
 }
 
+/* Row q (particles p0 ..) complete: its force, then its update. */
+LAT_INLINE void finish_row(const lat_args *a, size_t p0, uint32_t n, double *const *X, double *const *V,
+                           double *const *ri, double *const *rg, const double *const *ro, double *const *F,
+                           double *const *t, double *const *B, double (*acc)[LANES])
+{
+    if (a->mode == MODE_EULER || a->mode == MODE_SYMPLECTIC) {
+        explicit_row(n, a->mode == MODE_SYMPLECTIC, a->backup, a->dt, a->g, a->drag, a->mass + p0,
+                     a->inv_mass + p0, X[0], X[1], X[2], V[0], V[1], V[2], ri[0], ri[1], ri[2], rg[0], rg[1], rg[2],
+                     ro ? ro[0] : NULL, ro ? ro[1] : NULL, ro ? ro[2] : NULL, a->x + p0, a->v + p0, a->x0 + p0,
+                     a->v0 + p0, t[0], t[1], t[2]);
+        lane_add(acc[L_MV2], t[0], n);
+        lane_add(acc[L_GAIN], t[1], n);
+        lane_add(acc[L_MVN2], t[2], n);
+        return;
+    }
+    assemble(a, p0, n, V, ri, rg, ro, F);
+    update(a, p0, n, X, V, F, t, B, acc);
+}
+
 LAT_INLINE void rows_of(double *ws, size_t st, int base, int row, double **out)
 {
     for (int c = 0; c < 3; c++) out[c] = ws + (size_t)(base + 3 * row + c) * st;
@@ -482,10 +611,10 @@ static void hub(const lat_args *a, double *const *rad, double (*acc)[LANES])
     double f[3] = {m * a->g.x - dm * vh.x, m * a->g.y - dm * vh.y, m * a->g.z - dm * vh.z};
     for (uint32_t i = 0; i < n; i++) f[0] += rad[0][i], f[1] += rad[1][i], f[2] += rad[2][i];
     double X[3] = {xh.x, xh.y, xh.z}, V[3] = {vh.x, vh.y, vh.z};
-    double T[3];
+    double T[3], Bh[6] = {0};
     double *Xp[3] = {X, X + 1, X + 2}, *Vp[3] = {V, V + 1, V + 2}, *Fp[3] = {f, f + 1, f + 2};
-    double *Tp[3] = {T, T + 1, T + 2};
-    update(a, 0, 1, Xp, Vp, Fp, Tp, acc);
+    double *Tp[3] = {T, T + 1, T + 2}, *Bp[6] = {Bh, Bh + 1, Bh + 2, Bh + 3, Bh + 4, Bh + 5};
+    update(a, 0, 1, Xp, Vp, Fp, Tp, Bp, acc);
 }
 
 /* Radial springs into band b's first row, from the state before the step. */
@@ -520,7 +649,8 @@ LAT_KERNEL static void band_pass(const lat_args *a, double *ws, uint32_t b)
     }
     rows_of(ws, st, WS_F, 0, F);
     double *e = ws + (size_t)WS_E * st, *p = ws + (size_t)WS_P * st;
-    double *t[3] = {e, p, ws + (size_t)WS_Q * st};
+    double *t[3] = {e, p, ws + (size_t)WS_Q * st}, *B[6];
+    for (int c = 0; c < 6; c++) B[c] = ws + (size_t)(WS_B + c) * st;
     double acc_e[LANES] = {0}, acc_p[LANES] = {0}, acc[L_NSUMS][LANES] = {{0}};
     double *cut[3], *next_cut[3];
     for (int c = 0; c < 3; c++) {
@@ -557,15 +687,14 @@ LAT_KERNEL static void band_pass(const lat_args *a, double *ws, uint32_t b)
                      L->grest + s0 + n - 1, RING[cur], n - 1, e, p, acc_e, acc_p);
         if (j > lo) {
             const size_t q0 = 1 + (size_t)(j - 1) * n;
-            assemble(a, q0, n, V[prev], rad_prev, RING[prev], (const double *const *)rad_cur, F);
-            update(a, q0, n, X[prev], V[prev], F, t, acc);
+            finish_row(a, q0, n, X[prev], V[prev], rad_prev, RING[prev], (const double *const *)rad_cur, F, t, B, acc);
         }
         rad_prev = rad_cur;
     }
     const int last = cur ^ 1;
     const size_t q0 = 1 + (size_t)(hi - 1) * n;
-    assemble(a, q0, n, V[last], rad_prev, RING[last], hi < L->rings ? (const double *const *)next_cut : NULL, F);
-    update(a, q0, n, X[last], V[last], F, t, acc);
+    finish_row(a, q0, n, X[last], V[last], rad_prev, RING[last],
+               hi < L->rings ? (const double *const *)next_cut : NULL, F, t, B, acc);
     double *out = L->partial + (size_t)b * L_NSUMS;
     if (b == 0) out[L_ELASTIC] = out[L_DAMP] = 0;
     out[L_ELASTIC] += lane_total(acc_e), out[L_DAMP] += lane_total(acc_p);
