@@ -17,9 +17,12 @@ def load(path):
 def step_table(rows):
     steps = [r for r in rows if r.get("bench") == "step"]
     sizes = sorted({r["particles"] for r in steps})
+    stencil = {r["integrator"] for r in steps if r.get("path") == "lattice"}
+
     def label(r):
-        # the general path of a web that also has the lattice (stencil) one
-        return r["integrator"] + (" (general path)" if r.get("path") == "general" else "")
+        # the general path of an integrator that also has the lattice (stencil) one
+        general = r.get("path") == "general" and r["integrator"] in stencil
+        return r["integrator"] + (" (general path)" if general else "")
     integrators = []
     for r in steps:
         if label(r) not in integrators:
