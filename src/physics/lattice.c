@@ -185,7 +185,7 @@ static void hub(const lat_args *a, double *const *rad, double (*acc)[LANES])
 }
 
 /* Radial springs into band b's first row, from the state before the step. */
-LAT_KERNEL static void cut_pass(const lat_args *a, double *ws, uint32_t b)
+SPN__KERNEL static void cut_pass(const lat_args *a, double *ws, uint32_t b)
 {
     const spn__lattice *L = a->L;
     const uint32_t n = L->radials, j = b * L->band_rows;
@@ -203,7 +203,7 @@ LAT_KERNEL static void cut_pass(const lat_args *a, double *ws, uint32_t b)
 }
 
 /* Sweep band b (see the file comment). */
-LAT_KERNEL static void band_pass(const lat_args *a, double *ws, uint32_t b)
+SPN__KERNEL static void band_pass(const lat_args *a, double *ws, uint32_t b)
 {
     const spn__lattice *L = a->L;
     const uint32_t n = L->radials, lo = b * L->band_rows;

@@ -18,14 +18,6 @@
 enum { L_ELASTIC, L_DAMP, L_MV2, L_GAIN, L_MVN2, L_NSUMS };
 #define LANES 8
 #define LAT_INLINE static inline __attribute__((always_inline))
-/* The sweep is also compiled for AVX-512 and AVX2, chosen when the program
- * loads (as SPN__KERNEL; no FMA, every operation correctly rounded, so all
- * versions give the same bits). */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && !defined(SPN_NO_CLONES)
-#define LAT_KERNEL __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define LAT_KERNEL
-#endif
 
 /* Arrays of one thread's workspace, each N doubles (see ws_array). */
 enum {

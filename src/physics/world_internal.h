@@ -161,12 +161,12 @@ struct spn_world {
     char *metadata;
 };
 
-/* A kernel also compiled for AVX2, chosen when the program loads (GCC on
- * x86-64 with ifunc support). -ffp-contract=off keeps FMA out, and every
- * operation is correctly rounded at any vector width, so both versions give
+/* A kernel also compiled for AVX-512 and AVX2, chosen when the program loads
+ * (GCC on x86-64 with ifunc support). -ffp-contract=off keeps FMA out, and every
+ * operation is correctly rounded at any vector width, so all versions give
  * the same bits. */
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && !defined(SPN_NO_CLONES)
-#define SPN__KERNEL __attribute__((target_clones("avx2", "default")))
+#define SPN__KERNEL __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
 #define SPN__KERNEL
 #endif
