@@ -15,7 +15,12 @@
  * time of the steps only, after one
  * warm-up step (which compiles the world); also the process CPU time (all
  * threads) per spring-step and the load average, because on a shared machine
- * the wall clock measures the neighbours too. */
+ * the wall clock measures the neighbours too.
+ *
+ * Euler, symplectic Euler and RK4 run twice: on the default path ("path":
+ * "lattice", the stencil step of a regular web, see src/physics/lattice.c)
+ * and with the lattice forbidden ("path":"general", the spring-record loops
+ * any world takes). */
 #include <spinneret/spinneret.h>
 
 #include <stdio.h>
@@ -64,7 +69,7 @@ static double step_size(spn_integrator integ)
 }
 
 /* Time `steps` steps of one integrator on 1 or 2 threads; print one line. */
-static int bench_one(const size_case *c, spn_integrator integ, int threads)
+static int bench_one(const size_case *c, spn_integrator integ, int threads, bool lattice)
 {
     spn_world_def def = spn_world_def_default();
     def.integrator = integ;
@@ -78,6 +83,7 @@ static int bench_one(const size_case *c, spn_integrator integ, int threads)
         fprintf(stderr, "bench_step: %s\n", spn_last_error());
         return 1;
     }
+    spn_world_set_lattice(w, lattice);
     const double dt = step_size(integ);
     if (spn_world_step(w, dt) != SPN_OK) {
         fprintf(stderr, "bench_step: %s\n", spn_last_error());
@@ -100,9 +106,9 @@ static int bench_one(const size_case *c, spn_integrator integ, int threads)
     double ns_spring_step = sec * per;
     printf("{\"bench\":\"step\",\"scene\":\"orb\",\"integrator\":\"%s\",\"particles\":%u,\"springs\":%u,"
            "\"threads\":%d,\"steps\":%d,\"dt\":%g,\"ns_per_spring_step\":%.3f,\"cpu_ns_per_spring_step\":%.3f,"
-           "\"load\":%.2f",
+           "\"load\":%.2f,\"path\":\"%s\"",
            spn_integrator_name(integ), spn_world_particle_count(w), spn_world_spring_count(w), threads, steps, dt,
-           ns_spring_step, cpu * per, load_average());
+           ns_spring_step, cpu * per, load_average(), spn_world_step_path(w));
     if (integ == SPN_INTEGRATOR_ADAPTIVE)
         printf(",\"substeps_per_step\":%.1f,\"ns_per_spring_substep\":%.3f", (double)substeps / steps,
                ns_spring_step * steps / (double)substeps);
@@ -129,7 +135,10 @@ int main(int argc, char **argv)
     }
     for (int c = 0; c < ncases; c++)
         for (int integ = 0; integ < SPN_INTEGRATOR_COUNT; integ++)
-            for (int threads = 1; threads <= 2; threads++)
-                if (bench_one(&cases[c], (spn_integrator)integ, threads)) return 1;
+            for (int threads = 1; threads <= 2; threads++) {
+                if (bench_one(&cases[c], (spn_integrator)integ, threads, true)) return 1;
+                if (integ <= SPN_INTEGRATOR_RK4 && bench_one(&cases[c], (spn_integrator)integ, threads, false))
+                    return 1;
+            }
     return 0;
 }

@@ -150,10 +150,12 @@ static bullet_run run_bullet(const spn_world *w, double dt, int steps, const std
 }
 
 // Wall and CPU ns per spring-step of our symplectic Euler (one advance call).
-static void run_spinneret(spn_world *w, double dt, int steps, double *wall, double *cpu)
+// *path: "lattice" (the stencil step of a regular web) or "general".
+static void run_spinneret(spn_world *w, double dt, int steps, double *wall, double *cpu, const char **path)
 {
     spn_world_set_integrator(w, SPN_INTEGRATOR_SYMPLECTIC);
     spn_world_compile(w);
+    *path = spn_world_step_path(w);
     double t0 = seconds_now(), c0 = cpu_now();
     if (spn_world_advance(w, dt, steps) != SPN_OK) {
         std::fprintf(stderr, "bullet_orb: %s\n", spn_last_error());
@@ -183,14 +185,16 @@ int main(int argc, char **argv)
         spn_world *w = make_web(sz.rings, sz.radials);
         bullet_run b = run_bullet(w, dt, sz.steps, ref);
         double ours, ours_cpu;
-        run_spinneret(w, dt, sz.steps, &ours, &ours_cpu);
+        const char *path;
+        run_spinneret(w, dt, sz.steps, &ours, &ours_cpu, &path);
         std::printf("{\"bench\":\"peer_bullet_softbody\",\"particles\":%u,\"springs\":%u,\"dt\":%g,\"steps\":%d,"
                     "\"threads\":1,\"bullet_ns_per_spring_step\":%.3f,\"spinneret_ns_per_spring_step\":%.3f,"
                     "\"ratio\":%.2f,\"bullet_cpu_ns_per_spring_step\":%.3f,\"spinneret_cpu_ns_per_spring_step\":%.3f,"
-                    "\"cpu_ratio\":%.2f,\"bullet_strain_error\":%.3g,\"spinneret_strain_error\":%.3g}\n",
+                    "\"cpu_ratio\":%.2f,\"bullet_strain_error\":%.3g,\"spinneret_strain_error\":%.3g,"
+                    "\"spinneret_path\":\"%s\"}\n",
                     spn_world_particle_count(w), spn_world_spring_count(w), dt, sz.steps, b.ns_per_spring_step, ours,
                     b.ns_per_spring_step / ours, b.cpu_ns_per_spring_step, ours_cpu,
-                    b.cpu_ns_per_spring_step / ours_cpu, b.strain_error, strain_error(w, ref));
+                    b.cpu_ns_per_spring_step / ours_cpu, b.strain_error, strain_error(w, ref), path);
         std::fflush(stdout);
         spn_world_destroy(w);
     }
