@@ -80,19 +80,19 @@ bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_f
     for (uint32_t i = 0; i < a->rows; i++)
         row_pattern(a, b, i, diag_first, marks + (size_t)thread_id() * b->cols, c->col + c->start[i]);
     free(marks);
-    spn__bsr_mul_values(a, b, c, threads);
-    return true;
+    marks = NULL;
+    if (spn__bsr_mul_values(a, b, c, threads)) return true;
 fail:
     free(marks);
     spn__bsr_free(c);
     return false;
 }
 
-void spn__bsr_mul_values(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, int threads)
+bool spn__bsr_mul_values(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, int threads)
 {
     int nt = team(a->rows, threads);
     uint32_t *pos = malloc((size_t)nt * (b->cols ? b->cols : 1) * sizeof *pos);
-    if (!pos) return; /* cannot happen after a successful spn__bsr_mul of the same size; keeps old values */
+    if (!pos) return false;
 #pragma omp parallel for schedule(static) num_threads(nt)
     for (uint32_t i = 0; i < a->rows; i++) {
         uint32_t *where = pos + (size_t)thread_id() * b->cols;
@@ -106,6 +106,7 @@ void spn__bsr_mul_values(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, int 
         }
     }
     free(pos);
+    return true;
 }
 
 bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm_out)
