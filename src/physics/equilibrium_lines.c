@@ -51,6 +51,7 @@ struct spn__lines {
     uint32_t *node;      /* particles of each line, in order */
     uint32_t *upos;      /* per line node k (not the last): the BSR entry (node[k], node[k+1]) */
     double *dinv;        /* 6 per line node: inverted pivots of the factorisation */
+    double *cu;          /* 9 per line node (not the last): Dinv_k U_k, for the back substitution */
     double *work;        /* 3 per line node */
     uint32_t colours, *colour_start; /* lines [colour_start[c], colour_start[c + 1]) have colour c */
 };
@@ -62,6 +63,7 @@ void spn__lines_free(spn__lines *L)
     free(L->node);
     free(L->upos);
     free(L->dinv);
+    free(L->cu);
     free(L->work);
     free(L->colour_start);
     free(L);
@@ -272,8 +274,9 @@ spn__lines *spn__lines_build(const spn__eq *e, const spn__bsr *a0)
     uint32_t total = L->start[L->count];
     L->upos = malloc((total ? total : 1) * sizeof *L->upos);
     L->dinv = malloc(6 * (size_t)(total ? total : 1) * sizeof *L->dinv);
+    L->cu = malloc(9 * (size_t)(total ? total : 1) * sizeof *L->cu);
     L->work = malloc(3 * (size_t)(total ? total : 1) * sizeof *L->work);
-    if (!L->upos || !L->dinv || !L->work) goto fail;
+    if (!L->upos || !L->dinv || !L->cu || !L->work) goto fail;
     for (uint32_t l = 0; l < L->count; l++)
         for (uint32_t k = L->start[l]; k + 1 < L->start[l + 1]; k++) L->upos[k] = find_entry(a0, L->node[k], L->node[k + 1]);
     return L;
@@ -312,6 +315,12 @@ bool spn__lines_factor(spn__lines *L, const spn__bsr *a0)
             if (k == L->start[l]) schur(d, zero6, d, piv); /* U^T 0 U = 0: the plain diagonal */
             else schur(d, L->dinv + 6 * (size_t)(k - 1), a0->val + 9 * (size_t)L->upos[k - 1], piv);
             if (!spn__sym_inverse(piv, L->dinv + 6 * (size_t)k)) return false;
+            if (k > L->start[l]) { /* Dinv_{k-1} U_{k-1} */
+                const double *m = L->dinv + 6 * (size_t)(k - 1);
+                double mm[9] = {m[0], m[3], m[4], m[3], m[1], m[5], m[4], m[5], m[2]}, *c = L->cu + 9 * (size_t)(k - 1);
+                memset(c, 0, 9 * sizeof *c);
+                spn__blk_mul_add(mm, a0->val + 9 * (size_t)L->upos[k - 1], c);
+            }
         }
     return true;
 }
@@ -339,15 +348,14 @@ static inline void forward_step(const spn__lines *L, const spn__bsr *a, uint32_t
     spn__sym_mul(L->dinv + 6 * (size_t)k, r, L->work + 3 * (size_t)k);
 }
 
-/* Step t of line l backward: g_t -= Dinv_t U_t g_{t+1}, then x += g_t. */
-static inline void backward_step(const spn__lines *L, const spn__bsr *a, uint32_t l, uint32_t t, double *x)
+/* Step t of line l backward: g_t -= (Dinv_t U_t) g_{t+1}, then x += g_t. */
+static inline void backward_step(const spn__lines *L, uint32_t l, uint32_t t, double *x)
 {
     uint32_t k = L->start[l] + t;
     double *g = L->work + 3 * (size_t)k;
     if (k + 1 < L->start[l + 1]) {
-        double uv[3], c[3];
-        spn__blk_mul_vec(a->val + 9 * (size_t)L->upos[k], g + 3, uv);
-        spn__sym_mul(L->dinv + 6 * (size_t)k, uv, c);
+        double c[3];
+        spn__blk_mul_vec(L->cu + 9 * (size_t)k, g + 3, c);
         g[0] -= c[0], g[1] -= c[1], g[2] -= c[2];
     }
     double *xi = x + 3 * (size_t)L->node[k];
@@ -365,7 +373,7 @@ static void solve_group(const spn__lines *L, const spn__bsr *a, uint32_t l0, uin
             if (t < L->start[l + 1] - L->start[l]) forward_step(L, a, l, t, b, x);
     for (uint32_t t = longest; t-- > 0;)
         for (uint32_t l = l0; l < l1; l++)
-            if (t < L->start[l + 1] - L->start[l]) backward_step(L, a, l, t, x);
+            if (t < L->start[l + 1] - L->start[l]) backward_step(L, l, t, x);
 }
 
 void spn__lines_sweep(const spn__lines *L, const spn__bsr *a0, const double *b, double *x, bool forward, int threads)

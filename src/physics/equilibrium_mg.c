@@ -399,7 +399,7 @@ static void smooth(const spn__mg *mg, int l, const double *b, double *x, bool fo
     else spn__bsr_gauss_seidel(&L->A, L->dinv, b, x, forward);
 }
 
-static void vcycle(const spn__mg *mg, int l, const double *b, double *x)
+static void vcycle(const spn__mg *mg, const spn__eq *e, int l, const double *b, double *x)
 {
     const mg_level *L = &mg->lv[l], *C = &mg->lv[l + 1];
     if (l == mg->nlevels - 1) {
@@ -408,9 +408,15 @@ static void vcycle(const spn__mg *mg, int l, const double *b, double *x)
     }
     memset(x, 0, 3 * (size_t)L->A.rows * sizeof *x);
     smooth(mg, l, b, x, true);
-    spn__bsr_residual(&L->A, b, x, L->r, mg->threads);
+    if (l == 0) { /* the spring system's own product reads each spring's 6 numbers once, not 2 x 9 */
+        spn__eq_matvec(e, x, L->r);
+        const uint32_t n3 = 3 * L->A.rows;
+        for (uint32_t k = 0; k < n3; k++) L->r[k] = b[k] - L->r[k];
+    } else {
+        spn__bsr_residual(&L->A, b, x, L->r, mg->threads);
+    }
     spn__bsr_apply(&L->R, L->r, C->b, false, mg->threads);
-    vcycle(mg, l + 1, C->b, C->x);
+    vcycle(mg, e, l + 1, C->b, C->x);
     spn__bsr_apply(&L->P, C->x, x, true, mg->threads);
     smooth(mg, l, b, x, false);
 }
@@ -421,5 +427,5 @@ void spn__mg_apply(const spn__mg *mg, const spn__eq *e, const double *r, double 
         for (uint32_t i = 0; i < e->n; i++) spn__sym_mul(mg->lv[0].dinv + 6 * (size_t)i, r + 3 * (size_t)i, z + 3 * (size_t)i);
         return;
     }
-    vcycle(mg, 0, r, z);
+    vcycle(mg, e, 0, r, z);
 }
