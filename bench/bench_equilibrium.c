@@ -15,7 +15,8 @@
  * Also the cloth and the hanging chain from the shared scenes.
  * One JSON line per figure, with the one-minute load average at its start
  * (wall time on a shared machine is only meaningful beside it). `--quick`:
- * the 5k web only; `--full`: add the 1M web (minutes). */
+ * the 5k web only; `--full`: add the 1M web (minutes); `--large`: the 1M
+ * web only. */
 #include "common/bench_common.h"
 
 #include <math.h>
@@ -140,7 +141,13 @@ static void other_scenes(void)
 int main(int argc, char **argv)
 {
     bool quick = argc > 1 && strcmp(argv[1], "--quick") == 0, full = argc > 1 && strcmp(argv[1], "--full") == 0;
+    bool large_only = argc > 1 && strcmp(argv[1], "--large") == 0;
     const spn_precond MG = SPN_PRECOND_MULTIGRID, BJ = SPN_PRECOND_BLOCK_JACOBI, SGS = SPN_PRECOND_SGS;
+    const figure large[] = {{"orb-1M", MG, 1, 1e-6}, {"orb-1M", MG, 2, 1e-6}, {"orb-1M", MG, 2, 1e-9}};
+    if (large_only) {
+        orb(&BENCH_ORB_SIZES[2], false, large, (int)(sizeof large / sizeof *large));
+        return 0;
+    }
     const figure small[] = {{"orb-5k", BJ, 1, 1e-6},  {"orb-5k", SGS, 1, 1e-6}, {"orb-5k", MG, 1, 1e-6},
                             {"orb-5k", BJ, 1, 1e-9},  {"orb-5k", SGS, 1, 1e-9}, {"orb-5k", MG, 1, 1e-9},
                             {"orb-5k", BJ, 2, 1e-6},  {"orb-5k", MG, 2, 1e-6}};
@@ -149,10 +156,7 @@ int main(int argc, char **argv)
     const figure mid[] = {{"orb-100k", BJ, 1, 1e-6}, {"orb-100k", MG, 1, 1e-6}, {"orb-100k", MG, 1, 1e-9},
                           {"orb-100k", MG, 2, 1e-6}};
     orb(&BENCH_ORB_SIZES[1], false, mid, (int)(sizeof mid / sizeof *mid));
-    if (full) {
-        const figure large[] = {{"orb-1M", MG, 1, 1e-6}, {"orb-1M", MG, 2, 1e-6}, {"orb-1M", MG, 2, 1e-9}};
-        orb(&BENCH_ORB_SIZES[2], false, large, (int)(sizeof large / sizeof *large));
-    }
+    if (full) orb(&BENCH_ORB_SIZES[2], false, large, (int)(sizeof large / sizeof *large));
     other_scenes();
     return 0;
 }
