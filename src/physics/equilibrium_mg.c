@@ -46,6 +46,8 @@
 
 #define THETA 0.08      /* strong coupling (block norms, scaled by the diagonals) */
 #define COARSEST 40u    /* particles on the level solved by dense Cholesky */
+#define DENSE_MAX 300u  /* a coarsest level larger than this (coarsening stalled) gets Gauss-Seidel sweeps instead */
+#define COARSE_SWEEPS 4
 #define MAX_LEVELS 24
 #define MAX_SMOOTHED_ROW 64.0 /* blocks a row above which a level's prolongator is not smoothed */
 #define POWER_STEPS 10  /* power iterations for rho(D^-1 A) on coarse levels */
@@ -150,10 +152,16 @@ static uint32_t aggregate(const spn__bsr *a, uint32_t *agg, double theta)
         dn[i] = fro(a->val + 9 * (size_t)a->start[i]);
     }
     for (uint32_t i = 0; i < n; i++) { /* roots whose strong neighbours are all free */
-        bool free_all = agg[i] == NONE;
+        bool free_all = agg[i] == NONE, any = false;
         for (uint32_t p = a->start[i]; p < a->start[i + 1] && free_all; p++)
-            if (strong(a, dn, i, p, theta) && agg[a->col[p]] != NONE) free_all = false;
-        if (!free_all) continue;
+            if (strong(a, dn, i, p, theta)) {
+                any = true;
+                if (agg[a->col[p]] != NONE) free_all = false;
+            }
+        /* a particle tied only weakly (slack threads) joins a neighbour below
+         * instead of rooting an aggregate of one: on a species web those
+         * stalled the coarsening and left a dense coarsest level of 1,000+ rows */
+        if (!free_all || !any) continue;
         agg[i] = na;
         for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++)
             if (strong(a, dn, i, p, theta)) agg[a->col[p]] = na;
@@ -366,9 +374,10 @@ static spn_status build(spn__mg *mg, const spn__eq *e, const double *inv0)
         if ((uint64_t)mg->lv[l + 1].A.rows * 10 > (uint64_t)mg->lv[l].A.rows * 9) break; /* stalled */
     }
     size_t N = 3 * (size_t)mg->lv[mg->nlevels - 1].A.rows;
+    if (mg->nlevels == 1 || N > 3 * DENSE_MAX) return SPN_OK;
     mg->dense = malloc((N ? N * N : 1) * sizeof *mg->dense);
     if (!mg->dense) return SPN_ERR_NOMEM;
-    return mg->nlevels == 1 || dense_factor(mg) ? SPN_OK : SPN_ERR_UNSTABLE;
+    return dense_factor(mg) ? SPN_OK : SPN_ERR_UNSTABLE;
 }
 
 spn_status spn__mg_setup(spn__mg **out, const spn__eq *e, const double *inv0)
@@ -402,8 +411,14 @@ static void smooth(const spn__mg *mg, int l, const double *b, double *x, bool fo
 static void vcycle(const spn__mg *mg, const spn__eq *e, int l, const double *b, double *x)
 {
     const mg_level *L = &mg->lv[l], *C = &mg->lv[l + 1];
-    if (l == mg->nlevels - 1) {
+    if (l == mg->nlevels - 1 && mg->dense) {
         dense_solve(mg, b, x);
+        return;
+    }
+    if (l == mg->nlevels - 1) { /* symmetric: as many sweeps back as forth */
+        memset(x, 0, 3 * (size_t)L->A.rows * sizeof *x);
+        for (int k = 0; k < COARSE_SWEEPS; k++) spn__bsr_gauss_seidel(&L->A, L->dinv, b, x, true);
+        for (int k = 0; k < COARSE_SWEEPS; k++) spn__bsr_gauss_seidel(&L->A, L->dinv, b, x, false);
         return;
     }
     memset(x, 0, 3 * (size_t)L->A.rows * sizeof *x);
