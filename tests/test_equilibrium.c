@@ -348,8 +348,7 @@ static void test_same_bits_twice_and_with_two_threads(void **state)
 /* The multigrid's CG iterations grow slowly with the web (smoothed
  * aggregation with thread-line smoothing; the plain aggregation it replaced
  * needed 168 at 5k and 648 at 100k): a web 20 times larger needs at most
- * twice as many. Measured: 22 (1k) and 42 (20k); 25 (5k) and 57 (50k);
- * block Jacobi 462 at 5k. */
+ * twice as many. Measured: 20 (1k) and 32 (20k); block Jacobi 462 at 5k. */
 static int multigrid_cg(int rings, int radials)
 {
     spn_orb_scene_def od = spn_orb_scene_def_default();
