@@ -113,8 +113,6 @@ spn__lines *spn__lines_build(const spn__eq *e, const struct spn__bsr *a0);
 bool spn__lines_factor(spn__lines *L, const struct spn__bsr *a0);
 void spn__lines_sweep(const spn__lines *L, const struct spn__bsr *a0, const double *b, double *x, bool forward,
                       int threads);
-uint32_t spn__lines_count(const spn__lines *L);
-uint32_t spn__lines_colours(const spn__lines *L);
 void spn__lines_free(spn__lines *L);
 
 #endif

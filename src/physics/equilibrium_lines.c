@@ -286,8 +286,6 @@ fail:
     return NULL;
 }
 
-uint32_t spn__lines_count(const spn__lines *L) { return L ? L->count : 0; }
-uint32_t spn__lines_colours(const spn__lines *L) { return L ? L->colours : 0; }
 
 /* out = sym(D - U^T M U), M symmetric (6), U a full block, D full (9). */
 static void schur(const double *d, const double *m, const double *u, double *out)
