@@ -5,6 +5,8 @@
  *
  *   bench_step            the full run (a couple of minutes)
  *   bench_step --quick    the 5,000-particle web only
+ *   bench_step --parallel-min N   def.parallel_min = N (default 32,768): the
+ *                         size from which loops, and the lattice, use threads
  *
  * Explicit steps use dt = 1e-7 s (inside the stability limit of the finest
  * web); the adaptive stepper an outer step of 1e-6 s (its sub-step count is
@@ -69,9 +71,10 @@ static double step_size(spn_integrator integ)
 }
 
 /* Time `steps` steps of one integrator on 1 or 2 threads; print one line. */
-static int bench_one(const size_case *c, spn_integrator integ, int threads, bool lattice)
+static int bench_one(const size_case *c, spn_integrator integ, int threads, bool lattice, long parallel_min)
 {
     spn_world_def def = spn_world_def_default();
+    if (parallel_min > 0) def.parallel_min = (uint32_t)parallel_min;
     def.integrator = integ;
     def.threads = threads;
     def.cg_tolerance = 1e-8;
@@ -126,18 +129,23 @@ static int bench_one(const size_case *c, spn_integrator integ, int threads, bool
 int main(int argc, char **argv)
 {
     int ncases = 3;
+    long parallel_min = 0; /* 0: the world's default */
     for (int i = 1; i < argc; i++) {
+        char *end = NULL;
         if (strcmp(argv[i], "--quick") == 0) ncases = 1;
+        else if (strcmp(argv[i], "--parallel-min") == 0 && i + 1 < argc &&
+                 (parallel_min = strtol(argv[++i], &end, 10)) >= 1 && parallel_min <= 0x7fffffffL && *end == 0)
+            continue;
         else {
-            fprintf(stderr, "usage: bench_step [--quick]\n");
+            fprintf(stderr, "usage: bench_step [--quick] [--parallel-min N (1..2^31-1)]\n");
             return 2;
         }
     }
     for (int c = 0; c < ncases; c++)
         for (int integ = 0; integ < SPN_INTEGRATOR_COUNT; integ++)
             for (int threads = 1; threads <= 2; threads++) {
-                if (bench_one(&cases[c], (spn_integrator)integ, threads, true)) return 1;
-                if (integ <= SPN_INTEGRATOR_RK4 && bench_one(&cases[c], (spn_integrator)integ, threads, false))
+                if (bench_one(&cases[c], (spn_integrator)integ, threads, true, parallel_min)) return 1;
+                if (integ <= SPN_INTEGRATOR_RK4 && bench_one(&cases[c], (spn_integrator)integ, threads, false, parallel_min))
                     return 1;
             }
     return 0;

@@ -51,18 +51,31 @@ def step_table(rows):
     return "\n".join(out)
 
 
+def equal_accuracy(r):
+    """Bullet's cost over ours once its strain error matches ours (the peer
+    shrinks Bullet's step until it does, or gives up)."""
+    if "equal_accuracy_reached" not in r:
+        return "–"
+    if r["equal_accuracy_reached"]:
+        return f"{r['equal_accuracy_cpu_ratio']:.1f} (Bullet at dt/{r['equal_accuracy_bullet_refine']})"
+    return (f"never: Bullet's best {r['bullet_best_strain_error']:.2g} at dt/{r['bullet_best_refine']}, "
+            f"{r['equal_accuracy_bullet_strain_error']:.2g} at dt/{r['equal_accuracy_bullet_refine']}")
+
+
 def peer_table(rows):
     peer = [r for r in rows if r.get("bench") == "peer_bullet_softbody"]
     if not peer:
         return ""
-    out = ["| particles | Bullet CPU (wall) | Spinneret CPU (wall) | ratio CPU (wall) | strain error Bullet / ours |",
-           "|---:|---:|---:|---:|---:|"]
+    out = ["| particles | Bullet CPU (wall) | Spinneret CPU (wall) | ratio CPU (wall) | strain error Bullet / ours "
+           "| CPU ratio at equal accuracy |",
+           "|---:|---:|---:|---:|---:|---:|"]
     for r in peer:
         out.append(f"| {r['particles']:,} | {r.get('bullet_cpu_ns_per_spring_step', float('nan')):.1f} "
                    f"({r['bullet_ns_per_spring_step']:.0f}) | "
                    f"{r.get('spinneret_cpu_ns_per_spring_step', float('nan')):.1f} "
                    f"({r['spinneret_ns_per_spring_step']:.0f}) | {r.get('cpu_ratio', float('nan')):.1f} "
-                   f"({r['ratio']:.1f}) | {r['bullet_strain_error']:.2g} / {r['spinneret_strain_error']:.2g} |")
+                   f"({r['ratio']:.1f}) | {r['bullet_strain_error']:.2g} / {r['spinneret_strain_error']:.2g} | "
+                   f"{equal_accuracy(r)} |")
     return "\n".join(out)
 
 
