@@ -21,6 +21,7 @@ cat >"$T/spinneret" <<WRAP
 exec $(command -v valgrind) ${vg[*]:1} --log-file=$T/vg-%p.log "$build/spinneret" "\$@"
 WRAP
 chmod +x "$T/spinneret"
+ln -s "$build/tests" "$T/tests" # CLI tests find their probes beside the program
 failed=0 start=$(date +%s)
 report() { printf '{"test":"%s","seconds":%s,"ok":%s}\n' "$1" "$2" "$3"; }
 for t in "$build"/tests/test_*; do
