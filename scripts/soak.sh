@@ -42,7 +42,7 @@ checked=0
 if "$S" animate --help >/dev/null 2>&1; then
   mode=animate
   mkdir -p "$T/states"
-  "$S" animate "$T/web.json" -o "$T/frames" --duration "$duration" --fps 2 --size 320x320 --quiet --solver implicit \
+  "$S" animate "$T/web.json" -o "$T/frames" --duration "$duration" --fps 2 --size 320x320 --quiet --solver implicit --substeps 10 --solver-tol 1e-3 \
     --wind air --wind-speed 3 --gust 0.6 --turbulence 0.3 --save-states "$T/states" \
     --impact '0.01,0.02,-0.2;0,0,2;0.0002;0.004' --impact '-0.03,0.05,-0.4;0.1,-0.2,3;0.0005;0.006' \
     2>"$T/err" &

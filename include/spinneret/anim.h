@@ -235,6 +235,7 @@ typedef struct spn_anim_def {
     double fps;                ///< frames per second, default 25
     int substeps;              ///< steps per frame; 0 (default): chosen for stability
     spn_integrator solver;     ///< SPN_INTEGRATOR_COUNT (default): keep the world's
+    double cg_tolerance;       ///< implicit: CG relative residual for the run; 0 (default): keep the world's
     int first_frame;           ///< frames handed to the callback: first..last, default 0
     int last_frame;            ///< -1 (default): to the end
     spn_wind_kind wind;

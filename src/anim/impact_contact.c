@@ -213,7 +213,7 @@ double spn_impact_step_limit(const spn_impact *im, const spn_world *w, double dt
         spn_vec3 c = spn_world_position(w, im->prey[p]);
         double speed = spn_v3_len(spn_world_velocity(w, im->prey[p])), R = im->radius[p];
         /* far from the web the prey flies freely: any step will do */
-        if (box_distance(c, lo, hi) > R + 2 * speed * dt) continue;
+        if (box_distance(c, lo, hi) > R + 1.5 * speed * dt) continue;
         if (speed * limit > 0.1 * R) limit = 0.1 * R / speed;
     }
     return limit;

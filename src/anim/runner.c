@@ -20,6 +20,7 @@ typedef struct runner {
     spn_thesis_wind *thesis;
     spn_air_field *air;
     spn_impact *impact;
+    double cg_tolerance; /* the world's, restored after the run */
 } runner;
 
 spn_anim_def spn_anim_def_default(void)
@@ -101,6 +102,7 @@ static spn_status check_def(const spn_anim_def *d)
     if (!(d->duration >= 0) || !(d->duration <= 1e5)) return spn_error(SPN_ERR_INVALID, "duration must be in [0, 1e5] s");
     if (!(d->fps > 0) || !(d->fps <= 10000)) return spn_error(SPN_ERR_INVALID, "fps must be in (0, 10000]");
     if (d->substeps < 0) return spn_error(SPN_ERR_INVALID, "substeps must be >= 0");
+    if (!(d->cg_tolerance >= 0 && d->cg_tolerance < 1)) return spn_error(SPN_ERR_INVALID, "solver tolerance must be in [0, 1)");
     int frames = spn_anim_frame_count(d);
     if (d->first_frame < 0 || d->first_frame >= frames)
         return spn_error(SPN_ERR_INVALID, "frame range starts at %d, outside 0..%d", d->first_frame, frames - 1);
@@ -148,7 +150,10 @@ static spn_status setup(runner *r, spn_world **w)
 {
     spn_status st = SPN_OK;
     if (r->def.solver != SPN_INTEGRATOR_COUNT) spn_world_set_integrator(*w, r->def.solver);
-    if (r->def.nprey > 0) st = spn_impact_create(w, r->def.prey, r->def.nprey, &r->def.impact, &r->impact);
+    r->cg_tolerance = spn_world_get_def(*w)->cg_tolerance;
+    if (r->def.cg_tolerance > 0)
+        st = spn_world_set_solver_tolerance(*w, r->def.cg_tolerance, spn_world_get_def(*w)->cg_max_iterations);
+    if (st == SPN_OK && r->def.nprey > 0) st = spn_impact_create(w, r->def.prey, r->def.nprey, &r->def.impact, &r->impact);
     if (st == SPN_OK && r->def.wind == SPN_WIND_THESIS) {
         spn_thesis_wind_def td = r->def.thesis;
         td.seed = r->def.seed;
@@ -162,6 +167,7 @@ static spn_status setup(runner *r, spn_world **w)
 
 static void teardown(runner *r, spn_world *w)
 {
+    if (r->def.cg_tolerance > 0) spn_world_set_solver_tolerance(w, r->cg_tolerance, spn_world_get_def(w)->cg_max_iterations);
     spn_world_set_force_callback(w, NULL, NULL);
     spn_world_set_break_callback(w, NULL, NULL);
     if (r->air) spn_world_set_air(w, NULL, NULL, r->def.air.rho, r->def.air.mu);
@@ -187,7 +193,7 @@ static spn_status one_step(runner *r, spn_world *w, double dt, uint64_t *steps)
  * of the state, so a frame is the same bits in any frame range. */
 static spn_status advance_frame(runner *r, spn_world *w, int substeps, double dt, uint64_t *steps, bool *stopped)
 {
-    const bool split = r->impact && spn_world_get_def(w)->integrator == SPN_INTEGRATOR_IMPLICIT && r->def.substeps == 0;
+    const bool split = r->impact && spn_world_get_def(w)->integrator == SPN_INTEGRATOR_IMPLICIT;
     for (int s = 0; s < substeps; s++) {
         double limit = split ? spn_impact_step_limit(r->impact, w, dt) : dt;
         int n = limit < dt ? (int)fmin(1e6, ceil(dt / limit)) : 1;
