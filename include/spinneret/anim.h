@@ -137,7 +137,8 @@ typedef struct spn_impact_def {
     bool plastic;              ///< threads yield past spn_thread_yield_strain (silk's hysteresis), default true
     double glue_strength;      ///< capture-thread glue: a droplet holding the prey lets go past this pull [N],
                                ///< default 4e-5 (tens of uN, Opell & Hendricks 2007); 0: not sticky
-    bool hysteresis;           ///< silk threads dissipate spn_thread_hysteresis of each loading cycle, default true
+    bool hysteresis;           ///< silk threads dissipate spn_thread_hysteresis of each loading cycle, default
+                               ///< true (with the implicit solver; explicit steps go without)
 } spn_impact_def;
 
 SPN_API spn_impact_def spn_impact_def_default(void);
@@ -214,7 +215,8 @@ SPN_API void spn_impact_track_wind(spn_impact *impact, spn_force_fn fn, void *us
 /// prey's contacts (spn_world_set_contacts) so it integrates them implicitly.
 SPN_API spn_status spn_impact_before_step(spn_impact *impact, spn_world *w, double dt);
 /// The step the prey need now [s]: at most a tenth of a radius of travel
-/// relative to the web while near it; `dt` (unchanged) otherwise.
+/// near the web, or 0.8 of the free flight to the web's bounding box; `dt`
+/// when that is shorter.
 SPN_API double spn_impact_step_limit(const spn_impact *impact, const spn_world *w, double dt);
 /// Update the energy ledger after a step of `dt` (call after every step).
 SPN_API void spn_impact_after_step(spn_impact *impact, spn_world *w, double dt);

@@ -243,8 +243,6 @@ void spn_impact_destroy(spn_impact *im)
     free(im->cseg);
     free(im->v0);
     free(im->cl);
-    free(im->cdepth);
-    free(im->ctether);
     free(im);
 }
 

@@ -32,24 +32,18 @@ static spn_status grow(spn_impact *im, uint32_t n)
     uint32_t cap = n < 64 ? 64 : 2 * n;
     spn_contact *c = realloc(im->cl, cap * sizeof *c);
     if (c) im->cl = c;
-    double *d = realloc(im->cdepth, cap * sizeof *d);
-    if (d) im->cdepth = d;
-    uint8_t *t = realloc(im->ctether, cap);
-    if (t) im->ctether = t;
     uint32_t *g = realloc(im->cseg, cap * sizeof *g);
     if (g) im->cseg = g;
-    if (!c || !d || !t || !g) return spn_error(SPN_ERR_NOMEM, "out of memory for %u contacts", n);
+    if (!c || !g) return spn_error(SPN_ERR_NOMEM, "out of memory for %u contacts", n);
     im->cap_cl = cap;
     return SPN_OK;
 }
 
-static spn_status push(spn_impact *im, spn_contact c, double depth, bool tether, uint32_t seg)
+static spn_status push(spn_impact *im, spn_contact c, uint32_t seg)
 {
     spn_status st = grow(im, im->ncl + 1);
     if (st != SPN_OK) return st;
     im->cl[im->ncl] = c;
-    im->cdepth[im->ncl] = depth;
-    im->ctether[im->ncl] = tether;
     im->cseg[im->ncl] = seg;
     im->ncl++;
     return SPN_OK;
@@ -99,7 +93,7 @@ static spn_status list_segments(spn_impact *im, const spn_vec3 *x, int p)
         double d = sqrt(d2), y = spn__impact_offset_depth(im, (size_t)p * im->ns + s, R - d, true);
         im->touched[p] = true;
         spn_contact ct = {ip, im->sa[s], im->sb[s], u, spn_v3_scale(r, 1 / d), im->kc, y, false, true};
-        spn_status st = push(im, ct, y, false, (uint32_t)p * im->ns + s);
+        spn_status st = push(im, ct, (uint32_t)p * im->ns + s);
         if (st != SPN_OK) return st;
     }
     return SPN_OK;
@@ -116,7 +110,7 @@ static spn_status list_tethers(spn_impact *im, const spn_vec3 *x)
         /* listed slack too: the world's active set drops it if it stays slack */
         t->listed = true;
         spn_contact ct = {ip, a, b, t->u, spn_v3_scale(l, 1 / len), im->kg, t->rest - len, true, true};
-        spn_status st = push(im, ct, t->rest - len, true, UINT32_MAX);
+        spn_status st = push(im, ct, UINT32_MAX);
         if (st != SPN_OK) return st;
     }
     return SPN_OK;
@@ -173,10 +167,10 @@ static double contacts_loss(const spn_impact *im, const spn_world *w, const spn_
         spn_vec3 dp = spn_v3_sub(x1[c->p], im->x0[c->p]);
         spn_vec3 da = spn_v3_sub(x1[c->a], im->x0[c->a]), db = spn_v3_sub(x1[c->b], im->x0[c->b]);
         spn_vec3 dg = spn_v3_sub(dp, spn_v3_add(spn_v3_scale(da, 1 - c->u), spn_v3_scale(db, c->u)));
-        double y0 = im->cdepth[i], y1 = y0 - spn_v3_dot(c->n, dg), dy = y1 - y0;
+        double y0 = c->depth, y1 = y0 - spn_v3_dot(c->n, dg), dy = y1 - y0;
         if (im->cseg[i] != UINT32_MAX) im->cend[im->cseg[i]] = fmax(y1, 0);
         /* the part of the linear model's energy the one-sided law does not have */
-        double off0 = im->ctether[i] ? fmin(-y0, 0) : fmin(y0, 0), off1 = im->ctether[i] ? fmin(-y1, 0) : fmin(y1, 0);
+        double off0 = c->pull ? fmin(-y0, 0) : fmin(y0, 0), off1 = c->pull ? fmin(-y1, 0) : fmin(y1, 0);
         loss += 0.5 * c->k * (dy * dy + off1 * off1 - off0 * off0);
     }
     return loss;
@@ -212,9 +206,11 @@ double spn_impact_step_limit(const spn_impact *im, const spn_world *w, double dt
     for (int p = 0; p < im->nprey; p++) {
         spn_vec3 c = spn_world_position(w, im->prey[p]);
         double speed = spn_v3_len(spn_world_velocity(w, im->prey[p])), R = im->radius[p];
-        /* far from the web the prey flies freely: any step will do */
-        if (box_distance(c, lo, hi) > R + 1.5 * speed * dt) continue;
-        if (speed * limit > 0.1 * R) limit = 0.1 * R / speed;
+        if (!(speed > 0)) continue;
+        /* a tenth of a radius per step, or a free flight up to most of the
+         * way to the web's box, whichever is longer */
+        double step = fmax(0.1 * R, 0.8 * (box_distance(c, lo, hi) - R)) / speed;
+        if (step < limit) limit = step;
     }
     return limit;
 }

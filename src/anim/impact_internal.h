@@ -58,11 +58,9 @@ struct spn_impact {
     void *wind_user;
     spn_vec3 *fbuf;
     /* implicit contacts (impact_contact.c): the list handed to the world
-     * before a step, with each contact's depth at the step's start */
+     * before a step */
     bool listed;                  /* the list holds this step's contacts */
     spn_contact *cl;
-    double *cdepth;
-    uint8_t *ctether;             /* 1: a glue tether (acts when depth < 0) */
     uint32_t ncl, cap_cl;
     spn_vec3 *x0, *v0;            /* state before the step, for the solver's loss */
     double *coff;                 /* per prey and segment: contact offset, < 0 when not touching */
