@@ -5,6 +5,8 @@
  *
  *   bench_step            the full run (a couple of minutes)
  *   bench_step --quick    the 5,000-particle web only
+ *   bench_step --parallel-min N   def.parallel_min = N (default 32,768): the
+ *                         size from which loops, and the lattice, use threads
  *
  * Explicit steps use dt = 1e-7 s (inside the stability limit of the finest
  * web); the adaptive stepper an outer step of 1e-6 s (its sub-step count is
@@ -15,7 +17,12 @@
  * time of the steps only, after one
  * warm-up step (which compiles the world); also the process CPU time (all
  * threads) per spring-step and the load average, because on a shared machine
- * the wall clock measures the neighbours too. */
+ * the wall clock measures the neighbours too.
+ *
+ * Euler, symplectic Euler and RK4 run twice: on the default path ("path":
+ * "lattice", the stencil step of a regular web, see src/physics/lattice.c)
+ * and with the lattice forbidden ("path":"general", the spring-record loops
+ * any world takes). */
 #include <spinneret/spinneret.h>
 
 #include <stdio.h>
@@ -64,9 +71,10 @@ static double step_size(spn_integrator integ)
 }
 
 /* Time `steps` steps of one integrator on 1 or 2 threads; print one line. */
-static int bench_one(const size_case *c, spn_integrator integ, int threads)
+static int bench_one(const size_case *c, spn_integrator integ, int threads, bool lattice, long parallel_min)
 {
     spn_world_def def = spn_world_def_default();
+    if (parallel_min > 0) def.parallel_min = (uint32_t)parallel_min;
     def.integrator = integ;
     def.threads = threads;
     def.cg_tolerance = 1e-8;
@@ -78,6 +86,7 @@ static int bench_one(const size_case *c, spn_integrator integ, int threads)
         fprintf(stderr, "bench_step: %s\n", spn_last_error());
         return 1;
     }
+    spn_world_set_lattice(w, lattice);
     const double dt = step_size(integ);
     if (spn_world_step(w, dt) != SPN_OK) {
         fprintf(stderr, "bench_step: %s\n", spn_last_error());
@@ -100,9 +109,9 @@ static int bench_one(const size_case *c, spn_integrator integ, int threads)
     double ns_spring_step = sec * per;
     printf("{\"bench\":\"step\",\"scene\":\"orb\",\"integrator\":\"%s\",\"particles\":%u,\"springs\":%u,"
            "\"threads\":%d,\"steps\":%d,\"dt\":%g,\"ns_per_spring_step\":%.3f,\"cpu_ns_per_spring_step\":%.3f,"
-           "\"load\":%.2f",
+           "\"load\":%.2f,\"path\":\"%s\"",
            spn_integrator_name(integ), spn_world_particle_count(w), spn_world_spring_count(w), threads, steps, dt,
-           ns_spring_step, cpu * per, load_average());
+           ns_spring_step, cpu * per, load_average(), spn_world_step_path(w));
     if (integ == SPN_INTEGRATOR_ADAPTIVE)
         printf(",\"substeps_per_step\":%.1f,\"ns_per_spring_substep\":%.3f", (double)substeps / steps,
                ns_spring_step * steps / (double)substeps);
@@ -120,16 +129,24 @@ static int bench_one(const size_case *c, spn_integrator integ, int threads)
 int main(int argc, char **argv)
 {
     int ncases = 3;
+    long parallel_min = 0; /* 0: the world's default */
     for (int i = 1; i < argc; i++) {
+        char *end = NULL;
         if (strcmp(argv[i], "--quick") == 0) ncases = 1;
+        else if (strcmp(argv[i], "--parallel-min") == 0 && i + 1 < argc &&
+                 (parallel_min = strtol(argv[++i], &end, 10)) >= 1 && parallel_min <= 0x7fffffffL && *end == 0)
+            continue;
         else {
-            fprintf(stderr, "usage: bench_step [--quick]\n");
+            fprintf(stderr, "usage: bench_step [--quick] [--parallel-min N (1..2^31-1)]\n");
             return 2;
         }
     }
     for (int c = 0; c < ncases; c++)
         for (int integ = 0; integ < SPN_INTEGRATOR_COUNT; integ++)
-            for (int threads = 1; threads <= 2; threads++)
-                if (bench_one(&cases[c], (spn_integrator)integ, threads)) return 1;
+            for (int threads = 1; threads <= 2; threads++) {
+                if (bench_one(&cases[c], (spn_integrator)integ, threads, true, parallel_min)) return 1;
+                if (integ <= SPN_INTEGRATOR_RK4 && bench_one(&cases[c], (spn_integrator)integ, threads, false, parallel_min))
+                    return 1;
+            }
     return 0;
 }

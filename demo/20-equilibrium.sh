@@ -38,11 +38,14 @@ t0=$(date +%s%N)
 "$SPN" settle "$OUT/equil-web.json" -o "$OUT/equil-static.json" --method equilibrium --load $load --rel-tol 1e-9
 t1=$(date +%s%N)
 echo "equilibrium demo: $(( (t1 - t0) / 1000000 )) ms, program start and file IO included" >&2
-python3 - "$OUT/equil-static.json" <<'PY'
+# the same with the multigrid (smoothed aggregation, thread-line smoothing): the same rest state
+"$SPN" settle "$OUT/equil-web.json" -o "$OUT/equil-static-mg.json" --method equilibrium --load $load --rel-tol 1e-9 \
+    --preconditioner multigrid
+python3 - "$OUT/equil-static.json" "$OUT/equil-static-mg.json" <<'PY'
 import json, sys
-d = json.load(open(sys.argv[1]))
-z = d["particles"]["position"][2]
-print(f"equilibrium demo: the hub moved {z * 1000:.3f} mm out of the plane", file=sys.stderr)
+z = [json.load(open(f))["particles"]["position"][2] for f in sys.argv[1:]]
+print(f"equilibrium demo: the hub moved {z[0] * 1000:.3f} mm out of the plane "
+      f"(multigrid: {z[1] * 1000:.3f} mm, difference {abs(z[0] - z[1]):.1e} m)", file=sys.stderr)
 PY
 if "$SPN" render --help >/dev/null 2>&1; then
     "$SPN" render "$OUT/equil-static.json" -o "$OUT/equil-static.png" || echo "equilibrium demo: render failed"

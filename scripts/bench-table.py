@@ -31,7 +31,11 @@ KNOWN = {
         ("particles", "particles"), ("springs", "springs"), ("steps", "steps"),
         ("bullet_ns_per_spring_step", "Bullet ns/spring/step"),
         ("spinneret_ns_per_spring_step", "Spinneret ns/spring/step"), ("ratio", "ratio"),
-        ("bullet_strain_error", "Bullet strain error"), ("spinneret_strain_error", "Spinneret strain error")]),
+        ("bullet_strain_error", "Bullet strain error"), ("spinneret_strain_error", "Spinneret strain error"),
+        ("spinneret_path", "Spinneret path"), ("equal_accuracy_reached", "Bullet reaches our error"),
+        ("equal_accuracy_bullet_refine", "Bullet step divisor tried"),
+        ("equal_accuracy_bullet_strain_error", "its strain error"),
+        ("equal_accuracy_cpu_ratio", "CPU ratio at that divisor")]),
     "bandwidth": ("Memory bandwidth (bench/bench_bandwidth.c, STREAM-style)", [
         ("kernel", "kernel"), ("threads", "threads"), ("gb_per_s", "GB/s")]),
 }

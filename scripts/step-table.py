@@ -17,11 +17,17 @@ def load(path):
 def step_table(rows):
     steps = [r for r in rows if r.get("bench") == "step"]
     sizes = sorted({r["particles"] for r in steps})
+    stencil = {r["integrator"] for r in steps if r.get("path") == "lattice"}
+
+    def label(r):
+        # the general path of an integrator that also has the lattice (stencil) one
+        general = r.get("path") == "general" and r["integrator"] in stencil
+        return r["integrator"] + (" (general path)" if general else "")
     integrators = []
     for r in steps:
-        if r["integrator"] not in integrators:
-            integrators.append(r["integrator"])
-    get = {(r["integrator"], r["particles"], r["threads"]): r for r in steps}
+        if label(r) not in integrators:
+            integrators.append(label(r))
+    get = {(label(r), r["particles"], r["threads"]): r for r in steps}
     head = " | ".join(f"{n:,}" for n in sizes)
     out = [f"| integrator | {head} | 2 threads, CPU (wall) |",
            "|---|" + "---:|" * len(sizes) + "---:|"]
@@ -45,18 +51,31 @@ def step_table(rows):
     return "\n".join(out)
 
 
+def equal_accuracy(r):
+    """Bullet's cost over ours once its strain error matches ours (the peer
+    shrinks Bullet's step until it does, or gives up)."""
+    if "equal_accuracy_reached" not in r:
+        return "–"
+    if r["equal_accuracy_reached"]:
+        return f"{r['equal_accuracy_cpu_ratio']:.1f} (Bullet at dt/{r['equal_accuracy_bullet_refine']})"
+    return (f"never: Bullet's best {r['bullet_best_strain_error']:.2g} at dt/{r['bullet_best_refine']}, "
+            f"{r['equal_accuracy_bullet_strain_error']:.2g} at dt/{r['equal_accuracy_bullet_refine']}")
+
+
 def peer_table(rows):
     peer = [r for r in rows if r.get("bench") == "peer_bullet_softbody"]
     if not peer:
         return ""
-    out = ["| particles | Bullet CPU (wall) | Spinneret CPU (wall) | ratio CPU (wall) | strain error Bullet / ours |",
-           "|---:|---:|---:|---:|---:|"]
+    out = ["| particles | Bullet CPU (wall) | Spinneret CPU (wall) | ratio CPU (wall) | strain error Bullet / ours "
+           "| CPU ratio at equal accuracy |",
+           "|---:|---:|---:|---:|---:|---:|"]
     for r in peer:
         out.append(f"| {r['particles']:,} | {r.get('bullet_cpu_ns_per_spring_step', float('nan')):.1f} "
                    f"({r['bullet_ns_per_spring_step']:.0f}) | "
                    f"{r.get('spinneret_cpu_ns_per_spring_step', float('nan')):.1f} "
                    f"({r['spinneret_ns_per_spring_step']:.0f}) | {r.get('cpu_ratio', float('nan')):.1f} "
-                   f"({r['ratio']:.1f}) | {r['bullet_strain_error']:.2g} / {r['spinneret_strain_error']:.2g} |")
+                   f"({r['ratio']:.1f}) | {r['bullet_strain_error']:.2g} / {r['spinneret_strain_error']:.2g} | "
+                   f"{equal_accuracy(r)} |")
     return "\n".join(out)
 
 

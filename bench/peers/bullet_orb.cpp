@@ -150,10 +150,12 @@ static bullet_run run_bullet(const spn_world *w, double dt, int steps, const std
 }
 
 // Wall and CPU ns per spring-step of our symplectic Euler (one advance call).
-static void run_spinneret(spn_world *w, double dt, int steps, double *wall, double *cpu)
+// *path: "lattice" (the stencil step of a regular web) or "general".
+static void run_spinneret(spn_world *w, double dt, int steps, double *wall, double *cpu, const char **path)
 {
     spn_world_set_integrator(w, SPN_INTEGRATOR_SYMPLECTIC);
     spn_world_compile(w);
+    *path = spn_world_step_path(w);
     double t0 = seconds_now(), c0 = cpu_now();
     if (spn_world_advance(w, dt, steps) != SPN_OK) {
         std::fprintf(stderr, "bullet_orb: %s\n", spn_last_error());
@@ -164,6 +166,53 @@ static void run_spinneret(spn_world *w, double dt, int steps, double *wall, doub
     *cpu = (cpu_now() - c0) * per;
 }
 
+// Cost at equal accuracy: Bullet steps the same simulated time with the step
+// divided by 1, 2, 4, ... (its links' kLST recomputed for each step, so the
+// physical web stays the same) until its largest strain error is no more than
+// `target` (ours at the standard step); it gives up when the next run would
+// pass `budget` CPU seconds or when two halvings in a row fail to beat its
+// best error. Debian's Bullet is built with float32 btScalar, and a node's
+// velocity is its position change over the step: each step's rounding of a
+// position (~1e-8 m here) becomes a velocity error of rounding / dt, so a
+// smaller step makes that noise larger (5k web, measured: 0.012, 0.15, 0.78
+// at dt, dt/2, dt/4). Solver iterations are not the knob: with kLST matched
+// to the spring stiffness, more iterations per step make the links stiffer,
+// a different web, not a more accurate one.
+struct equal_accuracy {
+    int refine;           // step divisor of the last run
+    double strain_error;  // its largest strain error
+    double cpu_seconds;   // its CPU time for the whole simulated span
+    bool reached;         // strain_error <= target
+    int best_refine;      // the divisor that gave the smallest error
+    double best_error;    // that error (Bullet's error need not fall as its step shrinks)
+};
+
+static equal_accuracy bullet_equal_accuracy(const spn_world *w, double dt, int steps, const std::vector<double> &ref,
+                                            double target, const bullet_run &first, double budget)
+{
+    const double spring_steps = (double)spn_world_spring_count(w) * steps;
+    equal_accuracy e = {1, first.strain_error, first.cpu_ns_per_spring_step * spring_steps * 1e-9,
+                        first.strain_error <= target, 1, first.strain_error};
+    int worse = 0; // successive runs with no better error than the best so far
+    while (!e.reached && worse < 2 && 2 * e.cpu_seconds <= budget) {
+        e.refine *= 2;
+        bullet_run b = run_bullet(w, dt / e.refine, steps * e.refine, ref);
+        e.strain_error = b.strain_error;
+        e.cpu_seconds = b.cpu_ns_per_spring_step * spring_steps * e.refine * 1e-9;
+        e.reached = b.strain_error <= target;
+        if (b.strain_error < e.best_error) {
+            e.best_error = b.strain_error;
+            e.best_refine = e.refine;
+            worse = 0;
+        } else {
+            worse++;
+        }
+        std::fprintf(stderr, "bullet_orb: %u particles, Bullet at dt/%d: strain error %.3g (target %.3g)\n",
+                     spn_world_particle_count(w), e.refine, b.strain_error, target);
+    }
+    return e;
+}
+
 int main(int argc, char **argv)
 {
     // dt inside the explicit stability limit of each web's stiffest (innermost,
@@ -171,7 +220,23 @@ int main(int argc, char **argv)
     // enough that no single step trips the blow-up check) and the 1M web blows up.
     struct size { int rings, radials, steps; double dt; } sizes[] = {
         {40, 125, 2000, 1e-6}, {250, 400, 100, 1e-7}, {1000, 1000, 10, 1e-7}};
-    int nsizes = argc > 1 && std::strcmp(argv[1], "--small") == 0 ? 1 : 3;
+    // --small: the 5k web only; --budget S: CPU seconds the equal-accuracy
+    // search may spend on Bullet per web (the runs double, so about 2 S at most).
+    int nsizes = 3;
+    double budget = 60;
+    for (int i = 1; i < argc; i++) {
+        if (std::strcmp(argv[i], "--small") == 0) nsizes = 1;
+        else if (std::strcmp(argv[i], "--budget") == 0 && i + 1 < argc) budget = std::atof(argv[++i]);
+        else if (std::strcmp(argv[i], "--sizes") == 0 && i + 1 < argc) nsizes = std::atoi(argv[++i]);
+        else {
+            std::fprintf(stderr, "usage: bench_peer_bullet [--small] [--sizes 1..3] [--budget CPU_SECONDS]\n");
+            return 2;
+        }
+    }
+    if (nsizes < 1 || nsizes > 3 || !(budget >= 0)) {
+        std::fprintf(stderr, "bench_peer_bullet: --sizes must be 1..3 and --budget >= 0\n");
+        return 2;
+    }
     for (int k = 0; k < nsizes; k++) {
         const size &sz = sizes[k];
         const double dt = sz.dt;
@@ -180,19 +245,30 @@ int main(int argc, char **argv)
         std::vector<double> ref = strains(reference);
         spn_world_destroy(reference);
 
-        spn_world *w = make_web(sz.rings, sz.radials);
-        bullet_run b = run_bullet(w, dt, sz.steps, ref);
+        spn_world *w0 = make_web(sz.rings, sz.radials); // initial state, for every Bullet run
+        bullet_run b = run_bullet(w0, dt, sz.steps, ref);
+        spn_world *w = spn_world_clone(w0);
         double ours, ours_cpu;
-        run_spinneret(w, dt, sz.steps, &ours, &ours_cpu);
+        const char *path;
+        run_spinneret(w, dt, sz.steps, &ours, &ours_cpu, &path);
+        const double our_error = strain_error(w, ref);
+        const double spring_steps = (double)spn_world_spring_count(w) * sz.steps;
+        equal_accuracy e = bullet_equal_accuracy(w0, dt, sz.steps, ref, our_error, b, budget);
         std::printf("{\"bench\":\"peer_bullet_softbody\",\"particles\":%u,\"springs\":%u,\"dt\":%g,\"steps\":%d,"
                     "\"threads\":1,\"bullet_ns_per_spring_step\":%.3f,\"spinneret_ns_per_spring_step\":%.3f,"
                     "\"ratio\":%.2f,\"bullet_cpu_ns_per_spring_step\":%.3f,\"spinneret_cpu_ns_per_spring_step\":%.3f,"
-                    "\"cpu_ratio\":%.2f,\"bullet_strain_error\":%.3g,\"spinneret_strain_error\":%.3g}\n",
+                    "\"cpu_ratio\":%.2f,\"bullet_strain_error\":%.3g,\"spinneret_strain_error\":%.3g,"
+                    "\"spinneret_path\":\"%s\",\"equal_accuracy_bullet_refine\":%d,"
+                    "\"equal_accuracy_bullet_strain_error\":%.3g,\"equal_accuracy_reached\":%s,"
+                    "\"equal_accuracy_cpu_ratio\":%.2f,\"bullet_best_refine\":%d,\"bullet_best_strain_error\":%.3g}\n",
                     spn_world_particle_count(w), spn_world_spring_count(w), dt, sz.steps, b.ns_per_spring_step, ours,
                     b.ns_per_spring_step / ours, b.cpu_ns_per_spring_step, ours_cpu,
-                    b.cpu_ns_per_spring_step / ours_cpu, b.strain_error, strain_error(w, ref));
+                    b.cpu_ns_per_spring_step / ours_cpu, b.strain_error, our_error, path, e.refine,
+                    e.strain_error, e.reached ? "true" : "false", e.cpu_seconds / (ours_cpu * spring_steps * 1e-9),
+                    e.best_refine, e.best_error);
         std::fflush(stdout);
         spn_world_destroy(w);
+        spn_world_destroy(w0);
     }
     return 0;
 }

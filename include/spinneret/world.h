@@ -108,6 +108,17 @@ SPN_API spn_status spn_world_add_spring(spn_world *w, const spn_spring_def *def,
 SPN_API spn_status spn_world_remove_springs(spn_world *w, const bool *remove);
 /// Build the flat stepping arrays now (stepping does it when needed).
 SPN_API spn_status spn_world_compile(spn_world *w);
+/// How the next Euler, symplectic or RK4 step of a compiled world runs:
+/// "lattice" when its springs are exactly a hub + rings x radials web
+/// (particle 0 the hub, 1 + ring * radials + radial the rest, as
+/// spn_scene_orb numbers them) with no spring broken, no force callback and
+/// no air drag: a stencil over rows, no spring records read; otherwise
+/// "general". Both give the same trajectory (bit-identical on webs numbered
+/// like spn_scene_orb below two sweep blocks, round-off apart otherwise).
+SPN_API const char *spn_world_step_path(const spn_world *w);
+/// Allow (the default) or forbid the lattice stencil, e.g. to measure or test
+/// the general path on a regular web.
+SPN_API void spn_world_set_lattice(spn_world *w, bool allow);
 
 /* ---- reading and writing state --------------------------------------- */
 

@@ -13,6 +13,7 @@
 void spn__free_compiled(spn_world *w)
 {
     spn__sweep_free(w);
+    spn__lattice_drop(w);
     free(w->adj_start);
     free(w->adj);
     free(w->a_start);
@@ -50,6 +51,7 @@ void spn__forget_compiled(spn_world *w)
     w->sweep_block = 0;
     w->xout_start = w->xout = w->xin_start = w->xin = NULL;
     w->facc = NULL;
+    w->lat = NULL;
     for (int i = 0; i < SPN_TMP_COUNT; i++) w->tmp[i] = NULL;
     w->compiled = false;
 }
@@ -170,6 +172,7 @@ spn_status spn_world_compile(spn_world *w)
     memset(count, 0, ((size_t)w->np + 1) * sizeof *count);
     build_adjacency(w, count);
     free(count);
+    spn__lattice_build(w);
     if (!alloc_air(w)) {
         spn__free_compiled(w);
         return spn_error(SPN_ERR_NOMEM, "out of memory for air drag on %u springs", w->ns);

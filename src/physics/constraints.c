@@ -139,6 +139,7 @@ int spn__check_breakage(spn_world *w)
         w->sflags[s] |= SPN_SPRING_BROKEN;
         w->hflags[w->iperm[s]] |= SPN_SPRING_BROKEN;
         w->hs[w->iperm[s]] = spn__hot_spring(w, s);
+        spn__lattice_drop(w);
         breaks++;
         if (w->break_fn) w->break_fn(w->break_user, s, w->t, len);
     }

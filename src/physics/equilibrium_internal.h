@@ -106,4 +106,13 @@ spn_status spn__mg_setup(spn__mg **mg, const spn__eq *e, const double *inv0);
 void spn__mg_apply(const spn__mg *mg, const spn__eq *e, const double *r, double *z);
 void spn__mg_free(spn__mg *mg);
 
+/* Thread-line smoother (equilibrium_lines.c) over level 0 of the multigrid. */
+typedef struct spn__lines spn__lines;
+struct spn__bsr;
+spn__lines *spn__lines_build(const spn__eq *e, const struct spn__bsr *a0);
+bool spn__lines_factor(spn__lines *L, const struct spn__bsr *a0);
+void spn__lines_sweep(const spn__lines *L, const struct spn__bsr *a0, const double *b, double *x, bool forward,
+                      int threads);
+void spn__lines_free(spn__lines *L);
+
 #endif

@@ -50,8 +50,18 @@ static inline __attribute__((always_inline)) void explicit_block(
     p[S_KE_NEW] = 0.5 * ke_new;
 }
 
+/* One block of the particle pass, compiled in clones like the spring kernels. */
+SPN__KERNEL static void explicit_range(const spn__gather_ctx *c, uint32_t lo, uint32_t hi, double dt, bool symplectic,
+                                       bool ext, bool backup, spn_vec3 *x, spn_vec3 *v, spn_vec3 *x0, spn_vec3 *v0,
+                                       double *p)
+{
+    if (symplectic && !ext && !backup) explicit_block(c, lo, hi, dt, true, false, false, x, v, x0, v0, p);
+    else explicit_block(c, lo, hi, dt, symplectic, ext, backup, x, v, x0, v0, p);
+}
+
 void spn__step_explicit(spn_world *w, double dt, bool symplectic, spn__step_result *r)
 {
+    if (spn__lattice_explicit(w, dt, symplectic, r)) return;
     if (!w->force_fn && !spn__air_active(w) && spn__step_sweep(w, dt, symplectic, r)) return;
     spn__eval e;
     spn__spring_pass(w, w->t, w->x, w->v, &e);
@@ -60,14 +70,13 @@ void spn__step_explicit(spn_world *w, double dt, bool symplectic, spn__step_resu
     spn_vec3 *restrict x = w->x, *restrict v = w->v, *restrict x0 = w->x0, *restrict v0 = w->v0;
     double *partial = w->partial;
     const spn__gather_ctx ctx = spn__gather_ctx_of(w);
-    const bool backup = !w->no_backup, fast = symplectic && !ext && !backup;
+    const bool backup = !w->no_backup;
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
     for (uint32_t blk = 0; blk < nb; blk++) {
         const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < np ? lo + SPN_BLOCK : np;
         const spn__gather_ctx c = ctx;
         double *p = partial + (size_t)blk * SPN_NSUMS;
-        if (fast) explicit_block(&c, lo, hi, dt, true, false, false, x, v, x0, v0, p);
-        else explicit_block(&c, lo, hi, dt, symplectic, ext, backup, x, v, x0, v0, p);
+        explicit_range(&c, lo, hi, dt, symplectic, ext, backup, x, v, x0, v0, p);
     }
     double sum[SPN_NSUMS];
     spn__sum_partials(w, nb, sum);
@@ -155,6 +164,7 @@ static void rk4_last_block(const rk4_ctx *k, spn_vec3 *restrict x, spn_vec3 *res
 
 spn_status spn__step_rk4(spn_world *w, double dt, spn__step_result *r)
 {
+    if (spn__lattice_rk4(w, dt, r)) return SPN_OK;
     spn_status st = spn__scratch(w, 4);
     if (st != SPN_OK) return st;
     static const double weight[4] = {1, 2, 2, 1}, frac[4] = {0, 0.5, 0.5, 1};

@@ -273,14 +273,20 @@ spn_spring_info spn_world_spring(const spn_world *w, uint32_t s)
 void spn_world_set_spring_rest(spn_world *w, uint32_t s, double rest)
 {
     w->rest[s] = rest;
-    if (w->compiled) w->hs[w->iperm[s]].rest = rest;
+    if (w->compiled) {
+        w->hs[w->iperm[s]].rest = rest;
+        spn__lattice_spring_changed(w, s);
+    }
 }
 
 void spn_world_set_spring_stiffness(spn_world *w, uint32_t s, double k, double kd)
 {
     w->k[s] = k;
     w->kd[s] = kd;
-    if (w->compiled) w->hs[w->iperm[s]] = spn__hot_spring(w, s);
+    if (w->compiled) {
+        w->hs[w->iperm[s]] = spn__hot_spring(w, s);
+        spn__lattice_spring_changed(w, s);
+    }
 }
 void spn_world_set_spring_tag(spn_world *w, uint32_t s, uint32_t tag)
 {
@@ -293,6 +299,7 @@ void spn_world_break_spring(spn_world *w, uint32_t s)
     if (w->compiled) {
         w->hflags[w->iperm[s]] |= SPN_SPRING_BROKEN;
         w->hs[w->iperm[s]] = spn__hot_spring(w, s);
+        spn__lattice_drop(w);
     }
 }
 

@@ -54,6 +54,9 @@ typedef struct spn_tag_diameter {
  * spn__tension_only), and a broken spring has k = kd = 0 here (its public k
  * and kd are kept), so the force loop needs no flag array. Particles are
  * therefore limited to 2^31 - 1. */
+/* A hub + rings x radials web recognised at compile time (lattice.c). */
+typedef struct spn__lattice spn__lattice;
+
 typedef struct spn__spring {
     uint32_t a;
     uint32_t bt; /* end b | tension-only << 31 (named apart so a plain `.b` does not compile) */
@@ -127,6 +130,8 @@ struct spn_world {
     uint32_t *xout_start, *xout;     /* per block: springs whose end b is in a later block */
     uint32_t *xin_start, *xin;       /* per block: springs whose end b is in it, end a before it */
     spn_vec3 *facc;                  /* per-particle spring force accumulator */
+    spn__lattice *lat;               /* the stencil step of a regular orb web (NULL: none) */
+    bool lattice_off;                /* spn_world_set_lattice(w, false) */
     spn_vec3 *tmp[SPN_TMP_COUNT]; /* per-particle scratch, allocated on demand */
     spn_vec3 *fair;       /* per-spring air force (on demand) */
     spn_vec3 *wind;       /* per-spring air velocity at the midpoint (on demand) */
@@ -169,12 +174,12 @@ struct spn_world {
     char *metadata;
 };
 
-/* A kernel also compiled for AVX2, chosen when the program loads (GCC on
- * x86-64 with ifunc support). -ffp-contract=off keeps FMA out, and every
- * operation is correctly rounded at any vector width, so both versions give
+/* A kernel also compiled for AVX-512 and AVX2, chosen when the program loads
+ * (GCC on x86-64 with ifunc support). -ffp-contract=off keeps FMA out, and every
+ * operation is correctly rounded at any vector width, so all versions give
  * the same bits. */
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && !defined(SPN_NO_CLONES)
-#define SPN__KERNEL __attribute__((target_clones("avx2", "default")))
+#define SPN__KERNEL __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
 #define SPN__KERNEL
 #endif
@@ -273,6 +278,21 @@ typedef struct spn__step_result {
  * and no air; false (nothing done) when out of memory for its buffers. */
 bool spn__step_sweep(spn_world *w, double dt, bool symplectic, spn__step_result *r);
 void spn__sweep_free(spn_world *w);
+
+/* ---- lattice.c ---- */
+
+/* Recognise a hub + rings x radials web in the compiled world (w->lat, or
+ * NULL when the springs are anything else). */
+void spn__lattice_build(spn_world *w);
+/* Forget the lattice: the general path steps the world from now on. */
+void spn__lattice_drop(spn_world *w);
+/* Public spring s changed its stiffness, rest length or broke. */
+void spn__lattice_spring_changed(spn_world *w, uint32_t s);
+/* The explicit step and RK4 as stencils over the lattice; false (nothing
+ * done) when the world has no lattice, a force callback or air, or when out
+ * of memory for its buffers. */
+bool spn__lattice_explicit(spn_world *w, double dt, bool symplectic, spn__step_result *r);
+bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r);
 
 /* ---- integrators (explicit.c, adaptive.c, implicit.c) ---- */
 

@@ -65,7 +65,9 @@ done
 if command -v ffmpeg > /dev/null; then
   "$SPN" animate "$WEB" -o "$T/v.mp4" --wind thesis --duration 60 --fps 25 --size 64x64 --quiet &
   pid=$!
-  sleep 1.5
+  # Interrupt once ffmpeg has written part of the video (a fixed sleep is too
+  # short under valgrind or on a loaded machine).
+  for _ in $(seq 1 6000); do [ -n "$(find "$T" -name 'v.mp4*tmp*' -size +0 -o -name '*tmp*v.mp4' -size +0)" ] && break; sleep 0.05; done
   kill -INT $pid
   wait $pid; code=$?
   [ $code -eq 130 ] || fail "interrupted video run exited $code, expected 130"
@@ -74,7 +76,7 @@ if command -v ffmpeg > /dev/null; then
 fi
 "$SPN" animate "$WEB" -o "$T/fr" --wind thesis --duration 60 --fps 25 --size 64x64 --quiet &
 pid=$!
-sleep 1.5
+for _ in $(seq 1 6000); do ls "$T/fr" 2>/dev/null | grep -q '^frame_.*\.png$' && break; sleep 0.05; done
 kill -TERM $pid
 wait $pid; code=$?
 [ $code -eq 130 ] || fail "interrupted frame run exited $code, expected 130"

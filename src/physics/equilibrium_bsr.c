@@ -1,0 +1,201 @@
+/* Block sparse rows with 3x3 blocks (equilibrium_bsr.h): products for the
+ * Galerkin coarse operators P^T (A P), the transpose, products with vectors
+ * and a Gauss-Seidel sweep. Products go row by row with a marker array per
+ * thread (Gustavson's algorithm), in two passes: the pattern, then the
+ * values; each row's entries appear in the order its terms are met, so the
+ * same inputs give the same bits for any thread count. */
+#include "equilibrium_bsr.h"
+#include "equilibrium_internal.h"
+
+#include <stdlib.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#define PAR_MIN 16384u /* rows below which a loop stays on one thread */
+
+static inline int team(uint32_t rows, int threads) { return rows < PAR_MIN ? 1 : threads; }
+static inline int thread_id(void)
+{
+#ifdef _OPENMP
+    return omp_get_thread_num();
+#else
+    return 0;
+#endif
+}
+
+void spn__bsr_free(spn__bsr *a)
+{
+    free(a->start);
+    free(a->col);
+    free(a->val);
+    memset(a, 0, sizeof *a);
+}
+
+/* Columns of row i of A B into cols (marker: per column, the last row that
+ * saw it); returns the count. */
+static uint32_t row_pattern(const spn__bsr *a, const spn__bsr *b, uint32_t i, bool diag_first, uint32_t *mark,
+                            uint32_t *cols)
+{
+    uint32_t cnt = 0;
+    if (diag_first) {
+        mark[i] = i;
+        if (cols) cols[cnt] = i;
+        cnt++;
+    }
+    for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) {
+        uint32_t k = a->col[p];
+        for (uint32_t q = b->start[k]; q < b->start[k + 1]; q++) {
+            uint32_t j = b->col[q];
+            if (mark[j] == i) continue;
+            mark[j] = i;
+            if (cols) cols[cnt] = j;
+            cnt++;
+        }
+    }
+    return cnt;
+}
+
+bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, int threads)
+{
+    memset(c, 0, sizeof *c);
+    c->rows = a->rows;
+    c->cols = b->cols;
+    int nt = team(a->rows, threads);
+    c->start = calloc((size_t)a->rows + 1, sizeof *c->start);
+    uint32_t *marks = malloc((size_t)nt * (b->cols ? b->cols : 1) * sizeof *marks);
+    if (!c->start || !marks) goto fail;
+    for (size_t t = 0; t < (size_t)nt * b->cols; t++) marks[t] = UINT32_MAX;
+#pragma omp parallel for schedule(static) num_threads(nt)
+    for (uint32_t i = 0; i < a->rows; i++)
+        c->start[i + 1] = row_pattern(a, b, i, diag_first, marks + (size_t)thread_id() * b->cols, NULL);
+    for (uint32_t i = 0; i < a->rows; i++) c->start[i + 1] += c->start[i];
+    size_t nnz = c->start[a->rows];
+    c->col = malloc((nnz ? nnz : 1) * sizeof *c->col);
+    c->val = malloc(9 * (nnz ? nnz : 1) * sizeof *c->val);
+    if (!c->col || !c->val) goto fail;
+    for (size_t t = 0; t < (size_t)nt * b->cols; t++) marks[t] = UINT32_MAX;
+#pragma omp parallel for schedule(static) num_threads(nt)
+    for (uint32_t i = 0; i < a->rows; i++)
+        row_pattern(a, b, i, diag_first, marks + (size_t)thread_id() * b->cols, c->col + c->start[i]);
+    free(marks);
+    marks = NULL;
+    if (spn__bsr_mul_values(a, b, c, threads)) return true;
+fail:
+    free(marks);
+    spn__bsr_free(c);
+    return false;
+}
+
+bool spn__bsr_mul_values(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, int threads)
+{
+    int nt = team(a->rows, threads);
+    uint32_t *pos = malloc((size_t)nt * (b->cols ? b->cols : 1) * sizeof *pos);
+    if (!pos) return false;
+#pragma omp parallel for schedule(static) num_threads(nt)
+    for (uint32_t i = 0; i < a->rows; i++) {
+        uint32_t *where = pos + (size_t)thread_id() * b->cols;
+        for (uint32_t q = c->start[i]; q < c->start[i + 1]; q++) where[c->col[q]] = q;
+        memset(c->val + 9 * (size_t)c->start[i], 0, 9 * (size_t)(c->start[i + 1] - c->start[i]) * sizeof *c->val);
+        for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) {
+            const double *ab = a->val + 9 * (size_t)p;
+            uint32_t k = a->col[p];
+            for (uint32_t q = b->start[k]; q < b->start[k + 1]; q++)
+                spn__blk_mul_add(ab, b->val + 9 * (size_t)q, c->val + 9 * (size_t)where[b->col[q]]);
+        }
+    }
+    free(pos);
+    return true;
+}
+
+bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm_out)
+{
+    memset(t, 0, sizeof *t);
+    t->rows = a->cols;
+    t->cols = a->rows;
+    size_t nnz = a->start[a->rows];
+    t->start = calloc((size_t)t->rows + 1, sizeof *t->start);
+    t->col = malloc((nnz ? nnz : 1) * sizeof *t->col);
+    t->val = malloc(9 * (nnz ? nnz : 1) * sizeof *t->val);
+    uint32_t *perm = malloc((nnz ? nnz : 1) * sizeof *perm), *fill = calloc(t->rows ? t->rows : 1, sizeof *fill);
+    if (!t->start || !t->col || !t->val || !perm || !fill) {
+        free(perm);
+        free(fill);
+        spn__bsr_free(t);
+        return false;
+    }
+    for (size_t p = 0; p < nnz; p++) t->start[a->col[p] + 1]++;
+    for (uint32_t r = 0; r < t->rows; r++) t->start[r + 1] += t->start[r];
+    for (uint32_t i = 0; i < a->rows; i++) /* rows of A in order: each row of T sorted by column */
+        for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) {
+            uint32_t q = t->start[a->col[p]] + fill[a->col[p]]++;
+            t->col[q] = i;
+            perm[q] = p;
+        }
+    free(fill);
+    *perm_out = perm;
+    spn__bsr_transpose_values(a, t, perm, 1);
+    return true;
+}
+
+void spn__bsr_transpose_values(const spn__bsr *a, spn__bsr *t, const uint32_t *perm, int threads)
+{
+    const uint32_t nnz = t->start[t->rows];
+#pragma omp parallel for schedule(static) num_threads(team(nnz, threads))
+    for (uint32_t q = 0; q < nnz; q++) {
+        const double *s = a->val + 9 * (size_t)perm[q];
+        double *d = t->val + 9 * (size_t)q;
+        d[0] = s[0], d[1] = s[3], d[2] = s[6];
+        d[3] = s[1], d[4] = s[4], d[5] = s[7];
+        d[6] = s[2], d[7] = s[5], d[8] = s[8];
+    }
+}
+
+void spn__bsr_apply(const spn__bsr *a, const double *x, double *y, bool add, int threads)
+{
+#pragma omp parallel for schedule(static) num_threads(team(a->rows, threads))
+    for (uint32_t i = 0; i < a->rows; i++) {
+        double s0 = 0, s1 = 0, s2 = 0;
+        for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) {
+            const double *m = a->val + 9 * (size_t)p, *v = x + 3 * (size_t)a->col[p];
+            s0 += m[0] * v[0] + m[1] * v[1] + m[2] * v[2];
+            s1 += m[3] * v[0] + m[4] * v[1] + m[5] * v[2];
+            s2 += m[6] * v[0] + m[7] * v[1] + m[8] * v[2];
+        }
+        double *o = y + 3 * (size_t)i;
+        if (add) o[0] += s0, o[1] += s1, o[2] += s2;
+        else o[0] = s0, o[1] = s1, o[2] = s2;
+    }
+}
+
+void spn__bsr_residual(const spn__bsr *a, const double *b, const double *x, double *r, int threads)
+{
+#pragma omp parallel for schedule(static) num_threads(team(a->rows, threads))
+    for (uint32_t i = 0; i < a->rows; i++) {
+        double s0 = b[3 * i], s1 = b[3 * i + 1], s2 = b[3 * i + 2];
+        for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) {
+            const double *m = a->val + 9 * (size_t)p, *v = x + 3 * (size_t)a->col[p];
+            s0 -= m[0] * v[0] + m[1] * v[1] + m[2] * v[2];
+            s1 -= m[3] * v[0] + m[4] * v[1] + m[5] * v[2];
+            s2 -= m[6] * v[0] + m[7] * v[1] + m[8] * v[2];
+        }
+        r[3 * i] = s0, r[3 * i + 1] = s1, r[3 * i + 2] = s2;
+    }
+}
+
+void spn__bsr_gauss_seidel(const spn__bsr *a, const double *dinv, const double *b, double *x, bool forward)
+{
+    const uint32_t n = a->rows;
+    for (uint32_t k = 0; k < n; k++) {
+        uint32_t i = forward ? k : n - 1 - k;
+        double s[3] = {b[3 * i], b[3 * i + 1], b[3 * i + 2]};
+        for (uint32_t p = a->start[i] + 1; p < a->start[i + 1]; p++) { /* the diagonal is first */
+            const double *m = a->val + 9 * (size_t)p, *v = x + 3 * (size_t)a->col[p];
+            s[0] -= m[0] * v[0] + m[1] * v[1] + m[2] * v[2];
+            s[1] -= m[3] * v[0] + m[4] * v[1] + m[5] * v[2];
+            s[2] -= m[6] * v[0] + m[7] * v[1] + m[8] * v[2];
+        }
+        spn__sym_mul(dinv + 6 * (size_t)i, s, x + 3 * (size_t)i);
+    }
+}

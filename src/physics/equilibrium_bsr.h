@@ -1,0 +1,57 @@
+/* Block sparse rows (3x3 blocks) for the equilibrium multigrid: the matrices
+ * of every level, the prolongators and their transposes.
+ *
+ * A block is 9 doubles, row-major. In a square level matrix the diagonal
+ * block is the first of its row (the smoothers and the coarse solve find it
+ * there). Every loop writes only its own rows, and every row is summed in a
+ * fixed order, so results are the same bits for any thread count. */
+#ifndef SPN_EQUILIBRIUM_BSR_H
+#define SPN_EQUILIBRIUM_BSR_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+typedef struct spn__bsr {
+    uint32_t rows, cols;
+    uint32_t *start; /* rows + 1 */
+    uint32_t *col;   /* start[rows] */
+    double *val;     /* 9 * start[rows] */
+} spn__bsr;
+
+void spn__bsr_free(spn__bsr *a);
+/* Pattern and values of C = A B (C's square-matrix diagonal first when
+ * diag_first). false on out of memory. */
+bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, int threads);
+/* Values only, into a C whose pattern came from spn__bsr_mul of the same
+ * patterns; false on out of memory. */
+bool spn__bsr_mul_values(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, int threads);
+/* T = A^T, blocks transposed; perm[k]: the entry of A that T's entry k came from. */
+bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm);
+void spn__bsr_transpose_values(const spn__bsr *a, spn__bsr *t, const uint32_t *perm, int threads);
+/* y = A x (add: y += A x). */
+void spn__bsr_apply(const spn__bsr *a, const double *x, double *y, bool add, int threads);
+/* r = b - A x. */
+void spn__bsr_residual(const spn__bsr *a, const double *b, const double *x, double *r, int threads);
+/* One block Gauss-Seidel sweep in place, rows in order (forward) or reverse;
+ * dinv: 6 per row, the inverted (symmetric) diagonal blocks. */
+void spn__bsr_gauss_seidel(const spn__bsr *a, const double *dinv, const double *b, double *x, bool forward);
+
+static inline void spn__blk_mul_vec(const double *m, const double *v, double *o)
+{
+    o[0] = m[0] * v[0] + m[1] * v[1] + m[2] * v[2];
+    o[1] = m[3] * v[0] + m[4] * v[1] + m[5] * v[2];
+    o[2] = m[6] * v[0] + m[7] * v[1] + m[8] * v[2];
+}
+/* c += a b */
+static inline void spn__blk_mul_add(const double *a, const double *b, double *c)
+{
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 3; k++) {
+            double s = a[3 * r + k];
+            c[3 * r] += s * b[3 * k];
+            c[3 * r + 1] += s * b[3 * k + 1];
+            c[3 * r + 2] += s * b[3 * k + 2];
+        }
+}
+
+#endif

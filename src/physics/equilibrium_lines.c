@@ -1,0 +1,388 @@
+/* Thread-line smoother for the equilibrium multigrid's finest level.
+ *
+ * Why: a taut silk thread is about 1/prestrain (~50) times stiffer along
+ * itself (EA/l) than across (T/l), and a rings-by-radials web has no
+ * diagonals, so in its plane the displacement along a radial is coupled
+ * strongly along the radial and weakly across, and the displacement along a
+ * ring the other way round: two anisotropic problems whose strong directions
+ * cross. A point smoother (block Jacobi or Gauss-Seidel) cannot smooth an
+ * error that is smooth along the threads but rough across them, and a
+ * coarsening that mixes both directions cannot represent it; CG then needs
+ * hundreds of iterations (measured: docs/physics-equilibrium.md). Solving
+ * exactly along every thread (line relaxation, the classical cure for
+ * anisotropy) removes those errors in one sweep.
+ *
+ * Lines are found from the geometry of any web, not from the lattice: at
+ * each particle the incident springs are paired greedily by straightness (a
+ * thread runs through a junction nearly straight: cos < -COLLINEAR), and the
+ * chains of paired springs are the lines (a ring closes on itself; it is cut
+ * where it started). Each spring between free particles lies on exactly one
+ * line; a particle lies on one line per thread through it; particles on no
+ * line are relaxed as one-particle lines. A line never visits a particle
+ * twice, and never passes through a junction (a particle with more than
+ * JUNCTION springs, such as the hub): every line through it would share it.
+ *
+ * Lines are coloured (greedily) so that no two lines of a colour share or
+ * couple a particle: the lines of one colour are then independent, and a
+ * sweep over them gives the same bits in any order or on any number of
+ * threads. A sweep runs over the colours in order (forward) or reverse order
+ * (backward: the adjoint, so a V-cycle with one of each is symmetric). For
+ * each line it forms the residual of its particles with the current values
+ * and solves the block-tridiagonal part of the matrix on the line (the 3x3
+ * blocks of the line's springs) by the block Thomas algorithm, factored once
+ * per Newton step. Lines of a colour go in groups of GROUP, a step along all
+ * of them at a time: a radial of a ring-major web strides through memory,
+ * but neighbouring radials step through neighbouring memory together. */
+#include "equilibrium_bsr.h"
+#include "equilibrium_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define COLLINEAR 0.9    /* springs at a junction continue one line when cos(angle) < -this */
+#define JUNCTION 8u      /* particles with more springs end every line through them */
+#define GROUP 8u         /* lines of a colour stepped together */
+#define PAR_MIN 4096u    /* particles in a colour below which it stays on one thread */
+
+struct spn__lines {
+    uint32_t count;      /* lines */
+    uint32_t *start;     /* count + 1: into node */
+    uint32_t *node;      /* particles of each line, in order */
+    uint32_t *upos;      /* per line node k (not the last): the BSR entry (node[k], node[k+1]) */
+    double *dinv;        /* 6 per line node: inverted pivots of the factorisation */
+    double *cu;          /* 9 per line node (not the last): Dinv_k U_k, for the back substitution */
+    double *work;        /* 3 per line node */
+    uint32_t colours, *colour_start; /* lines [colour_start[c], colour_start[c + 1]) have colour c */
+};
+
+void spn__lines_free(spn__lines *L)
+{
+    if (!L) return;
+    free(L->start);
+    free(L->node);
+    free(L->upos);
+    free(L->dinv);
+    free(L->cu);
+    free(L->work);
+    free(L->colour_start);
+    free(L);
+}
+
+typedef struct pair_cand {
+    double c;
+    uint32_t a, b;
+} pair_cand;
+
+static int by_cos(const void *x, const void *y)
+{
+    const pair_cand *p = x, *q = y;
+    if (p->c != q->c) return p->c < q->c ? -1 : 1;
+    if (p->a != q->a) return p->a < q->a ? -1 : 1;
+    return p->b < q->b ? -1 : (p->b > q->b);
+}
+
+static inline bool junction(const spn__eq *e, uint32_t i) { return e->adj_start[i + 1] - e->adj_start[i] > JUNCTION; }
+
+/* A line may run from particle i along its adjacency entry j: both ends
+ * free, neither a junction. */
+static bool linkable(const spn__eq *e, uint32_t i, uint32_t j)
+{
+    int32_t o = e->adj_other[j];
+    return o >= 0 && !junction(e, i) && !junction(e, (uint32_t)o);
+}
+
+/* partner[j] for each adjacency entry: the entry at the same particle its
+ * thread continues through, or UINT32_MAX. */
+static bool pair_springs(const spn__eq *e, uint32_t *partner)
+{
+    uint32_t nadj = e->adj_start[e->n];
+    for (uint32_t j = 0; j < nadj; j++) partner[j] = UINT32_MAX;
+    pair_cand cand[JUNCTION * JUNCTION / 2 + 1];
+    double dir[3 * JUNCTION];
+    for (uint32_t i = 0; i < e->n; i++) {
+        uint32_t j0 = e->adj_start[i], deg = e->adj_start[i + 1] - j0, nc = 0;
+        if (deg < 2 || junction(e, i)) continue;
+        for (uint32_t a = 0; a < deg; a++) {
+            bool ok = linkable(e, i, j0 + a);
+            int32_t o = e->adj_other[j0 + a];
+            double *d = dir + 3 * a, len = 0;
+            for (int c = 0; c < 3; c++) {
+                d[c] = ok ? e->x[3 * (size_t)o + c] - e->x[3 * (size_t)i + c] : 0;
+                len += d[c] * d[c];
+            }
+            len = sqrt(len);
+            for (int c = 0; c < 3; c++) d[c] = len > 0 ? d[c] / len : 0;
+        }
+        for (uint32_t a = 0; a < deg; a++)
+            for (uint32_t b = a + 1; b < deg; b++) {
+                const double *da = dir + 3 * a, *db = dir + 3 * b;
+                double c = da[0] * db[0] + da[1] * db[1] + da[2] * db[2];
+                if (c < -COLLINEAR) cand[nc++] = (pair_cand){c, a, b};
+            }
+        qsort(cand, nc, sizeof *cand, by_cos);
+        for (uint32_t k = 0; k < nc; k++) {
+            uint32_t a = j0 + cand[k].a, b = j0 + cand[k].b;
+            if (partner[a] != UINT32_MAX || partner[b] != UINT32_MAX) continue;
+            partner[a] = b;
+            partner[b] = a;
+        }
+    }
+    return true;
+}
+
+/* The BSR entry of (i, c) in row i (the merged block of every spring between them). */
+static uint32_t find_entry(const spn__bsr *a, uint32_t i, uint32_t c)
+{
+    for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++)
+        if (a->col[p] == c) return p;
+    return UINT32_MAX;
+}
+
+typedef struct walker {
+    const spn__eq *e;
+    const uint32_t *partner, *end_entry; /* end_entry[2 s + end]: the adjacency entry of spring s at that end */
+    uint8_t *used;                       /* per spring */
+    uint32_t *seen;                      /* per particle: the last line that visited it, + 1 */
+    spn__lines *L;
+    uint32_t nodes;
+} walker;
+
+/* Follow the thread from particle u out along adjacency entry j; appends one line. */
+static void walk(walker *w, uint32_t u, uint32_t j)
+{
+    const spn__eq *e = w->e;
+    spn__lines *L = w->L;
+    uint32_t id = L->count + 1;
+    L->node[w->nodes++] = u;
+    w->seen[u] = id;
+    for (;;) {
+        uint32_t s = e->adj[j] >> 1, v = (uint32_t)e->adj_other[j];
+        if (w->used[s]) break;
+        w->used[s] = 1; /* a spring closing a loop stays off every line (it is in the residual) */
+        if (w->seen[v] == id) break;
+        L->node[w->nodes++] = v;
+        w->seen[v] = id;
+        uint32_t jv = w->end_entry[2 * (size_t)s + !(e->adj[j] & 1u)];
+        if (w->partner[jv] == UINT32_MAX) break;
+        j = w->partner[jv];
+    }
+    L->start[++L->count] = w->nodes;
+}
+
+static bool find_lines(spn__lines *L, const spn__eq *e, const uint32_t *partner)
+{
+    uint32_t nadj = e->adj_start[e->n];
+    walker w = {e, partner, NULL, NULL, NULL, L, 0};
+    uint32_t *end_entry = malloc(2 * (size_t)(e->m ? e->m : 1) * sizeof *end_entry);
+    w.used = calloc(e->m ? e->m : 1, 1);
+    w.seen = calloc(e->n ? e->n : 1, sizeof *w.seen);
+    if (!end_entry || !w.used || !w.seen) {
+        free(end_entry), free(w.used), free(w.seen);
+        return false;
+    }
+    for (uint32_t j = 0; j < nadj; j++) end_entry[2 * (size_t)(e->adj[j] >> 1) + (e->adj[j] & 1u)] = j;
+    w.end_entry = end_entry;
+    L->start[0] = 0;
+    /* threads with an end first (started there), then the closed loops */
+    for (int pass = 0; pass < 2; pass++)
+        for (uint32_t i = 0; i < e->n; i++)
+            for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++)
+                if (linkable(e, i, j) && !w.used[e->adj[j] >> 1] && (pass == 1 || partner[j] == UINT32_MAX))
+                    walk(&w, i, j);
+    for (uint32_t i = 0; i < e->n; i++) /* on no line: relaxed alone */
+        if (!w.seen[i]) {
+            L->node[w.nodes++] = i;
+            L->start[++L->count] = w.nodes;
+        }
+    free(end_entry), free(w.used), free(w.seen);
+    return true;
+}
+
+/* Greedy colours: a line takes the first colour that no line sharing or
+ * coupled to one of its particles has. Then the lines are reordered by
+ * colour (stable). */
+static bool colour_lines(spn__lines *L, const spn__bsr *a)
+{
+    uint32_t n = a->rows, total = L->start[L->count];
+    uint32_t *ns = calloc((size_t)n + 1, sizeof *ns), *nl = malloc((total ? total : 1) * sizeof *nl);
+    uint32_t *colour = malloc((L->count ? L->count : 1) * sizeof *colour);
+    uint32_t *stamp = malloc(((size_t)L->count + 1) * sizeof *stamp), *fill = calloc((n > L->count ? n : L->count) + 1, sizeof *fill);
+    bool ok = ns && nl && colour && stamp && fill;
+    if (ok) { /* particle -> the lines through it */
+        for (uint32_t k = 0; k < total; k++) ns[L->node[k] + 1]++;
+        for (uint32_t i = 0; i < n; i++) ns[i + 1] += ns[i];
+        for (uint32_t l = 0; l < L->count; l++)
+            for (uint32_t k = L->start[l]; k < L->start[l + 1]; k++) nl[ns[L->node[k]] + fill[L->node[k]]++] = l;
+        for (uint32_t c = 0; c <= L->count; c++) stamp[c] = UINT32_MAX;
+        L->colours = 0;
+        for (uint32_t l = 0; l < L->count; l++) {
+            for (uint32_t k = L->start[l]; k < L->start[l + 1]; k++)
+                for (uint32_t p = a->start[L->node[k]]; p < a->start[L->node[k] + 1]; p++)
+                    for (uint32_t q = ns[a->col[p]]; q < ns[a->col[p] + 1]; q++)
+                        if (nl[q] < l) stamp[colour[nl[q]]] = l;
+            uint32_t c = 0;
+            while (stamp[c] == l) c++;
+            colour[l] = c;
+            if (c + 1 > L->colours) L->colours = c + 1;
+        }
+    }
+    uint32_t *start = NULL, *node = NULL;
+    if (ok) {
+        L->colour_start = calloc((size_t)L->colours + 1, sizeof *L->colour_start);
+        start = malloc(((size_t)L->count + 1) * sizeof *start);
+        node = malloc((total ? total : 1) * sizeof *node);
+        ok = L->colour_start && start && node;
+    }
+    if (ok) {
+        for (uint32_t l = 0; l < L->count; l++) L->colour_start[colour[l] + 1]++;
+        for (uint32_t c = 0; c < L->colours; c++) L->colour_start[c + 1] += L->colour_start[c];
+        memset(fill, 0, ((n > L->count ? n : L->count) + 1) * sizeof *fill);
+        uint32_t *order = nl; /* reuse: new position -> old line */
+        for (uint32_t l = 0; l < L->count; l++) {
+            uint32_t c = colour[l];
+            order[L->colour_start[c] + fill[c]++] = l;
+        }
+        start[0] = 0;
+        for (uint32_t k = 0; k < L->count; k++) {
+            uint32_t l = order[k], len = L->start[l + 1] - L->start[l];
+            memcpy(node + start[k], L->node + L->start[l], len * sizeof *node);
+            start[k + 1] = start[k] + len;
+        }
+        free(L->start), free(L->node);
+        L->start = start, L->node = node;
+        start = node = NULL;
+    }
+    free(start), free(node), free(ns), free(nl), free(colour), free(stamp), free(fill);
+    return ok;
+}
+
+spn__lines *spn__lines_build(const spn__eq *e, const spn__bsr *a0)
+{
+    spn__lines *L = calloc(1, sizeof *L);
+    uint32_t nadj = e->adj_start[e->n];
+    /* every line has one more particle than springs: at most m + n particles on at most m + n lines */
+    size_t cap = (size_t)e->m + e->n + 1;
+    uint32_t *partner = malloc((nadj ? nadj : 1) * sizeof *partner);
+    if (!L || !partner) goto fail;
+    L->start = malloc((cap + 1) * sizeof *L->start);
+    L->node = malloc(cap * sizeof *L->node);
+    if (!L->start || !L->node || !pair_springs(e, partner) || !find_lines(L, e, partner)) goto fail;
+    free(partner);
+    partner = NULL;
+    if (!colour_lines(L, a0)) goto fail;
+    uint32_t total = L->start[L->count];
+    L->upos = malloc((total ? total : 1) * sizeof *L->upos);
+    L->dinv = malloc(6 * (size_t)(total ? total : 1) * sizeof *L->dinv);
+    L->cu = malloc(9 * (size_t)(total ? total : 1) * sizeof *L->cu);
+    L->work = malloc(3 * (size_t)(total ? total : 1) * sizeof *L->work);
+    if (!L->upos || !L->dinv || !L->cu || !L->work) goto fail;
+    for (uint32_t l = 0; l < L->count; l++)
+        for (uint32_t k = L->start[l]; k + 1 < L->start[l + 1]; k++) L->upos[k] = find_entry(a0, L->node[k], L->node[k + 1]);
+    return L;
+fail:
+    free(partner);
+    spn__lines_free(L);
+    return NULL;
+}
+
+
+/* out = sym(D - U^T M U), M symmetric (6), U a full block, D full (9). */
+static void schur(const double *d, const double *m, const double *u, double *out)
+{
+    double mm[9] = {m[0], m[3], m[4], m[3], m[1], m[5], m[4], m[5], m[2]}, w[9] = {0}, t[9] = {0}, ut[9];
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++) ut[3 * r + c] = u[3 * c + r];
+    spn__blk_mul_add(mm, u, w);
+    spn__blk_mul_add(ut, w, t);
+    out[0] = d[0] - t[0];
+    out[1] = d[4] - t[4];
+    out[2] = d[8] - t[8];
+    out[3] = 0.5 * (d[1] + d[3]) - 0.5 * (t[1] + t[3]);
+    out[4] = 0.5 * (d[2] + d[6]) - 0.5 * (t[2] + t[6]);
+    out[5] = 0.5 * (d[5] + d[7]) - 0.5 * (t[5] + t[7]);
+}
+
+bool spn__lines_factor(spn__lines *L, const spn__bsr *a0)
+{
+    static const double zero6[6] = {0, 0, 0, 0, 0, 0};
+    for (uint32_t l = 0; l < L->count; l++)
+        for (uint32_t k = L->start[l]; k < L->start[l + 1]; k++) {
+            const double *d = a0->val + 9 * (size_t)a0->start[L->node[k]];
+            double piv[6];
+            if (k == L->start[l]) schur(d, zero6, d, piv); /* U^T 0 U = 0: the plain diagonal */
+            else schur(d, L->dinv + 6 * (size_t)(k - 1), a0->val + 9 * (size_t)L->upos[k - 1], piv);
+            if (!spn__sym_inverse(piv, L->dinv + 6 * (size_t)k)) return false;
+            if (k > L->start[l]) { /* Dinv_{k-1} U_{k-1} */
+                const double *m = L->dinv + 6 * (size_t)(k - 1);
+                double mm[9] = {m[0], m[3], m[4], m[3], m[1], m[5], m[4], m[5], m[2]}, *c = L->cu + 9 * (size_t)(k - 1);
+                memset(c, 0, 9 * sizeof *c);
+                spn__blk_mul_add(mm, a0->val + 9 * (size_t)L->upos[k - 1], c);
+            }
+        }
+    return true;
+}
+
+/* Step t of line l forward: residual of its particle t, minus the
+ * eliminated part of step t - 1, times the inverted pivot, into g_t. */
+static inline void forward_step(const spn__lines *L, const spn__bsr *a, uint32_t l, uint32_t t, const double *b,
+                                const double *x)
+{
+    uint32_t k = L->start[l] + t, i = L->node[k];
+    double r0 = b[3 * i], r1 = b[3 * i + 1], r2 = b[3 * i + 2];
+    for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) {
+        const double *m = a->val + 9 * (size_t)p, *v = x + 3 * (size_t)a->col[p];
+        r0 -= m[0] * v[0] + m[1] * v[1] + m[2] * v[2];
+        r1 -= m[3] * v[0] + m[4] * v[1] + m[5] * v[2];
+        r2 -= m[6] * v[0] + m[7] * v[1] + m[8] * v[2];
+    }
+    if (t > 0) { /* r -= U_{t-1}^T g_{t-1} */
+        const double *u = a->val + 9 * (size_t)L->upos[k - 1], *gp = L->work + 3 * (size_t)(k - 1);
+        r0 -= u[0] * gp[0] + u[3] * gp[1] + u[6] * gp[2];
+        r1 -= u[1] * gp[0] + u[4] * gp[1] + u[7] * gp[2];
+        r2 -= u[2] * gp[0] + u[5] * gp[1] + u[8] * gp[2];
+    }
+    double r[3] = {r0, r1, r2};
+    spn__sym_mul(L->dinv + 6 * (size_t)k, r, L->work + 3 * (size_t)k);
+}
+
+/* Step t of line l backward: g_t -= (Dinv_t U_t) g_{t+1}, then x += g_t. */
+static inline void backward_step(const spn__lines *L, uint32_t l, uint32_t t, double *x)
+{
+    uint32_t k = L->start[l] + t;
+    double *g = L->work + 3 * (size_t)k;
+    if (k + 1 < L->start[l + 1]) {
+        double c[3];
+        spn__blk_mul_vec(L->cu + 9 * (size_t)k, g + 3, c);
+        g[0] -= c[0], g[1] -= c[1], g[2] -= c[2];
+    }
+    double *xi = x + 3 * (size_t)L->node[k];
+    xi[0] += g[0], xi[1] += g[1], xi[2] += g[2];
+}
+
+/* Lines [l0, l1) of one colour, stepped together. */
+static void solve_group(const spn__lines *L, const spn__bsr *a, uint32_t l0, uint32_t l1, const double *b, double *x)
+{
+    uint32_t longest = 0;
+    for (uint32_t l = l0; l < l1; l++)
+        if (L->start[l + 1] - L->start[l] > longest) longest = L->start[l + 1] - L->start[l];
+    for (uint32_t t = 0; t < longest; t++)
+        for (uint32_t l = l0; l < l1; l++)
+            if (t < L->start[l + 1] - L->start[l]) forward_step(L, a, l, t, b, x);
+    for (uint32_t t = longest; t-- > 0;)
+        for (uint32_t l = l0; l < l1; l++)
+            if (t < L->start[l + 1] - L->start[l]) backward_step(L, l, t, x);
+}
+
+void spn__lines_sweep(const spn__lines *L, const spn__bsr *a0, const double *b, double *x, bool forward, int threads)
+{
+    for (uint32_t k = 0; k < L->colours; k++) {
+        uint32_t c = forward ? k : L->colours - 1 - k;
+        uint32_t l0 = L->colour_start[c], l1 = L->colour_start[c + 1], groups = (l1 - l0 + GROUP - 1) / GROUP;
+        int team = L->start[l1] - L->start[l0] < PAR_MIN ? 1 : threads;
+        (void)team;
+#pragma omp parallel for schedule(static) num_threads(team)
+        for (uint32_t g = 0; g < groups; g++)
+            solve_group(L, a0, l0 + g * GROUP, l0 + (g + 1) * GROUP < l1 ? l0 + (g + 1) * GROUP : l1, b, x);
+    }
+}
