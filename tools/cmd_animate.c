@@ -34,6 +34,7 @@ static void usage(FILE *out)
             "                          (--fps 400 --playback-fps 25: 16 times slow motion)\n"
             "      --solver NAME       euler, symplectic, rk4, adaptive or implicit; default: WEB's\n"
             "      --substeps N        steps per frame, in [1, 1e7]; default: stable for the solver\n"
+            "      --solver-tol R      implicit: CG relative residual, in [1e-14, 0.5]; default the web's (1e-10)\n"
             "      --seed N            seeds the wind; default 1\n"
             "      --frame-range A-B   render frames A..B only (same bits as in a whole run)\n"
             "      --save-states DIR   also write each rendered frame's world as DIR/state_NNNNN.json\n"
@@ -101,7 +102,7 @@ static bool wind_model(const char *arg, spn_wind_kind *out)
 enum {
     OPT_DURATION = 256, OPT_FPS, OPT_SOLVER, OPT_SUBSTEPS, OPT_SEED, OPT_RANGE, OPT_STATES, OPT_QUIET, OPT_WIND,
     OPT_TMASS, OPT_TGAIN, OPT_TRANDOM, OPT_TPERIOD, OPT_TTICK, OPT_TRAD, OPT_TFALL, OPT_SPEED, OPT_DIR, OPT_GUST,
-    OPT_TURB, OPT_STOP, OPT_IMPACT, OPT_REPORT, OPT_NOBREAK, OPT_GLUE, OPT_PGRAV, OPT_PLAYBACK
+    OPT_TURB, OPT_STOP, OPT_IMPACT, OPT_REPORT, OPT_NOBREAK, OPT_GLUE, OPT_PGRAV, OPT_PLAYBACK, OPT_SOLVER_TOL
 };
 
 static bool sim_option(int c, const char *arg, animate_options *o)
@@ -120,6 +121,7 @@ static bool sim_option(int c, const char *arg, animate_options *o)
         if (!cli_int(CMD, "--substeps", arg, 1, 10000000, &n)) return false;
         d->substeps = (int)n;
         return true;
+    case OPT_SOLVER_TOL: return cli_double(CMD, "--solver-tol", arg, 1e-14, 0.5, &d->cg_tolerance);
     case OPT_SEED: return cli_u64(CMD, "--seed", arg, &d->seed);
     case OPT_RANGE: return frame_range(arg, d);
     case OPT_WIND: return wind_model(arg, &d->wind);
@@ -172,7 +174,7 @@ static const struct option long_options[] = {
     {"output", required_argument, NULL, 'o'},    {"duration", required_argument, NULL, OPT_DURATION},
     {"playback-fps", required_argument, NULL, OPT_PLAYBACK},
     {"fps", required_argument, NULL, OPT_FPS},   {"solver", required_argument, NULL, OPT_SOLVER},
-    {"substeps", required_argument, NULL, OPT_SUBSTEPS}, {"seed", required_argument, NULL, OPT_SEED},
+    {"substeps", required_argument, NULL, OPT_SUBSTEPS}, {"solver-tol", required_argument, NULL, OPT_SOLVER_TOL}, {"seed", required_argument, NULL, OPT_SEED},
     {"frame-range", required_argument, NULL, OPT_RANGE}, {"save-states", required_argument, NULL, OPT_STATES},
     {"quiet", no_argument, NULL, OPT_QUIET},     {"wind", required_argument, NULL, OPT_WIND},
     {"thesis-mass", required_argument, NULL, OPT_TMASS}, {"thesis-gain", required_argument, NULL, OPT_TGAIN},

@@ -106,6 +106,14 @@ SPN_API double spn_thread_breaking_strain(uint32_t tag);
 SPN_API double spn_thread_yield_strain(uint32_t tag);
 #define SPN_POST_YIELD 0.3
 
+/// Fraction of the work of a loading cycle a thread kind dissipates (silk's
+/// hysteresis: Gosline et al. 1999, dragline 0.65; viscid capture silk more,
+/// Denny 1976); 0 for kinds that are not silk.
+SPN_API double spn_thread_hysteresis(uint32_t tag);
+/// Strain rate [1/s] above which the hysteresis is rate-independent (below
+/// it, a dashpot; see spn_world_set_tag_hysteresis).
+#define SPN_HYSTERESIS_RATE 0.1
+
 /* ---- prey ---------------------------------------------------------------- */
 
 /// Particle tag given to prey particles.
@@ -129,6 +137,8 @@ typedef struct spn_impact_def {
     bool plastic;              ///< threads yield past spn_thread_yield_strain (silk's hysteresis), default true
     double glue_strength;      ///< capture-thread glue: a droplet holding the prey lets go past this pull [N],
                                ///< default 4e-5 (tens of uN, Opell & Hendricks 2007); 0: not sticky
+    bool hysteresis;           ///< silk threads dissipate spn_thread_hysteresis of each loading cycle, default
+                               ///< true (with the implicit solver; explicit steps go without)
 } spn_impact_def;
 
 SPN_API spn_impact_def spn_impact_def_default(void);
@@ -137,7 +147,7 @@ SPN_API spn_impact_def spn_impact_def_default(void);
 typedef struct spn_kind_energy {
     uint32_t tag;
     double elastic;     ///< elastic energy now minus at the start
-    double damping;     ///< dissipated by the springs' damping
+    double damping;     ///< dissipated by the springs' damping and silk's hysteresis
     double plastic;     ///< dissipated by yielding (permanent stretch)
     double broken;      ///< elastic energy lost when springs broke
     uint32_t breaks;    ///< springs broken
@@ -164,6 +174,7 @@ typedef struct spn_impact_report {
     double air_work;              ///< work done by the air on the web (negative: drag absorbed) [J]
     double wind_work;             ///< work of the force callback wind [J]
     double viscous;               ///< dissipated by the world's viscous drag [J]
+    double solver;                ///< dissipated by the implicit solver itself (backward Euler) [J]
     double glue;                  ///< lost when glue droplets let go [J]
     int glue_held;                ///< droplets holding prey at the end
     double contact_energy;        ///< penalty energy stored in contacts now [J]
@@ -200,6 +211,13 @@ SPN_API uint32_t spn_impact_prey_particle(const spn_impact *impact, int i);
 /// Tell the ledger the world has an air field / a wind force (for the work terms).
 SPN_API void spn_impact_track_air(spn_impact *impact, spn_air_fn fn, void *user, double rho, double mu);
 SPN_API void spn_impact_track_wind(spn_impact *impact, spn_force_fn fn, void *user);
+/// Before every step of `dt`: with the implicit solver, hand the world the
+/// prey's contacts (spn_world_set_contacts) so it integrates them implicitly.
+SPN_API spn_status spn_impact_before_step(spn_impact *impact, spn_world *w, double dt);
+/// The step the prey need now [s]: at most a tenth of a radius of travel
+/// near the web, or 0.8 of the free flight to the web's bounding box; `dt`
+/// when that is shorter.
+SPN_API double spn_impact_step_limit(const spn_impact *impact, const spn_world *w, double dt);
 /// Update the energy ledger after a step of `dt` (call after every step).
 SPN_API void spn_impact_after_step(spn_impact *impact, spn_world *w, double dt);
 SPN_API void spn_impact_report_get(spn_impact *impact, const spn_world *w, spn_impact_report *report);
@@ -219,6 +237,7 @@ typedef struct spn_anim_def {
     double fps;                ///< frames per second, default 25
     int substeps;              ///< steps per frame; 0 (default): chosen for stability
     spn_integrator solver;     ///< SPN_INTEGRATOR_COUNT (default): keep the world's
+    double cg_tolerance;       ///< implicit: CG relative residual for the run; 0 (default): keep the world's
     int first_frame;           ///< frames handed to the callback: first..last, default 0
     int last_frame;            ///< -1 (default): to the end
     spn_wind_kind wind;

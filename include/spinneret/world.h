@@ -201,6 +201,48 @@ SPN_API spn_status spn_world_add_plane(spn_world *w, spn_vec3 normal, double off
 SPN_API spn_status spn_world_add_sphere(spn_world *w, spn_vec3 centre, double radius,
                                         double restitution, double friction);
 
+/* ---- silk hysteresis and stiff contacts (hysteresis.c, contact.c) ------- */
+
+/// Silk's hysteresis for springs with `tag`: while stretched (s = |l| - r > 0)
+/// the axial force becomes k s (1 + eta tanh(s' / (rate0 r))), eta = loss /
+/// (2 - loss), so loading from slack to any length and back loses `loss` of the
+/// work done, whatever the rate above a strain rate of `rate0` [1/s] (below
+/// it the term is a dashpot). loss in [0, 1); 0 (the default of every tag)
+/// turns it off. Applied as an axial damping coefficient set from the state
+/// before each step (the secant eta k s tanh(.) / s'), so the implicit solver
+/// carries it at any step and its loss is counted in spn_energy.dissipated;
+/// explicit integrators get it capped at the stable m / (2 dt).
+SPN_API spn_status spn_world_set_tag_hysteresis(spn_world *w, uint32_t tag, double loss, double rate0);
+/// Axial damping coefficient spring s used in the last step [N s/m]: kd plus
+/// the hysteresis secant.
+SPN_API double spn_world_spring_damping(const spn_world *w, uint32_t s);
+
+/// A one-sided contact between particle p and the point (1 - u) x_a + u x_b
+/// of a segment, for the implicit solver: the world applies the force
+/// k y n to p (and -(1 - u), -u of it to a and b), where y = depth - n . (dg)
+/// follows the separation g = x_p - (1 - u) x_a - u x_b from the step's
+/// start, inside backward Euler's system (its stiffness -k n n^T joins the
+/// springs'), so a stiff contact between a heavy body and 1e-10 kg thread
+/// particles needs no explicit-sized step. A pushing contact (pull false)
+/// acts while y > 0, a pulling one (a tether, pull true) while y < 0: a
+/// contact whose y ends the step on the wrong side is dropped and the step
+/// solved again without it (an active set), so contacts never stick.
+typedef struct spn_contact {
+    uint32_t p, a, b;
+    double u;
+    spn_vec3 n;     ///< unit
+    double k;       ///< stiffness [N/m]
+    double depth;   ///< y at the step's start [m]
+    bool pull;      ///< a tether: acts while y < 0
+    bool active;    ///< set by the world: in force at the end of the last step
+} spn_contact;
+/// Contacts for the following implicit steps (copied; n = 0 clears). Their
+/// potential k y^2 / 2 is the caller's to count: spn_energy does not hold it,
+/// and their forces are not external work. Other integrators ignore them.
+SPN_API spn_status spn_world_set_contacts(spn_world *w, const spn_contact *contacts, uint32_t n);
+/// The contacts as the last step left them (`active` filled in).
+SPN_API const spn_contact *spn_world_contacts(const spn_world *w, uint32_t *n);
+
 /* ---- stepping --------------------------------------------------------- */
 
 /// What the last call to spn_world_step did.

@@ -28,6 +28,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#define SPN_GLUE_STRETCH 1e-3 /* [m] */
+
 spn_impact_def spn_impact_def_default(void)
 {
     spn_impact_def d;
@@ -37,6 +39,7 @@ spn_impact_def spn_impact_def_default(void)
     d.prey_gravity = false;
     d.plastic = true;
     d.glue_strength = 4e-5;
+    d.hysteresis = true;
     return d;
 }
 
@@ -75,9 +78,16 @@ static spn_status cache_springs(spn_impact *im, const spn_world *w)
     im->slot = malloc(ns + 1);
     im->tag = malloc(ns * sizeof *im->tag + 1);
     im->rest0 = malloc(ns * sizeof *im->rest0 + 1);
+    im->len0 = malloc(ns * sizeof *im->len0 + 1);
     im->fbuf = malloc(im->np * sizeof *im->fbuf + 1);
+    im->x0 = malloc(im->np * sizeof *im->x0 + 1);
+    im->v0 = malloc(im->np * sizeof *im->v0 + 1);
+    im->coff = malloc((size_t)(im->nprey ? im->nprey : 1) * ns * sizeof *im->coff + 1);
+    im->cend = malloc((size_t)(im->nprey ? im->nprey : 1) * ns * sizeof *im->cend + 1);
+    if (!im->x0 || !im->v0 || !im->coff || !im->cend) return spn_error(SPN_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < (size_t)im->nprey * ns; i++) im->coff[i] = im->cend[i] = -1;
     if (!im->sa || !im->sb || !im->k || !im->kd || !im->rest || !im->diam || !im->tension_only || !im->broken ||
-        !im->slot || !im->tag || !im->rest0 || !im->fbuf)
+        !im->slot || !im->tag || !im->rest0 || !im->len0 || !im->fbuf)
         return spn_error(SPN_ERR_NOMEM, "out of memory");
     double kmax = 0;
     for (uint32_t s = 0; s < ns; s++) {
@@ -88,6 +98,7 @@ static spn_status cache_springs(spn_impact *im, const spn_world *w)
         im->kd[s] = in.kd;
         im->rest[s] = in.rest;
         im->rest0[s] = in.rest;
+        im->len0[s] = in.length;
         im->diam[s] = spn_thread_diameter(in.tag);
         im->tension_only[s] = in.tension_only;
         im->broken[s] = in.broken;
@@ -96,6 +107,10 @@ static spn_status cache_springs(spn_impact *im, const spn_world *w)
         if (!in.broken) kmax = fmax(kmax, in.k);
     }
     im->kc = im->def.contact_stiffness > 0 ? im->def.contact_stiffness : (kmax > 0 ? kmax : 1);
+    /* A glue droplet is soft: it draws out about a millimetre before it lets
+     * go at glue_strength (droplets extend several times their size, Opell &
+     * Hendricks 2007); our assumption of the length. */
+    im->kg = im->def.glue_strength > 0 ? im->def.glue_strength / SPN_GLUE_STRETCH : 0;
     return SPN_OK;
 }
 
@@ -186,6 +201,12 @@ spn_status spn_impact_create(spn_world **w, const spn_prey_def *prey, int nprey,
             *w = copy;
         }
     }
+    /* Hysteresis as a stiff secant dashpot is for the implicit solver: an
+     * explicit step would need it capped at m / (2 dt), most of it lost. */
+    if (st == SPN_OK && im->def.hysteresis && spn_world_get_def(*w)->integrator == SPN_INTEGRATOR_IMPLICIT)
+        for (uint32_t tag = 0; tag <= SPN_THREAD_SHOT && st == SPN_OK; tag++)
+            if (spn_thread_hysteresis(tag) > 0)
+                st = spn_world_set_tag_hysteresis(*w, tag, spn_thread_hysteresis(tag), SPN_HYSTERESIS_RATE);
     if (st == SPN_OK) st = add_prey(im, *w, prey, nprey);
     if (st == SPN_OK) st = cache_springs(im, *w);
     if (st != SPN_OK) {
@@ -214,7 +235,14 @@ void spn_impact_destroy(spn_impact *im)
     free(im->slot);
     free(im->tag);
     free(im->rest0);
+    free(im->len0);
     free(im->fbuf);
+    free(im->x0);
+    free(im->coff);
+    free(im->cend);
+    free(im->cseg);
+    free(im->v0);
+    free(im->cl);
     free(im);
 }
 
@@ -236,12 +264,12 @@ static double tether_force(spn_impact *im, const spn__tether *t, const spn_vec3 
     double len = spn_v3_len(l), stretch = len - t->rest;
     if (stretch <= 0) return 0;
     if (f) {
-        spn_vec3 F = spn_v3_scale(l, -im->kc * stretch / len);
+        spn_vec3 F = spn_v3_scale(l, -im->kg * stretch / len);
         f[p] = spn_v3_add(f[p], F);
         f[a] = spn_v3_sub(f[a], spn_v3_scale(F, 1 - t->u));
         f[b] = spn_v3_sub(f[b], spn_v3_scale(F, t->u));
     }
-    return 0.5 * im->kc * stretch * stretch;
+    return 0.5 * im->kg * stretch * stretch;
 }
 
 double spn__impact_contact(spn_impact *im, const spn_vec3 *x, spn_vec3 *f)
@@ -257,6 +285,8 @@ double spn__impact_contact(spn_impact *im, const spn_vec3 *x, spn_vec3 *f)
             double d2 = spn__impact_closest(im, s, x, c, &u, &r);
             if (d2 >= R * R || d2 <= 1e-30) continue;
             double d = sqrt(d2), depth = R - d;
+            if (im->offsets) depth = spn__impact_offset_depth(im, (size_t)p * im->ns + s, depth, false);
+            if (depth <= 0) continue;
             energy += 0.5 * im->kc * depth * depth;
             if (!f) continue;
             im->touched[p] = true;
@@ -279,10 +309,13 @@ void spn__impact_yield(spn_impact *im, spn_world *w)
         double ey = spn_thread_yield_strain(im->tag[s]), r0 = im->rest0[s];
         if (!isfinite(ey)) continue;
         double len = spn_v3_len(spn_v3_sub(x[im->sa[s]], x[im->sb[s]]));
-        double over = len - r0 * (1 + ey);
+        /* A thread built past its yield strain (a web's frame and anchors
+         * hold 7-10% in equilibrium) yielded while it was made: it yields
+         * again only past the length it had then. */
+        double ylen = fmax(r0 * (1 + ey), im->len0[s]), over = len - ylen;
         if (over <= 0) continue;
-        /* force k (len - rest) on the post-yield line k (ey r0 + a over) */
-        double rest = len - ey * r0 - SPN_POST_YIELD * over;
+        /* force k (len - rest) on the post-yield line k (ylen - r0 + a over) */
+        double rest = len - (ylen - r0) - SPN_POST_YIELD * over;
         if (rest <= im->rest[s]) continue;
         double d0 = len - im->rest[s], d1 = len - rest;
         im->kinds[im->slot[s]].plastic += 0.5 * im->k[s] * (d0 * d0 - d1 * d1);
@@ -304,10 +337,19 @@ void spn__impact_glue_update(spn_impact *im, const spn_world *w)
 {
     if (!(im->def.glue_strength > 0)) return;
     const spn_vec3 *x = spn_world_positions(w);
+    /* A slack droplet was not in the implicit step (it had no force): what it
+     * stretched over the step without pulling is slack taken up, not energy. */
+    for (int i = 0; i < im->ntethers && im->offsets; i++) {
+        spn__tether *t = &im->tethers[i];
+        if (t->listed) continue;
+        uint32_t a = im->sa[t->s], b = im->sb[t->s];
+        spn_vec3 q = spn_v3_add(x[a], spn_v3_scale(spn_v3_sub(x[b], x[a]), t->u));
+        t->rest = fmax(t->rest, spn_v3_len(spn_v3_sub(x[im->prey[t->prey]], q)));
+    }
     /* Droplets that let go: pulled past their strength, or on a broken thread. */
     for (int i = 0; i < im->ntethers;) {
         double e = tether_force(im, &im->tethers[i], x, NULL);
-        double pull = sqrt(2 * e * im->kc);
+        double pull = sqrt(2 * e * im->kg);
         if (pull > im->def.glue_strength || im->broken[im->tethers[i].s]) {
             im->glue_lost += e;
             im->detached++;
@@ -323,7 +365,7 @@ void spn__impact_glue_update(spn_impact *im, const spn_world *w)
             double u;
             spn_vec3 r;
             if (spn__impact_closest(im, s, x, x[im->prey[p]], &u, &r) >= im->radius[p] * im->radius[p]) continue;
-            spn__tether t = {p, s, u, im->radius[p]};
+            spn__tether t = {p, s, u, im->radius[p], false};
             im->tethers[im->ntethers++] = t;
         }
 }
@@ -341,8 +383,10 @@ void spn_impact_force(void *user, const spn_world *w, double t, const spn_vec3 *
 {
     (void)t;
     (void)v;
-    lift(user, w, f);
-    spn__impact_contact(user, x, f);
+    spn_impact *im = user;
+    lift(im, w, f);
+    /* With the implicit solver the world applies the listed contacts itself. */
+    if (!im->listed) spn__impact_contact(im, x, f);
 }
 
 void spn_impact_track_air(spn_impact *im, spn_air_fn fn, void *user, double rho, double mu)

@@ -13,6 +13,7 @@ typedef struct spn__tether {
     int prey;
     uint32_t s;
     double u, rest;
+    bool listed; /* handed to the implicit solver for the step just taken */
 } spn__tether;
 
 #define MAX_PREY 8
@@ -32,7 +33,8 @@ struct spn_impact {
     bool strike_done;             /* every prey arrested or through: snapshot taken */
     double strike_time;
     spn_impact_report strike;     /* the ledger at that moment */ /* broken springs' distance from the nearest hit */
-    double kc;
+    double kc;    /* contact stiffness [N/m] */
+    double kg;    /* glue droplet (tether) stiffness [N/m] */
     /* springs, cached at creation (the graph does not change) */
     uint32_t ns, np;
     uint32_t *sa, *sb;
@@ -40,6 +42,7 @@ struct spn_impact {
     uint8_t *tension_only, *broken, *slot;
     uint32_t *tag;
     double *rest0;  /* rest lengths at creation (yield and breaking refer to them) */
+    double *len0;   /* lengths at creation */
     /* ledger */
     int nkinds;
     spn_kind_energy kinds[SPN_KIND_SLOTS];
@@ -54,6 +57,17 @@ struct spn_impact {
     spn_force_fn wind_fn;
     void *wind_user;
     spn_vec3 *fbuf;
+    /* implicit contacts (impact_contact.c): the list handed to the world
+     * before a step */
+    bool listed;                  /* the list holds this step's contacts */
+    spn_contact *cl;
+    uint32_t ncl, cap_cl;
+    spn_vec3 *x0, *v0;            /* state before the step, for the solver's loss */
+    double *coff;                 /* per prey and segment: contact offset, < 0 when not touching */
+    double *cend;                 /* per prey and segment: the solver's depth at the last step's end */
+    uint32_t *cseg;               /* per listed contact: its segment (tethers: UINT32_MAX) */
+    bool offsets;                 /* contacts use the offsets (the implicit path) */
+    double solver;                /* backward Euler's own dissipation so far [J] */
     /* glue */
     spn__tether tethers[MAX_TETHERS];
     int ntethers;
@@ -71,6 +85,13 @@ void spn__impact_ledger_start(spn_impact *im, const spn_world *w);
  * rest so its force follows the post-yield line; the elastic energy this
  * releases is dissipated (silk's hysteresis). */
 void spn__impact_yield(spn_impact *im, spn_world *w);
+/* The depth a contact of geometric depth `depth` (> 0) counts from, by its
+ * offset (impact_contact.c); `update` brings the offset up to date. */
+double spn__impact_offset_depth(spn_impact *im, size_t i, double depth, bool update);
+/* Backward Euler's numerical dissipation over the step just taken (exact for
+ * linear springs): 1/2 dv^T M dv + 1/2 dx^T K dx, contacts included. */
+double spn__impact_solver_loss(spn_impact *im, const spn_world *w);
+
 /* Glue after a step: new droplets where prey touch capture thread, droplets
  * that let go. */
 void spn__impact_glue_update(spn_impact *im, const spn_world *w);

@@ -10,7 +10,7 @@
 
 /* Elastic energy per kind into im->elastic and damping power per kind into
  * damp[], for the state (x, v). */
-static void spring_energies(spn_impact *im, const spn_vec3 *x, const spn_vec3 *v, double *damp)
+static void spring_energies(spn_impact *im, const spn_world *w, const spn_vec3 *x, const spn_vec3 *v, double *damp)
 {
     for (int i = 0; i < SPN_KIND_SLOTS; i++) im->elastic[i] = damp[i] = 0;
     for (uint32_t s = 0; s < im->ns; s++) {
@@ -19,9 +19,13 @@ static void spring_energies(spn_impact *im, const spn_vec3 *x, const spn_vec3 *v
         spn_vec3 l = spn_v3_sub(x[a], x[b]);
         double len = spn_v3_len(l), d = len - im->rest[s];
         if ((d < 0 && im->tension_only[s]) || len <= 0) continue;
-        double rate = spn_v3_dot(spn_v3_sub(v[a], v[b]), l) / len;
+        /* backward Euler's damping acts along the direction at the step's start */
+        spn_vec3 dir = l;
+        if (im->listed) dir = spn_v3_sub(im->x0[a], im->x0[b]);
+        double dlen = spn_v3_len(dir), rate = dlen > 0 ? spn_v3_dot(spn_v3_sub(v[a], v[b]), dir) / dlen : 0;
         im->elastic[im->slot[s]] += 0.5 * im->k[s] * d * d;
-        damp[im->slot[s]] += im->kd[s] * rate * rate;
+        /* the coefficient of the last step: kd plus silk's hysteresis */
+        damp[im->slot[s]] += spn_world_spring_damping(w, s) * rate * rate;
     }
 }
 
@@ -96,7 +100,7 @@ static double prey_kinetic(const spn_impact *im, const spn_world *w)
 void spn__impact_ledger_start(spn_impact *im, const spn_world *w)
 {
     const spn_vec3 *x = spn_world_positions(w), *v = spn_world_velocities(w);
-    spring_energies(im, x, v, im->damp_prev);
+    spring_energies(im, w, x, v, im->damp_prev);
     memcpy(im->elastic0, im->elastic, sizeof im->elastic0);
     im->viscous_prev = viscous_power(w, v);
     im->total0 = mechanical(im, w, x);
@@ -110,18 +114,24 @@ static void check_strike(spn_impact *im, spn_world *w);
 
 void spn_impact_after_step(spn_impact *im, spn_world *w, double dt)
 {
+    /* Before yielding moves rest lengths: the loss is the step's. */
+    im->solver += spn__impact_solver_loss(im, w);
     spn__impact_yield(im, w);
     const spn_vec3 *x = spn_world_positions(w), *v = spn_world_velocities(w);
     double damp[SPN_KIND_SLOTS];
-    spring_energies(im, x, v, damp);
+    spring_energies(im, w, x, v, damp);
+    /* Backward Euler's forces act at the step's end (rectangle rule), the
+     * explicit solvers' between (trapezoid). */
+    const double a = im->listed ? 0 : 0.5 * dt, b = dt - a;
     for (int i = 0; i < SPN_KIND_SLOTS; i++) {
-        im->kinds[i].damping += 0.5 * dt * (im->damp_prev[i] + damp[i]);
+        im->kinds[i].damping += a * im->damp_prev[i] + b * damp[i];
         im->damp_prev[i] = damp[i];
     }
     double pv = viscous_power(w, v), pa = air_power(im, w, x, v), pw = wind_power(im, w, x, v);
-    im->viscous += 0.5 * dt * (im->viscous_prev + pv);
-    im->air_work += 0.5 * dt * (im->air_prev + pa);
-    im->wind_work += 0.5 * dt * (im->wind_prev + pw);
+    im->viscous += a * im->viscous_prev + b * pv;
+    im->air_work += a * im->air_prev + b * pa;
+    im->wind_work += a * im->wind_prev + b * pw;
+    im->listed = false;
     im->viscous_prev = pv;
     spn__impact_glue_update(im, w);
     for (int p = 0; p < im->nprey; p++)
@@ -189,7 +199,7 @@ void spn_impact_report_get(spn_impact *im, const spn_world *w, spn_impact_report
     r->prey_kinetic_end = prey_kinetic(im, w);
     r->total_start = im->total0;
     double damp[SPN_KIND_SLOTS];
-    spring_energies(im, spn_world_positions(w), spn_world_velocities(w), damp);
+    spring_energies(im, w, spn_world_positions(w), spn_world_velocities(w), damp);
     r->total_now = mechanical(im, w, spn_world_positions(w));
     r->air_work = im->air_work;
     r->wind_work = im->wind_work;
@@ -203,7 +213,8 @@ void spn_impact_report_get(spn_impact *im, const spn_world *w, spn_impact_report
     r->nkinds = im->nkinds;
     r->glue = im->glue_lost;
     r->glue_held = im->ntethers;
-    double lost = im->viscous + im->glue_lost;
+    r->solver = im->solver;
+    double lost = im->viscous + im->glue_lost + im->solver;
     for (int i = 0; i < im->nkinds; i++) {
         r->kinds[i] = im->kinds[i];
         r->kinds[i].elastic = im->elastic[i] - im->elastic0[i];

@@ -20,6 +20,7 @@ typedef struct runner {
     spn_thesis_wind *thesis;
     spn_air_field *air;
     spn_impact *impact;
+    double cg_tolerance; /* the world's, restored after the run */
 } runner;
 
 spn_anim_def spn_anim_def_default(void)
@@ -101,6 +102,7 @@ static spn_status check_def(const spn_anim_def *d)
     if (!(d->duration >= 0) || !(d->duration <= 1e5)) return spn_error(SPN_ERR_INVALID, "duration must be in [0, 1e5] s");
     if (!(d->fps > 0) || !(d->fps <= 10000)) return spn_error(SPN_ERR_INVALID, "fps must be in (0, 10000]");
     if (d->substeps < 0) return spn_error(SPN_ERR_INVALID, "substeps must be >= 0");
+    if (!(d->cg_tolerance >= 0 && d->cg_tolerance < 1)) return spn_error(SPN_ERR_INVALID, "solver tolerance must be in [0, 1)");
     int frames = spn_anim_frame_count(d);
     if (d->first_frame < 0 || d->first_frame >= frames)
         return spn_error(SPN_ERR_INVALID, "frame range starts at %d, outside 0..%d", d->first_frame, frames - 1);
@@ -148,7 +150,10 @@ static spn_status setup(runner *r, spn_world **w)
 {
     spn_status st = SPN_OK;
     if (r->def.solver != SPN_INTEGRATOR_COUNT) spn_world_set_integrator(*w, r->def.solver);
-    if (r->def.nprey > 0) st = spn_impact_create(w, r->def.prey, r->def.nprey, &r->def.impact, &r->impact);
+    r->cg_tolerance = spn_world_get_def(*w)->cg_tolerance;
+    if (r->def.cg_tolerance > 0)
+        st = spn_world_set_solver_tolerance(*w, r->def.cg_tolerance, spn_world_get_def(*w)->cg_max_iterations);
+    if (st == SPN_OK && r->def.nprey > 0) st = spn_impact_create(w, r->def.prey, r->def.nprey, &r->def.impact, &r->impact);
     if (st == SPN_OK && r->def.wind == SPN_WIND_THESIS) {
         spn_thesis_wind_def td = r->def.thesis;
         td.seed = r->def.seed;
@@ -162,6 +167,7 @@ static spn_status setup(runner *r, spn_world **w)
 
 static void teardown(runner *r, spn_world *w)
 {
+    if (r->def.cg_tolerance > 0) spn_world_set_solver_tolerance(w, r->cg_tolerance, spn_world_get_def(w)->cg_max_iterations);
     spn_world_set_force_callback(w, NULL, NULL);
     spn_world_set_break_callback(w, NULL, NULL);
     if (r->air) spn_world_set_air(w, NULL, NULL, r->def.air.rho, r->def.air.mu);
@@ -170,18 +176,34 @@ static void teardown(runner *r, spn_world *w)
     spn_impact_destroy(r->impact);
 }
 
+static spn_status one_step(runner *r, spn_world *w, double dt, uint64_t *steps)
+{
+    double t = spn_world_time(w);
+    if (r->air) spn_air_prepare(r->air, t, t + dt);
+    spn_status st = r->impact ? spn_impact_before_step(r->impact, w, dt) : SPN_OK;
+    if (st == SPN_OK) st = spn_world_step(w, dt);
+    if (st != SPN_OK) return st;
+    (*steps)++;
+    if (r->impact) spn_impact_after_step(r->impact, w, dt);
+    return SPN_OK;
+}
+
+/* With the implicit solver a substep near a prey is split so the prey moves
+ * at most a tenth of its radius per step (spn_impact_step_limit): a function
+ * of the state, so a frame is the same bits in any frame range. */
 static spn_status advance_frame(runner *r, spn_world *w, int substeps, double dt, uint64_t *steps, bool *stopped)
 {
+    const bool split = r->impact && spn_world_get_def(w)->integrator == SPN_INTEGRATOR_IMPLICIT;
     for (int s = 0; s < substeps; s++) {
-        double t = spn_world_time(w);
-        if (r->air) spn_air_prepare(r->air, t, t + dt);
-        spn_status st = spn_world_step(w, dt);
-        if (st != SPN_OK) return st;
-        (*steps)++;
-        if (r->impact) spn_impact_after_step(r->impact, w, dt);
-        if (r->def.stop && *r->def.stop) {
-            *stopped = true;
-            return SPN_OK;
+        double limit = split ? spn_impact_step_limit(r->impact, w, dt) : dt;
+        int n = limit < dt ? (int)fmin(1e6, ceil(dt / limit)) : 1;
+        for (int j = 0; j < n; j++) {
+            spn_status st = one_step(r, w, dt / n, steps);
+            if (st != SPN_OK) return st;
+            if (r->def.stop && *r->def.stop) {
+                *stopped = true;
+                return SPN_OK;
+            }
         }
     }
     return SPN_OK;
@@ -202,13 +224,15 @@ spn_status spn_animate(spn_world **w, const spn_anim_def *def, spn_anim_frame_fn
     double kc = r.impact ? spn_impact_contact_stiffness(r.impact) : 0;
     spn_integrator solver = spn_world_get_def(*w)->integrator;
     rep.substeps = def->substeps > 0 ? def->substeps : spn_anim_stable_substeps(*w, def->fps, solver, kc);
-    /* Any solver: contact forces are explicit (a callback), so they need the
-     * explicit step; and a prey moves at most a tenth of its radius per step. */
-    if (r.impact && def->substeps == 0 && (solver == SPN_INTEGRATOR_IMPLICIT || solver == SPN_INTEGRATOR_ADAPTIVE)) {
+    /* The adaptive solver meets the contact forces explicitly (a callback), so
+     * it needs the explicit step; the implicit one carries their stiffness
+     * (spn_impact_before_step) and splits steps near prey (advance_frame).
+     * Explicit solvers: a prey moves at most a tenth of its radius per step. */
+    if (r.impact && def->substeps == 0 && solver == SPN_INTEGRATOR_ADAPTIVE) {
         int n = spn_anim_stable_substeps(*w, def->fps, SPN_INTEGRATOR_SYMPLECTIC, kc);
         if (n > rep.substeps) rep.substeps = n;
     }
-    for (int i = 0; i < def->nprey && def->substeps == 0; i++) {
+    for (int i = 0; i < def->nprey && def->substeps == 0 && solver != SPN_INTEGRATOR_IMPLICIT; i++) {
         double v = spn_v3_len(def->prey[i].velocity), n = ceil(10 * v / (def->fps * def->prey[i].radius));
         if (n > rep.substeps && n < 1e7) rep.substeps = (int)n;
     }

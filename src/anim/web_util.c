@@ -18,20 +18,24 @@
 
 typedef struct thread_props {
     uint32_t tag;
-    double diameter, breaking_strain, yield_strain;
+    double diameter, breaking_strain, yield_strain, hysteresis;
 } thread_props;
 
 /* Dragline yields at ~0.04 and then stiffens at ~0.3 E up to breaking: with
  * E = 10 GPa this gives Gosline's strength 1.1 GPa at 0.27 and a toughness of
- * ~180 MJ/m^3 (measured 160). Viscid capture silk is rubbery: no yield. */
+ * ~180 MJ/m^3 (measured 160). Viscid capture silk is rubbery: no yield.
+ * Hysteresis: Gosline et al. 1999 measured 65% for Araneus dragline; viscid
+ * silk loses more (Denny 1976): we take 75%, an assumption within its range. */
+#define DL 0.65
 static const thread_props props[] = {
-    {SPN_THREAD_GENERIC, 3e-6, INFINITY, INFINITY}, {SPN_THREAD_ANCHOR, 5e-6, 0.27, 0.04},
-    {SPN_THREAD_FRAME, 4e-6, 0.27, 0.04},           {SPN_THREAD_RADIUS, 3e-6, 0.27, 0.04},
-    {SPN_THREAD_HUB, 2e-6, 0.27, 0.04},             {SPN_THREAD_AUX_SPIRAL, 2e-6, 0.33, 0.04},
-    {SPN_THREAD_CAPTURE, 10e-6, 2.7, INFINITY},     {SPN_THREAD_INSCRIPTION, 10e-6, 2.7, INFINITY},
-    {SPN_THREAD_STABILIMENTUM, 20e-6, 0.5, 0.04},   {SPN_THREAD_SIGNAL, 3e-6, 0.27, 0.04},
-    {SPN_THREAD_BRIDGE, 5e-6, 0.27, 0.04},          {SPN_THREAD_SHOT, 5e-6, 0.27, 0.04},
+    {SPN_THREAD_GENERIC, 3e-6, INFINITY, INFINITY, 0}, {SPN_THREAD_ANCHOR, 5e-6, 0.27, 0.04, DL},
+    {SPN_THREAD_FRAME, 4e-6, 0.27, 0.04, DL},           {SPN_THREAD_RADIUS, 3e-6, 0.27, 0.04, DL},
+    {SPN_THREAD_HUB, 2e-6, 0.27, 0.04, DL},             {SPN_THREAD_AUX_SPIRAL, 2e-6, 0.33, 0.04, DL},
+    {SPN_THREAD_CAPTURE, 10e-6, 2.7, INFINITY, 0.75},   {SPN_THREAD_INSCRIPTION, 10e-6, 2.7, INFINITY, 0.75},
+    {SPN_THREAD_STABILIMENTUM, 20e-6, 0.5, 0.04, DL},   {SPN_THREAD_SIGNAL, 3e-6, 0.27, 0.04, DL},
+    {SPN_THREAD_BRIDGE, 5e-6, 0.27, 0.04, DL},          {SPN_THREAD_SHOT, 5e-6, 0.27, 0.04, DL},
 };
+#undef DL
 
 static const thread_props *find(uint32_t tag)
 {
@@ -56,6 +60,12 @@ double spn_thread_yield_strain(uint32_t tag)
 {
     const thread_props *p = find(tag);
     return p ? p->yield_strain : INFINITY;
+}
+
+double spn_thread_hysteresis(uint32_t tag)
+{
+    const thread_props *p = find(tag);
+    return p ? p->hysteresis : 0;
 }
 
 static bool is_web_particle(const spn_world *w, uint32_t i) { return spn_world_particle_tag(w, i) != SPN_PARTICLE_PREY; }

@@ -71,7 +71,7 @@ static void build_jacobian(spn_world *w, double h)
 }
 
 /* Inverse of the symmetric 3x3 block (xx, yy, zz, xy, xz, yz), by cofactors. */
-static void invert_sym3(const double a[6], double out[6])
+void spn__invert_sym3(const double a[6], double out[6])
 {
     const double xx = a[0], yy = a[1], zz = a[2], xy = a[3], xz = a[4], yz = a[5];
     const double c0 = yy * zz - yz * yz, c1 = xx * zz - xz * xz, c2 = xx * yy - xy * xy;
@@ -82,6 +82,27 @@ static void invert_sym3(const double a[6], double out[6])
     out[3] = c3 * inv, out[4] = c4 * inv, out[5] = c5 * inv;
 }
 
+/* Particle i's diagonal block of A: mass (scaled by 1 + h drag) plus its
+ * springs' Jacobian blocks. */
+static void block_of(const spn_world *w, uint32_t i, double m_scale, double d[6])
+{
+    const double m = w->mass[i] * m_scale;
+    d[0] = d[1] = d[2] = m;
+    d[3] = d[4] = d[5] = 0;
+    for (uint32_t k = w->adj_start[i]; k < w->adj_start[i + 1]; k++) {
+        const spn__jac *j = &w->jac[w->adj[k] >> 1];
+        const double iso = j->iso + j->air, ax = j->axial - j->air;
+        const spn_vec3 u = j->u;
+        d[0] += iso + ax * u.x * u.x, d[1] += iso + ax * u.y * u.y, d[2] += iso + ax * u.z * u.z;
+        d[3] += ax * u.x * u.y, d[4] += ax * u.x * u.z, d[5] += ax * u.y * u.z;
+    }
+}
+
+void spn__implicit_block(const spn_world *w, uint32_t i, double h, double d[6])
+{
+    block_of(w, i, 1 + h * w->def.drag, d);
+}
+
 /* Right-hand side b = h f + h^2 K v, and the inverse of each particle's 3x3
  * diagonal block of A (block Jacobi: a strand's node is stiff along the
  * thread and soft across it, which a scalar diagonal cannot see). */
@@ -90,7 +111,7 @@ static void build_rhs(spn_world *w, double h)
     const uint32_t np = w->np;
     spn_vec3 *b = w->tmp[T_B];
     double *minv = w->pinv;
-    const double drag = w->def.drag;
+    const double m_scale = 1 + h * w->def.drag;
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
     for (uint32_t i = 0; i < np; i++) {
         double *mi = minv + 6 * (size_t)i;
@@ -100,20 +121,16 @@ static void build_rhs(spn_world *w, double h)
             continue;
         }
         spn_vec3 bi = spn_v3_scale(w->f[i], h);
-        const double m = w->mass[i] * (1 + h * drag);
-        double d[6] = {m, m, m, 0, 0, 0};
+        double d[6];
+        block_of(w, i, m_scale, d);
         for (uint32_t k = w->adj_start[i]; k < w->adj_start[i + 1]; k++) {
             const uint32_t e = w->adj[k], s = e >> 1;
-            const spn__jac *j = &w->jac[s];
             bi = (e & 1u) ? spn_v3_sub(bi, w->fs[s]) : spn_v3_add(bi, w->fs[s]);
-            const double iso = j->iso + j->air, ax = j->axial - j->air;
-            const spn_vec3 u = j->u;
-            d[0] += iso + ax * u.x * u.x, d[1] += iso + ax * u.y * u.y, d[2] += iso + ax * u.z * u.z;
-            d[3] += ax * u.x * u.y, d[4] += ax * u.x * u.z, d[5] += ax * u.y * u.z;
         }
         b[i] = bi;
-        invert_sym3(d, mi);
+        spn__invert_sym3(d, mi);
     }
+    if (w->ncontacts) spn__contact_system(w, h, b, minv);
 }
 
 /* Per-spring product into fs (and fair with air): the force of the spring's
@@ -183,6 +200,7 @@ static double apply(spn_world *w, double h, const spn_vec3 *restrict p, spn_vec3
     }
     double sum = 0;
     for (uint32_t blk = 0; blk < nb; blk++) sum += partial[(size_t)blk * SPN_NSUMS];
+    if (w->ncontacts) sum += spn__contact_apply(w, h, p, ap);
     return sum;
 }
 
@@ -315,8 +333,15 @@ spn_status spn__step_implicit(spn_world *w, double h, spn__step_result *r)
     r->e_before = e.kinetic + e.elastic;
     r->elastic = e.elastic;
     build_jacobian(w, h);
+    if (w->ncontacts) spn__contact_begin(w);
     build_rhs(w, h);
     w->last.cg_iterations = solve(w, h, e.gross);
+    /* One-sided contacts (contact.c): drop those the solve left pulling. */
+    for (int round = 0; round < 4 && w->ncontacts && spn__contact_release(w, h, w->tmp[T_DV]); round++) {
+        build_jacobian(w, h); /* the solve used fs as scratch */
+        build_rhs(w, h);
+        w->last.cg_iterations += solve(w, h, e.gross);
+    }
     finish(w, h, ext, r);
     return SPN_OK;
 }

@@ -83,6 +83,7 @@ static spn_status step_once(spn_world *w, double dt)
     w->last.substeps = 1;
     spn__step_result r;
     memset(&r, 0, sizeof r);
+    if (w->nhyst) spn__hysteresis_prepare(w, dt);
     spn_status st = integrate(w, dt, &r);
     if (st != SPN_OK) return st;
     double gain = r.gain_kp - r.elastic - r.work;

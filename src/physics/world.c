@@ -102,6 +102,7 @@ void spn_world_destroy(spn_world *w)
     free(w->diam);
     free(w->colliders);
     free(w->metadata);
+    spn__silk_free(w);
     free(w);
 }
 
@@ -432,6 +433,9 @@ spn_world *spn_world_clone(const spn_world *w)
     c->diam = NULL;
     c->colliders = NULL;
     c->metadata = NULL;
+    c->hyst = NULL;
+    c->contacts = NULL;
+    c->ncontacts = c->cap_contacts = 0;
     c->cap_p = w->np;
     c->cap_s = w->ns;
     bool ok = dup_array((void **)&c->x, w->x, w->np, sizeof *w->x) &&
@@ -452,7 +456,8 @@ spn_world *spn_world_clone(const spn_world *w)
               dup_array((void **)&c->sorder, w->sorder, w->ns, sizeof *w->sorder) &&
               dup_array((void **)&c->diam, w->diam, w->ndiam, sizeof *w->diam) &&
               dup_array((void **)&c->colliders, w->colliders, w->ncolliders, sizeof *w->colliders) &&
-              dup_array((void **)&c->metadata, w->metadata, w->metadata ? strlen(w->metadata) + 1 : 0, 1);
+              dup_array((void **)&c->metadata, w->metadata, w->metadata ? strlen(w->metadata) + 1 : 0, 1) &&
+              spn__silk_clone(c, w);
     if (!ok) {
         spn_world_destroy(c);
         return NULL;

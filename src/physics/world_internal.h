@@ -38,6 +38,12 @@ typedef struct spn_collider {
     double restitution, friction;
 } spn_collider;
 
+/* Silk hysteresis of one thread kind (hysteresis.c). */
+typedef struct spn_tag_hysteresis {
+    uint32_t tag;
+    double eta, rate0;
+} spn_tag_hysteresis;
+
 typedef struct spn_tag_diameter {
     uint32_t tag;
     double diameter;
@@ -157,6 +163,13 @@ struct spn_world {
 
     spn_collider *colliders;
     uint32_t ncolliders;
+
+    /* silk hysteresis per tag (hysteresis.c) and the implicit solver's
+     * contacts (contact.c); a clone copies the first, not the second */
+    spn_tag_hysteresis *hyst;
+    uint32_t nhyst;
+    spn_contact *contacts;
+    uint32_t ncontacts, cap_contacts;
 
     char *metadata;
 };
@@ -287,6 +300,30 @@ void spn__step_explicit(spn_world *w, double dt, bool symplectic, spn__step_resu
 spn_status spn__step_rk4(spn_world *w, double dt, spn__step_result *r);
 spn_status spn__step_adaptive(spn_world *w, double dt, spn__step_result *r);
 spn_status spn__step_implicit(spn_world *w, double dt, spn__step_result *r);
+
+/* ---- hysteresis.c, contact.c ---- */
+
+/* Set each hysteretic spring's damping coefficient in the hot records from
+ * the state, for a step of dt (kd plus the hysteresis secant). */
+void spn__hysteresis_prepare(spn_world *w, double dt);
+/* Free / duplicate (into a fresh clone) the hysteresis table and contacts. */
+void spn__silk_free(spn_world *w);
+bool spn__silk_clone(spn_world *c, const spn_world *w);
+/* Implicit solver (implicit.c): particle i's 3x3 diagonal block of A from
+ * its springs, mass and drag (xx, yy, zz, xy, xz, yz), and its inverse. */
+void spn__implicit_block(const spn_world *w, uint32_t i, double h, double d[6]);
+void spn__invert_sym3(const double a[6], double out[6]);
+/* Every contact active, before a step's first solve. */
+void spn__contact_begin(spn_world *w);
+/* The active contacts' part of the implicit system: their forces and
+ * h^2 K v0 into the right-hand side b, their blocks into the inverted
+ * diagonal blocks pinv. */
+void spn__contact_system(spn_world *w, double h, spn_vec3 *b, double *pinv);
+/* ap += A_contacts p; returns p . A_contacts p. */
+double spn__contact_apply(const spn_world *w, double h, const spn_vec3 *p, spn_vec3 *ap);
+/* After a solve for dv: drop the contacts that end on the wrong side; true
+ * when any was dropped (solve again). */
+bool spn__contact_release(spn_world *w, double h, const spn_vec3 *dv);
 
 /* ---- constraints.c ---- */
 

@@ -1,0 +1,216 @@
+/* Prey contact for the implicit solver, and the solver's own dissipation.
+ *
+ * Before each implicit step the impact lists its contacts for the world
+ * (spn_world_set_contacts): every segment closer to a prey's centre than its
+ * radius, and every taut glue tether. The force callback gives each the
+ * force k depth0 n of its depth at the step's start and the world's backward
+ * Euler step carries the stiffness, so the prey and the 1e-10 kg thread
+ * particles move together at the solver's step instead of the 1e-7 s an
+ * explicit contact needs. A contact is found a step late, already some way
+ * in (the prey moves at most a tenth of its radius per step, runner.c): the
+ * depth it first has becomes the contact's offset, so the penalty does not
+ * create k depth^2 / 2 from nothing (the sphere is that much smaller for that
+ * thread; the offset shrinks as the thread comes back out).
+ *
+ * Backward Euler removes energy by itself: for a quadratic energy one step
+ * loses exactly 1/2 dv^T M dv + 1/2 dx^T K dx (with dv, dx the step's changes;
+ * Hairer, Lubich & Wanner, or a two-line derivation from M dv = h f(x1)).
+ * The ledger counts it as the solver's loss, from the saved start state:
+ * particles' 1/2 m |dv|^2, springs' 1/2 k [(1 - tau)(u . dd)^2 + tau |dd|^2]
+ * (the Hessian the solver uses, tau = 1 - r / L >= 0, slack springs none),
+ * and per contact 1/2 k dy^2 plus the difference between the one-sided
+ * penalty and its two-sided linear model at the ends of the step. */
+#include "impact_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static spn_status grow(spn_impact *im, uint32_t n)
+{
+    if (n <= im->cap_cl) return SPN_OK;
+    uint32_t cap = n < 64 ? 64 : 2 * n;
+    spn_contact *c = realloc(im->cl, cap * sizeof *c);
+    if (c) im->cl = c;
+    uint32_t *g = realloc(im->cseg, cap * sizeof *g);
+    if (g) im->cseg = g;
+    if (!c || !g) return spn_error(SPN_ERR_NOMEM, "out of memory for %u contacts", n);
+    im->cap_cl = cap;
+    return SPN_OK;
+}
+
+static spn_status push(spn_impact *im, spn_contact c, uint32_t seg)
+{
+    spn_status st = grow(im, im->ncl + 1);
+    if (st != SPN_OK) return st;
+    im->cl[im->ncl] = c;
+    im->cseg[im->ncl] = seg;
+    im->ncl++;
+    return SPN_OK;
+}
+
+/* A new contact counts from the depth it has (no force acted while it got
+ * there); one the solver held at depth y_end (cend) that is found deeper,
+ * because the thread slid over the curved sphere where the solver's frozen
+ * normal saw a plane, counts from y_end (the offset takes up the rest: energy
+ * no force paid for is not created); otherwise the offset only shrinks. */
+double spn__impact_offset_depth(spn_impact *im, size_t i, double depth, bool update)
+{
+    double off = im->coff[i], end = im->cend[i];
+    if (off < 0) off = depth;
+    else if (end >= 0 && depth - off > end) off = depth - end;
+    else off = fmin(off, depth);
+    if (update) {
+        im->coff[i] = off;
+        im->cend[i] = -1;
+    }
+    return depth - off;
+}
+
+/* Segments touching prey p, with their offsets brought up to date: a contact
+ * found for the first time gets the depth it reached without force as its
+ * offset (the penalty counts from there, so it creates no energy), and an
+ * offset only shrinks after (it follows a thread pushed back out, where the
+ * penalty is zero, so that costs no energy either). */
+static spn_status list_segments(spn_impact *im, const spn_vec3 *x, int p)
+{
+    const uint32_t ip = im->prey[p];
+    const spn_vec3 c = x[ip];
+    const double R = im->radius[p];
+    double *coff = im->coff + (size_t)p * im->ns;
+    for (uint32_t s = 0; s < im->ns; s++) {
+        if (im->broken[s]) {
+            coff[s] = -1;
+            continue;
+        }
+        double u;
+        spn_vec3 r;
+        double d2 = spn__impact_closest(im, s, x, c, &u, &r);
+        if (d2 >= R * R || d2 <= 1e-30) {
+            coff[s] = -1;
+            continue;
+        }
+        double d = sqrt(d2), y = spn__impact_offset_depth(im, (size_t)p * im->ns + s, R - d, true);
+        im->touched[p] = true;
+        spn_contact ct = {ip, im->sa[s], im->sb[s], u, spn_v3_scale(r, 1 / d), im->kc, y, false, true};
+        spn_status st = push(im, ct, (uint32_t)p * im->ns + s);
+        if (st != SPN_OK) return st;
+    }
+    return SPN_OK;
+}
+
+static spn_status list_tethers(spn_impact *im, const spn_vec3 *x)
+{
+    for (int i = 0; i < im->ntethers; i++) {
+        spn__tether *t = &im->tethers[i];
+        uint32_t a = im->sa[t->s], b = im->sb[t->s], ip = im->prey[t->prey];
+        spn_vec3 q = spn_v3_add(x[a], spn_v3_scale(spn_v3_sub(x[b], x[a]), t->u)), l = spn_v3_sub(x[ip], q);
+        double len = spn_v3_len(l);
+        if (!(len > 0)) continue;
+        /* listed slack too: the world's active set drops it if it stays slack */
+        t->listed = true;
+        spn_contact ct = {ip, a, b, t->u, spn_v3_scale(l, 1 / len), im->kg, t->rest - len, true, true};
+        spn_status st = push(im, ct, UINT32_MAX);
+        if (st != SPN_OK) return st;
+    }
+    return SPN_OK;
+}
+
+spn_status spn_impact_before_step(spn_impact *im, spn_world *w, double dt)
+{
+    (void)dt;
+    const spn_vec3 *x = spn_world_positions(w), *v = spn_world_velocities(w);
+    memcpy(im->x0, x, im->np * sizeof *x);
+    memcpy(im->v0, v, im->np * sizeof *v);
+    im->ncl = 0;
+    im->listed = spn_world_get_def(w)->integrator == SPN_INTEGRATOR_IMPLICIT;
+    spn_status st = SPN_OK;
+    if (im->listed) {
+        im->offsets = true;
+        for (int p = 0; p < im->nprey && st == SPN_OK; p++) st = list_segments(im, x, p);
+        if (st == SPN_OK) st = list_tethers(im, x);
+    }
+    if (st == SPN_OK) st = spn_world_set_contacts(w, im->cl, im->listed ? im->ncl : 0);
+    if (st != SPN_OK) im->listed = false;
+    return st;
+}
+
+static double springs_loss(const spn_impact *im, const spn_vec3 *x1)
+{
+    double loss = 0;
+    for (uint32_t s = 0; s < im->ns; s++) {
+        if (im->broken[s]) continue;
+        uint32_t a = im->sa[s], b = im->sb[s];
+        spn_vec3 l = spn_v3_sub(im->x0[a], im->x0[b]);
+        double len = spn_v3_len(l), rest = im->rest[s];
+        if (!(len > 0) || (len < rest && im->tension_only[s])) continue;
+        spn_vec3 u = spn_v3_scale(l, 1 / len);
+        spn_vec3 dd = spn_v3_sub(spn_v3_sub(x1[a], im->x0[a]), spn_v3_sub(x1[b], im->x0[b]));
+        double tau = len > rest ? 1 - rest / len : 0, ax = spn_v3_dot(u, dd);
+        loss += 0.5 * im->k[s] * ((1 - tau) * ax * ax + tau * spn_v3_dot(dd, dd));
+    }
+    return loss;
+}
+
+/* The contacts in force at the end of the step (the world's active set). */
+static double contacts_loss(const spn_impact *im, const spn_world *w, const spn_vec3 *x1)
+{
+    uint32_t n;
+    const spn_contact *wc = spn_world_contacts(w, &n);
+    double loss = 0;
+    for (uint32_t i = 0; i < im->ncl && i < n; i++) {
+        const spn_contact *c = &im->cl[i];
+        if (!wc[i].active) { /* the solver left it at the surface */
+            if (im->cseg[i] != UINT32_MAX) im->cend[im->cseg[i]] = 0;
+            continue;
+        }
+        spn_vec3 dp = spn_v3_sub(x1[c->p], im->x0[c->p]);
+        spn_vec3 da = spn_v3_sub(x1[c->a], im->x0[c->a]), db = spn_v3_sub(x1[c->b], im->x0[c->b]);
+        spn_vec3 dg = spn_v3_sub(dp, spn_v3_add(spn_v3_scale(da, 1 - c->u), spn_v3_scale(db, c->u)));
+        double y0 = c->depth, y1 = y0 - spn_v3_dot(c->n, dg), dy = y1 - y0;
+        if (im->cseg[i] != UINT32_MAX) im->cend[im->cseg[i]] = fmax(y1, 0);
+        /* the part of the linear model's energy the one-sided law does not have */
+        double off0 = c->pull ? fmin(-y0, 0) : fmin(y0, 0), off1 = c->pull ? fmin(-y1, 0) : fmin(y1, 0);
+        loss += 0.5 * c->k * (dy * dy + off1 * off1 - off0 * off0);
+    }
+    return loss;
+}
+
+double spn__impact_solver_loss(spn_impact *im, const spn_world *w)
+{
+    if (!im->listed) return 0;
+    const spn_vec3 *x1 = spn_world_positions(w), *v1 = spn_world_velocities(w);
+    double loss = 0;
+    for (uint32_t i = 0; i < im->np; i++) {
+        if (spn_world_is_fixed(w, i)) continue;
+        spn_vec3 dv = spn_v3_sub(v1[i], im->v0[i]);
+        loss += 0.5 * spn_world_mass(w, i) * spn_v3_dot(dv, dv);
+    }
+    double sl = springs_loss(im, x1), cl = contacts_loss(im, w, x1);
+    return loss + sl + cl;
+}
+
+/* Distance from c to the box [lo, hi] (0 inside). */
+static double box_distance(spn_vec3 c, spn_vec3 lo, spn_vec3 hi)
+{
+    double dx = fmax(fmax(lo.x - c.x, c.x - hi.x), 0), dy = fmax(fmax(lo.y - c.y, c.y - hi.y), 0);
+    double dz = fmax(fmax(lo.z - c.z, c.z - hi.z), 0);
+    return sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+double spn_impact_step_limit(const spn_impact *im, const spn_world *w, double dt)
+{
+    spn_vec3 lo, hi;
+    spn__web_bounds(w, &lo, &hi);
+    double limit = dt;
+    for (int p = 0; p < im->nprey; p++) {
+        spn_vec3 c = spn_world_position(w, im->prey[p]);
+        double speed = spn_v3_len(spn_world_velocity(w, im->prey[p])), R = im->radius[p];
+        if (!(speed > 0)) continue;
+        /* a tenth of a radius per step, or a free flight up to most of the
+         * way to the web's box, whichever is longer */
+        double step = fmax(0.1 * R, 0.8 * (box_distance(c, lo, hi) - R)) / speed;
+        if (step < limit) limit = step;
+    }
+    return limit;
+}
