@@ -166,7 +166,7 @@ static void assemble(spn__imp_mg *m, const spn_world *w, double h)
 
 bool spn__imp_mg_prepare(spn_world *w, double h)
 {
-    const bool want = w->implicit_pc == 2 || (w->implicit_pc == 0 && w->np >= SPN__IMPLICIT_MG_MIN);
+    const bool want = w->implicit_pc == 2 || (w->implicit_pc == 0 && w->np >= SPN__IMPLICIT_MG_MIN && h >= SPN__IMPLICIT_MG_DT);
     if (!want) return false;
     const uint64_t sig = signature(w);
     if (w->imp_mg && w->imp_mg->sig != sig) {

@@ -316,8 +316,11 @@ bool spn__silk_clone(spn_world *c, const spn_world *w);
 void spn__implicit_block(const spn_world *w, uint32_t i, double h, double d[6]);
 void spn__invert_sym3(const double a[6], double out[6]);
 /* The multigrid preconditioner of the implicit step (implicit_mg.c). Auto
- * uses it from this many particles (measured, docs/physics-implicit-mg.md). */
+ * uses it from this many particles and this step [s]: below, a step needs too
+ * few block-Jacobi iterations for the cycle's cost to pay (measured on the
+ * 20k web: break-even near 2e-3 s; docs/physics-implicit-mg.md). */
 #define SPN__IMPLICIT_MG_MIN 4096u
+#define SPN__IMPLICIT_MG_DT 5e-3
 typedef struct spn__imp_mg spn__imp_mg;
 void spn__imp_mg_free(spn__imp_mg *m);
 /* After w->jac and w->pinv are built for step h: (re)build or refresh the
