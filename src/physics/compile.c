@@ -35,6 +35,7 @@ void spn__free_compiled(spn_world *w)
     free(w->cair);
     free(w->jac);
     free(w->pinv);
+    spn__imp_mg_free(w->imp_mg);
     free(w->partial);
     spn__forget_compiled(w);
 }
@@ -47,6 +48,7 @@ void spn__forget_compiled(spn_world *w)
     w->fs = w->f = w->fext = w->x0 = w->v0 = w->fair = w->wind = NULL;
     w->sdiam = w->cair = w->partial = w->pinv = NULL;
     w->jac = NULL;
+    w->imp_mg = NULL;
     w->npartial = 0;
     w->sweep_block = 0;
     w->xout_start = w->xout = w->xin_start = w->xin = NULL;

@@ -423,7 +423,8 @@ static void vcycle(const spn__mg *mg, const spn__eq *e, int l, const double *b, 
     }
     memset(x, 0, 3 * (size_t)L->A.rows * sizeof *x);
     smooth(mg, l, b, x, true);
-    if (l == 0) { /* the spring system's own product reads each spring's 6 numbers once, not 2 x 9 */
+    if (l == 0 && e->hs) { /* the spring system's own product reads each spring's 6 numbers once, not 2 x 9
+                            * (the implicit step's system has no spring blocks: implicit_mg.c) */
         spn__eq_matvec(e, x, L->r);
         const uint32_t n3 = 3 * L->A.rows;
         for (uint32_t k = 0; k < n3; k++) L->r[k] = b[k] - L->r[k];

@@ -3,7 +3,8 @@
  *   (M - h df/dv - h^2 df/dx) dv = h (f0 + h df/dx v0),
  *   v1 = v0 + dv,  x1 = x0 + h v1,
  * solved by conjugate gradients with a block-Jacobi preconditioner (the
- * inverse of each particle's 3x3 diagonal block).
+ * inverse of each particle's 3x3 diagonal block) or, on large webs, the
+ * equilibrium solver's multigrid (implicit_mg.c).
  * Fixed particles are filtered out (their rows and columns are the identity
  * with a zero right-hand side: their dv stays exactly 0).
  *
@@ -204,8 +205,9 @@ static double apply(spn_world *w, double h, const spn_vec3 *restrict p, spn_vec3
     return sum;
 }
 
-/* dv += alpha p; r -= alpha Ap; z = M^-1 r. Returns r.z and r.r via out. */
-static void cg_update(spn_world *w, double alpha, double *rz, double *rr)
+/* dv += alpha p; r -= alpha Ap; z = M^-1 r (block Jacobi inline, or the
+ * multigrid after the loop). Returns r.z and r.r via out. */
+static void cg_update(spn_world *w, double alpha, bool mg, double *rz, double *rr)
 {
     spn_vec3 *dv = w->tmp[T_DV], *r = w->tmp[T_R], *z = w->tmp[T_Z];
     const spn_vec3 *p = w->tmp[T_P], *ap = w->tmp[T_AP];
@@ -219,16 +221,27 @@ static void cg_update(spn_world *w, double alpha, double *rz, double *rr)
         for (uint32_t i = lo; i < hi; i++) {
             dv[i] = spn_v3_add(dv[i], spn_v3_scale(p[i], alpha));
             const spn_vec3 ri = spn_v3_sub(r[i], spn_v3_scale(ap[i], alpha));
+            r[i] = ri;
+            c += spn_v3_dot(ri, ri);
+            if (mg) continue;
             const double *m = minv + 6 * (size_t)i;
             const spn_vec3 zi = spn_v3(m[0] * ri.x + m[3] * ri.y + m[4] * ri.z, m[3] * ri.x + m[1] * ri.y + m[5] * ri.z,
                                        m[4] * ri.x + m[5] * ri.y + m[2] * ri.z);
-            r[i] = ri;
             z[i] = zi;
             a += spn_v3_dot(ri, zi);
-            c += spn_v3_dot(ri, ri);
         }
         partial[(size_t)blk * SPN_NSUMS] = a;
         partial[(size_t)blk * SPN_NSUMS + 1] = c;
+    }
+    if (mg) {
+        spn__imp_mg_apply(w, r, z);
+#pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
+        for (uint32_t blk = 0; blk < nb; blk++) {
+            const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < np ? lo + SPN_BLOCK : np;
+            double a = 0;
+            for (uint32_t i = lo; i < hi; i++) a += spn_v3_dot(r[i], z[i]);
+            partial[(size_t)blk * SPN_NSUMS] = a;
+        }
     }
     double sum[SPN_NSUMS];
     spn__sum_partials(w, nb, sum);
@@ -253,6 +266,7 @@ static void cg_direction(spn_world *w, double beta)
  * could be met. */
 static int solve(spn_world *w, double h, double gross)
 {
+    const bool mg = spn__imp_mg_prepare(w, h);
     const uint32_t np = w->np;
     spn_vec3 *dv = w->tmp[T_DV], *r = w->tmp[T_R], *z = w->tmp[T_Z], *p = w->tmp[T_P];
     memset(dv, 0, np * sizeof *dv);
@@ -260,7 +274,7 @@ static int solve(spn_world *w, double h, double gross)
     double rz, rr;
     memset(p, 0, np * sizeof *p);
     memset(w->tmp[T_AP], 0, np * sizeof *p);
-    cg_update(w, 0, &rz, &rr); /* z = M^-1 r and the norms */
+    cg_update(w, 0, mg, &rz, &rr); /* z = M^-1 r and the norms */
     memcpy(p, z, np * sizeof *p);
     const double floor = 1e-13 * h * gross;
     double stop = w->def.cg_tolerance * w->def.cg_tolerance * rr;
@@ -270,7 +284,7 @@ static int solve(spn_world *w, double h, double gross)
         double pap = apply(w, h, p, w->tmp[T_AP]);
         if (!(pap > 0)) break;
         double rz_old = rz;
-        cg_update(w, rz / pap, &rz, &rr);
+        cg_update(w, rz / pap, mg, &rz, &rr);
         it++;
         if (rr <= stop) break;
         cg_direction(w, rz / rz_old);

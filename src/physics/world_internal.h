@@ -138,6 +138,8 @@ struct spn_world {
     double *cair;         /* per-spring linear air-drag coefficient (on demand) */
     spn__jac *jac;        /* implicit: per-spring Jacobian (on demand) */
     double *pinv;         /* implicit: per-particle inverse 3x3 block, 6 each (on demand) */
+    struct spn__imp_mg *imp_mg; /* implicit: the multigrid preconditioner (implicit_mg.c, on demand) */
+    uint8_t implicit_pc;  /* implicit preconditioner: 0 auto, 1 block Jacobi, 2 multigrid */
     double *partial;      /* SPN_NSUMS per block */
     uint32_t npartial;    /* blocks the partial array holds */
 
@@ -313,6 +315,19 @@ bool spn__silk_clone(spn_world *c, const spn_world *w);
  * its springs, mass and drag (xx, yy, zz, xy, xz, yz), and its inverse. */
 void spn__implicit_block(const spn_world *w, uint32_t i, double h, double d[6]);
 void spn__invert_sym3(const double a[6], double out[6]);
+/* The multigrid preconditioner of the implicit step (implicit_mg.c). Auto
+ * uses it from this many particles and this step [s]: below, a step needs too
+ * few block-Jacobi iterations for the cycle's cost to pay (measured on the
+ * 20k web: break-even near 2e-3 s; docs/physics-implicit-mg.md). */
+#define SPN__IMPLICIT_MG_MIN 4096u
+#define SPN__IMPLICIT_MG_DT 5e-3
+typedef struct spn__imp_mg spn__imp_mg;
+void spn__imp_mg_free(spn__imp_mg *m);
+/* After w->jac and w->pinv are built for step h: (re)build or refresh the
+ * hierarchy; false when the step should use block Jacobi. */
+bool spn__imp_mg_prepare(spn_world *w, double h);
+/* z = M^-1 r over all particles (fixed rows 0). */
+void spn__imp_mg_apply(const spn_world *w, const spn_vec3 *r, spn_vec3 *z);
 /* Every contact active, before a step's first solve. */
 void spn__contact_begin(spn_world *w);
 /* The active contacts' part of the implicit system: their forces and

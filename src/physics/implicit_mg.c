@@ -1,0 +1,208 @@
+/* The equilibrium solver's multigrid (equilibrium_mg.c) as the preconditioner
+ * of the implicit step's CG (implicit.c).
+ *
+ * Backward Euler's matrix A = M - h D - h^2 K is the spring Hessian (with
+ * damping and air terms) plus a mass diagonal: the same graph and the same
+ * 50:1 thread anisotropy the multigrid was built for, only better
+ * conditioned. Block Jacobi needs 400-600 CG iterations a step on a 20k web
+ * at dt 0.05 s; the multigrid a few tens (docs/physics-implicit-mg.md).
+ *
+ * The particles that carry a live spring (spn__eq_init's free set) get the
+ * V-cycle; every other free particle (a prey body held only by contacts) its
+ * inverted 3x3 block; fixed rows stay zero. Level 0 is assembled every step
+ * from the per-spring Jacobian: for spring s with u, iso, axial, air the
+ * off-diagonal block is -(iso - air) I - (axial + air) u u^T, and a particle's
+ * diagonal block is the one block Jacobi inverts (contacts included: the
+ * contacts' couplings between particles are left out, which keeps the
+ * preconditioner symmetric positive definite; CG still solves the full A).
+ *
+ * Reuse: the hierarchy (aggregates, prolongators, coarse operators) is built
+ * once and kept while the set of live springs and fixed particles is the
+ * same; each step refreshes level 0 and the line factors only, as the
+ * equilibrium solver does between Newton steps. A break, a new fixed point
+ * or a recompiled world changes the signature and the hierarchy is rebuilt.
+ * The preconditioner is a fixed linear map within a solve, so CG's result
+ * differs from block Jacobi's only within the solver tolerance; every product
+ * is summed in a fixed order, so the bits do not depend on the thread count. */
+#include "equilibrium_internal.h"
+#include "world_internal.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+struct spn__imp_mg {
+    spn__eq e;
+    spn__mg *mg;
+    uint32_t *espring; /* eq spring -> internal spring id */
+    double *inv0;      /* 6 n: inverted diagonal blocks in eq order */
+    double *r, *z;     /* 3 n */
+    uint64_t sig;      /* of the live springs and fixed particles it was built for */
+    bool failed;       /* the build failed for this signature: block Jacobi until it changes */
+};
+
+spn_status spn_world_set_implicit_preconditioner(spn_world *w, spn_precond p)
+{
+    switch (p) {
+    case SPN_PRECOND_AUTO: w->implicit_pc = 0; return SPN_OK;
+    case SPN_PRECOND_BLOCK_JACOBI: w->implicit_pc = 1; return SPN_OK;
+    case SPN_PRECOND_MULTIGRID: w->implicit_pc = 2; return SPN_OK;
+    default:
+        return spn_error(SPN_ERR_INVALID, "implicit preconditioner: block-jacobi, multigrid or auto, not %s",
+                         spn_precond_name(p));
+    }
+}
+
+void spn__imp_mg_free(spn__imp_mg *m)
+{
+    if (!m) return;
+    spn__mg_free(m->mg);
+    spn__eq_free(&m->e);
+    free(m->espring), free(m->inv0), free(m->r), free(m->z);
+    free(m);
+}
+
+/* FNV-1a over the dead springs and the fixed particles (O(springs + particles),
+ * nothing next to one CG iteration). */
+static uint64_t signature(const spn_world *w)
+{
+    uint64_t h = 1469598103934665603u;
+#define MIX(v) (h = (h ^ (uint64_t)(v)) * 1099511628211u)
+    MIX(w->np), MIX(w->ns);
+    for (uint32_t s = 0; s < w->ns; s++)
+        if (!(w->hs[s].k > 0)) MIX(s);
+    for (uint32_t i = 0; i < w->np; i++)
+        if (w->inv_mass[i] == 0) MIX(i | 0x80000000u);
+#undef MIX
+    return h;
+}
+
+/* The eq spring order of spn__eq_init (gather_springs), mapped to internal ids. */
+static bool map_springs(spn__imp_mg *m, const spn_world *w)
+{
+    const spn__eq *e = &m->e;
+    int32_t *local = malloc((w->np ? w->np : 1) * sizeof *local);
+    m->espring = malloc((e->m ? e->m : 1) * sizeof *m->espring);
+    if (!local || !m->espring) {
+        free(local);
+        return false;
+    }
+    for (uint32_t i = 0; i < w->np; i++) local[i] = -1;
+    for (uint32_t l = 0; l < e->nl; l++) local[e->world_id[l]] = (int32_t)l;
+    uint32_t k = 0;
+    for (int pass = 0; pass < 2; pass++)
+        for (uint32_t s = 0; s < w->ns; s++) {
+            spn_spring_info si = spn_world_spring(w, s);
+            if (si.broken || !(si.k > 0) || si.a == si.b) continue;
+            int32_t a = local[si.a], b = local[si.b];
+            bool fa = a >= 0 && (uint32_t)a < e->n, fb = b >= 0 && (uint32_t)b < e->n;
+            if ((!fa && !fb) || (pass == 0) != (fa && fb)) continue;
+            if (k < e->m) m->espring[k] = w->iperm[s];
+            k++;
+        }
+    free(local);
+    return k == e->m;
+}
+
+static spn__imp_mg *create(const spn_world *w)
+{
+    spn__imp_mg *m = calloc(1, sizeof *m);
+    if (!m) return NULL;
+    spn_equilibrium_def d = spn_equilibrium_def_default();
+    d.threads = 0; /* the world's */
+    if (spn__eq_init(&m->e, w, &d) != SPN_OK) {
+        free(m);
+        return NULL;
+    }
+    /* without the spring blocks the V-cycle's level-0 residual uses the
+     * assembled matrix (the Jacobian's air terms do not fit that form) */
+    free(m->e.hs);
+    m->e.hs = NULL;
+    size_t n = m->e.n ? m->e.n : 1;
+    m->inv0 = malloc(6 * n * sizeof *m->inv0);
+    m->r = malloc(3 * n * sizeof *m->r);
+    m->z = malloc(3 * n * sizeof *m->z);
+    if (!m->inv0 || !m->r || !m->z || !map_springs(m, w)) {
+        spn__imp_mg_free(m);
+        return NULL;
+    }
+    return m;
+}
+
+static bool in_contact(const spn_world *w, uint32_t i)
+{
+    for (uint32_t k = 0; k < w->ncontacts; k++) {
+        const spn_contact *c = &w->contacts[k];
+        if (c->active && (c->p == i || c->a == i || c->b == i)) return true;
+    }
+    return false;
+}
+
+/* Level 0 from the step's Jacobian (w->jac) and block inverses (w->pinv). */
+static void assemble(spn__imp_mg *m, const spn_world *w, double h)
+{
+    spn__eq *e = &m->e;
+    const uint32_t n = e->n;
+#pragma omp parallel for schedule(static) num_threads(spn__threads(w, n))
+    for (uint32_t i = 0; i < n; i++) {
+        const uint32_t wid = e->world_id[i];
+        double *d = e->diag + 6 * (size_t)i;
+        memcpy(m->inv0 + 6 * (size_t)i, w->pinv + 6 * (size_t)wid, 6 * sizeof *d);
+        if (w->ncontacts && in_contact(w, wid)) spn__invert_sym3(w->pinv + 6 * (size_t)wid, d);
+        else spn__implicit_block(w, wid, h, d);
+        for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++) {
+            double *o = e->offd + 6 * (size_t)j;
+            if (e->adj_other[j] < 0) {
+                memset(o, 0, 6 * sizeof *o);
+                continue;
+            }
+            const spn__jac *jc = &w->jac[m->espring[e->adj[j] >> 1]];
+            const double iso = jc->iso - jc->air, ax = jc->axial + jc->air;
+            const spn_vec3 u = jc->u;
+            o[0] = -(iso + ax * u.x * u.x), o[1] = -(iso + ax * u.y * u.y), o[2] = -(iso + ax * u.z * u.z);
+            o[3] = -ax * u.x * u.y, o[4] = -ax * u.x * u.z, o[5] = -ax * u.y * u.z;
+        }
+    }
+}
+
+bool spn__imp_mg_prepare(spn_world *w, double h)
+{
+    const bool want = w->implicit_pc == 2 || (w->implicit_pc == 0 && w->np >= SPN__IMPLICIT_MG_MIN && h >= SPN__IMPLICIT_MG_DT);
+    if (!want) return false;
+    const uint64_t sig = signature(w);
+    if (w->imp_mg && w->imp_mg->sig != sig) {
+        spn__imp_mg_free(w->imp_mg);
+        w->imp_mg = NULL;
+    }
+    if (!w->imp_mg) {
+        if (!(w->imp_mg = create(w))) return false; /* out of memory: block Jacobi does the step */
+        w->imp_mg->sig = sig;
+    }
+    spn__imp_mg *m = w->imp_mg;
+    if (m->failed || m->e.n == 0) return false;
+    assemble(m, w, h);
+    if (spn__mg_setup(&m->mg, &m->e, m->inv0) != SPN_OK) {
+        spn__mg_free(m->mg);
+        m->mg = NULL;
+        m->failed = true;
+        return false;
+    }
+    return true;
+}
+
+void spn__imp_mg_apply(const spn_world *w, const spn_vec3 *r, spn_vec3 *z)
+{
+    const spn__imp_mg *m = w->imp_mg;
+    const spn__eq *e = &m->e;
+    const uint32_t n = e->n, np = w->np;
+    const double *pinv = w->pinv;
+#pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
+    for (uint32_t i = 0; i < np; i++) { /* block Jacobi for all; the V-cycle overwrites its own */
+        const double *q = pinv + 6 * (size_t)i;
+        const spn_vec3 ri = r[i];
+        z[i] = spn_v3(q[0] * ri.x + q[3] * ri.y + q[4] * ri.z, q[3] * ri.x + q[1] * ri.y + q[5] * ri.z,
+                      q[4] * ri.x + q[5] * ri.y + q[2] * ri.z);
+    }
+    for (uint32_t i = 0; i < n; i++) memcpy(m->r + 3 * (size_t)i, &r[e->world_id[i]], 3 * sizeof(double));
+    spn__mg_apply(m->mg, e, m->r, m->z);
+    for (uint32_t i = 0; i < n; i++) memcpy(&z[e->world_id[i]], m->z + 3 * (size_t)i, 3 * sizeof(double));
+}
