@@ -60,6 +60,11 @@ static spn_anim_report strike(spn_world **w, spn_prey_def prey, double duration,
            spn_prey_outcome_name(r->outcome[0]), r->breaks, r->prey_kinetic_start, r->prey_kinetic_end,
            100 * r->balance_error / r->prey_kinetic_start, 100 * r->solver / r->prey_kinetic_start,
            (unsigned long long)rep.steps);
+    for (int i = 0; i < r->nkinds; i++)
+        printf("#   %s: elastic %.3g damping %.3g plastic %.3g broken %.3g\n", spn_thread_kind_name(r->kinds[i].tag),
+               r->kinds[i].elastic, r->kinds[i].damping, r->kinds[i].plastic, r->kinds[i].broken);
+    printf("#   glue %.3g, contact %.3g, solver %.3g, viscous %.3g, air %.3g, web kinetic %.3g\n", r->glue,
+           r->contact_energy, r->solver, r->viscous, -r->air_work, r->web_kinetic);
     return rep;
 }
 
@@ -97,17 +102,63 @@ static spn_world *small_web(void)
     return w;
 }
 
+/* Distance of the prey's centre from the nearest intact thread segment. */
+static double web_distance(const spn_world *w, uint32_t prey)
+{
+    spn_vec3 c = spn_world_position(w, prey);
+    double best = INFINITY;
+    for (uint32_t s = 0; s < spn_world_spring_count(w); s++) {
+        spn_spring_info in = spn_world_spring(w, s);
+        if (in.broken) continue;
+        spn_vec3 a = spn_world_position(w, in.a), ab = spn_v3_sub(spn_world_position(w, in.b), a);
+        double l2 = spn_v3_dot(ab, ab), t = l2 > 0 ? spn_v3_dot(spn_v3_sub(c, a), ab) / l2 : 0;
+        t = t < 0 ? 0 : (t > 1 ? 1 : t);
+        best = fmin(best, spn_v3_len(spn_v3_sub(c, spn_v3_add(a, spn_v3_scale(ab, t)))));
+    }
+    return best;
+}
+
+static uint32_t hub_of(const spn_world *w)
+{
+    for (uint32_t i = 0; i < spn_world_particle_count(w); i++)
+        if (spn_world_particle_tag(w, i) == SPN_PARTICLE_HUB) return i;
+    return 0;
+}
+
+/* A slow prey on the small Araneus web: 0.2 g at 0.5 m/s (25 uJ) 24 mm from
+ * the hub, among the capture rings. It is stopped with nothing broken, the
+ * capture thread it touches glues to it, and the energy is accounted for
+ * within 2%. NOT yet what a real web does: a real web holds such a prey;
+ * here the web still throws it back with about half its energy, far more
+ * than the glue's work of adhesion can take (docs/wind-and-prey.md,
+ * "Capture"). The numbers are printed so the gap stays visible. */
+static void test_slow_prey_on_a_web(void **state)
+{
+    (void)state;
+    spn_world *w = small_web();
+    spn_vec3 h = spn_world_position(w, hub_of(w));
+    spn_prey_def prey = {{h.x + 0.024, h.y - 0.006, 0.006}, {0, 0, -0.5}, 2e-4, 0.004};
+    spn_anim_report rep = strike(&w, prey, 0.2, true);
+    const spn_impact_report *r = &rep.impact;
+    uint32_t ip = (uint32_t)spn_world_particle_count(w) - 1;
+    double speed = spn_v3_len(spn_world_velocity(w, ip)), dist = web_distance(w, ip);
+    printf("# web: %s, glue held %d, glue work %.3g J, end speed %.3g m/s (%.1f%% of its energy), %.1f mm from a "
+           "thread\n",
+           spn_prey_outcome_name(r->outcome[0]), r->glue_held, r->glue, speed,
+           100 * r->prey_kinetic_end / r->prey_kinetic_start, 1e3 * dist);
+    assert_int_equal(r->breaks, 0);
+    assert_true(r->strike_time > 0); /* arrested */
+    assert_true(r->outcome[0] != SPN_PREY_PASSED);
+    assert_true(r->glue > 0); /* capture thread glued to it, and let go */
+    assert_true(r->balance_error <= 0.02 * r->prey_kinetic_start);
+    spn_world_destroy(w);
+}
+
 static void test_fast_prey_breaks_locally_and_passes(void **state)
 {
     (void)state;
     spn_world *w = small_web();
-    uint32_t hub = 0;
-    for (uint32_t i = 0; i < spn_world_particle_count(w); i++)
-        if (spn_world_particle_tag(w, i) == SPN_PARTICLE_HUB) {
-            hub = i;
-            break;
-        }
-    spn_vec3 h = spn_world_position(w, hub);
+    spn_vec3 h = spn_world_position(w, hub_of(w));
     spn_prey_def prey = {{h.x + 0.024, h.y - 0.006, 0.01}, {0, 0, -8}, 2e-4, 0.004};
     spn_anim_report rep = strike(&w, prey, 0.04, true);
     const spn_impact_report *r = &rep.impact;
@@ -123,6 +174,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_slow_prey_on_a_thread),
+        cmocka_unit_test(test_slow_prey_on_a_web),
         cmocka_unit_test(test_fast_prey_breaks_locally_and_passes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -137,6 +137,10 @@ typedef struct spn_impact_def {
     bool plastic;              ///< threads yield past spn_thread_yield_strain (silk's hysteresis), default true
     double glue_strength;      ///< capture-thread glue: a droplet holding the prey lets go past this pull [N],
                                ///< default 4e-5 (tens of uN, Opell & Hendricks 2007); 0: not sticky
+    double glue_adhesion;      ///< glue per metre of capture thread in contact with the prey [N/m]: a
+                               ///< segment's droplets hold together this times the length of it inside
+                               ///< the prey (at least glue_strength); default 0.05 (50 uN/mm, Opell &
+                               ///< Hendricks 2009); 0: one droplet per segment
     bool hysteresis;           ///< silk threads dissipate spn_thread_hysteresis of each loading cycle, default
                                ///< true (with the implicit solver; explicit steps go without)
 } spn_impact_def;

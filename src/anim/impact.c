@@ -28,6 +28,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Glue is soft: it draws out about a millimetre before it lets go at its
+ * strength (droplets extend several times their size, Opell & Hendricks
+ * 2007); our assumption of the length. */
 #define SPN_GLUE_STRETCH 1e-3 /* [m] */
 
 spn_impact_def spn_impact_def_default(void)
@@ -39,6 +42,7 @@ spn_impact_def spn_impact_def_default(void)
     d.prey_gravity = false;
     d.plastic = true;
     d.glue_strength = 4e-5;
+    d.glue_adhesion = 0.05;
     d.hysteresis = true;
     return d;
 }
@@ -107,10 +111,6 @@ static spn_status cache_springs(spn_impact *im, const spn_world *w)
         if (!in.broken) kmax = fmax(kmax, in.k);
     }
     im->kc = im->def.contact_stiffness > 0 ? im->def.contact_stiffness : (kmax > 0 ? kmax : 1);
-    /* A glue droplet is soft: it draws out about a millimetre before it lets
-     * go at glue_strength (droplets extend several times their size, Opell &
-     * Hendricks 2007); our assumption of the length. */
-    im->kg = im->def.glue_strength > 0 ? im->def.glue_strength / SPN_GLUE_STRETCH : 0;
     return SPN_OK;
 }
 
@@ -191,7 +191,8 @@ spn_status spn_impact_create(spn_world **w, const spn_prey_def *prey, int nprey,
     if (!im) return spn_error(SPN_ERR_NOMEM, "out of memory");
     im->def = def ? *def : spn_impact_def_default();
     spn_status st = SPN_OK;
-    if (!(im->def.breaking_scale > 0) || !(im->def.contact_stiffness >= 0) || !(im->def.glue_strength >= 0))
+    if (!(im->def.breaking_scale > 0) || !(im->def.contact_stiffness >= 0) || !(im->def.glue_strength >= 0) ||
+        !(im->def.glue_adhesion >= 0))
         st = spn_error(SPN_ERR_INVALID, "impact: breaking scale must be > 0, contact stiffness and glue >= 0");
     if (st == SPN_OK && im->def.breakage) {
         spn_world *copy = NULL;
@@ -264,12 +265,12 @@ static double tether_force(spn_impact *im, const spn__tether *t, const spn_vec3 
     double len = spn_v3_len(l), stretch = len - t->rest;
     if (stretch <= 0) return 0;
     if (f) {
-        spn_vec3 F = spn_v3_scale(l, -im->kg * stretch / len);
+        spn_vec3 F = spn_v3_scale(l, -t->k * stretch / len);
         f[p] = spn_v3_add(f[p], F);
         f[a] = spn_v3_sub(f[a], spn_v3_scale(F, 1 - t->u));
         f[b] = spn_v3_sub(f[b], spn_v3_scale(F, t->u));
     }
-    return 0.5 * im->kg * stretch * stretch;
+    return 0.5 * t->k * stretch * stretch;
 }
 
 double spn__impact_contact(spn_impact *im, const spn_vec3 *x, spn_vec3 *f)
@@ -326,16 +327,51 @@ void spn__impact_yield(spn_impact *im, spn_world *w)
 
 static bool sticky(uint32_t tag) { return tag == SPN_THREAD_CAPTURE || tag == SPN_THREAD_INSCRIPTION; }
 
-static bool has_tether(const spn_impact *im, int p, uint32_t s)
+static spn__tether *find_tether(spn_impact *im, int p, uint32_t s)
 {
     for (int i = 0; i < im->ntethers; i++)
-        if (im->tethers[i].prey == p && im->tethers[i].s == s) return true;
-    return false;
+        if (im->tethers[i].prey == p && im->tethers[i].s == s) return &im->tethers[i];
+    return NULL;
+}
+
+/* Length of segment s inside the sphere (c, R): the part of the thread whose
+ * droplets touch the prey. */
+static double chord(const spn_impact *im, uint32_t s, const spn_vec3 *x, spn_vec3 c, double R)
+{
+    spn_vec3 a = x[im->sa[s]], ab = spn_v3_sub(x[im->sb[s]], a), ac = spn_v3_sub(a, c);
+    double A = spn_v3_dot(ab, ab), B = spn_v3_dot(ab, ac), C = spn_v3_dot(ac, ac) - R * R, disc = B * B - A * C;
+    if (!(A > 0) || !(disc > 0)) return 0;
+    double r = sqrt(disc), t0 = fmax((-B - r) / A, 0), t1 = fmin((-B + r) / A, 1);
+    return t1 > t0 ? (t1 - t0) * sqrt(A) : 0;
+}
+
+/* A segment inside prey p: glue it there, or, if it is glued already, wet
+ * the droplets it now touches too (adhesive recruitment, Opell & Hendricks
+ * 2009). The glue grows and moves to the closest point only while the thread
+ * is inside the sphere, where the tether (rest >= R) is slack: that changes
+ * no energy. */
+static void glue_segment(spn_impact *im, int p, uint32_t s, const spn_vec3 *x, double u)
+{
+    double R = im->radius[p];
+    double strength = fmax(im->def.glue_strength, im->def.glue_adhesion * chord(im, s, x, x[im->prey[p]], R));
+    spn__tether *t = find_tether(im, p, s);
+    if (!t) {
+        if (im->ntethers == MAX_TETHERS) return;
+        t = &im->tethers[im->ntethers++];
+        *t = (spn__tether){p, s, u, R, 0, 0, false};
+    }
+    if (strength <= t->strength) return;
+    /* the droplets where it held let go of whatever they still held */
+    double before = tether_force(im, t, x, NULL);
+    t->u = u;
+    t->strength = strength;
+    t->k = strength / SPN_GLUE_STRETCH;
+    im->glue_lost += before - tether_force(im, t, x, NULL);
 }
 
 void spn__impact_glue_update(spn_impact *im, const spn_world *w)
 {
-    if (!(im->def.glue_strength > 0)) return;
+    if (!(im->def.glue_strength > 0) && !(im->def.glue_adhesion > 0)) return;
     const spn_vec3 *x = spn_world_positions(w);
     /* A slack droplet was not in the implicit step (it had no force): what it
      * stretched over the step without pulling is slack taken up, not energy. */
@@ -349,8 +385,8 @@ void spn__impact_glue_update(spn_impact *im, const spn_world *w)
     /* Droplets that let go: pulled past their strength, or on a broken thread. */
     for (int i = 0; i < im->ntethers;) {
         double e = tether_force(im, &im->tethers[i], x, NULL);
-        double pull = sqrt(2 * e * im->kg);
-        if (pull > im->def.glue_strength || im->broken[im->tethers[i].s]) {
+        double pull = sqrt(2 * e * im->tethers[i].k);
+        if (pull > im->tethers[i].strength || im->broken[im->tethers[i].s]) {
             im->glue_lost += e;
             im->detached++;
             im->tethers[i] = im->tethers[--im->ntethers];
@@ -358,15 +394,14 @@ void spn__impact_glue_update(spn_impact *im, const spn_world *w)
             i++;
         }
     }
-    /* New droplets where a prey touches capture thread. */
+    /* Glue where a prey touches capture thread. */
     for (int p = 0; p < im->nprey; p++)
-        for (uint32_t s = 0; s < im->ns && im->ntethers < MAX_TETHERS; s++) {
-            if (im->broken[s] || !sticky(im->tag[s]) || has_tether(im, p, s)) continue;
+        for (uint32_t s = 0; s < im->ns; s++) {
+            if (im->broken[s] || !sticky(im->tag[s])) continue;
             double u;
             spn_vec3 r;
             if (spn__impact_closest(im, s, x, x[im->prey[p]], &u, &r) >= im->radius[p] * im->radius[p]) continue;
-            spn__tether t = {p, s, u, im->radius[p], false};
-            im->tethers[im->ntethers++] = t;
+            glue_segment(im, p, s, x, u);
         }
 }
 

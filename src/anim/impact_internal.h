@@ -7,12 +7,15 @@
 
 #define MAX_TETHERS 256
 
-/* A glue droplet holding prey p to point u of segment s: tension-only, rest
- * length `rest` from the prey's centre. */
+/* The glue holding prey p to segment s, attached at point u: tension-only,
+ * rest length `rest` from the prey's centre. It stands for all the droplets
+ * of the segment's length that touched the prey. */
 typedef struct spn__tether {
     int prey;
     uint32_t s;
     double u, rest;
+    double strength; /* it lets go past this pull [N]: glue over its contact length */
+    double k;        /* strength / SPN_GLUE_STRETCH [N/m] */
     bool listed; /* handed to the implicit solver for the step just taken */
 } spn__tether;
 
@@ -34,7 +37,6 @@ struct spn_impact {
     double strike_time;
     spn_impact_report strike;     /* the ledger at that moment */ /* broken springs' distance from the nearest hit */
     double kc;    /* contact stiffness [N/m] */
-    double kg;    /* glue droplet (tether) stiffness [N/m] */
     /* springs, cached at creation (the graph does not change) */
     uint32_t ns, np;
     uint32_t *sa, *sb;
