@@ -35,18 +35,6 @@ static uint32_t free_count(const spn_world *w)
     return n;
 }
 
-/* One-minute load average, -1 if unknown. */
-static double load_average(void)
-{
-    double load = -1;
-    FILE *fp = fopen("/proc/loadavg", "r");
-    if (fp) {
-        if (fscanf(fp, "%lf", &load) != 1) load = -1;
-        fclose(fp);
-    }
-    return load;
-}
-
 typedef struct figure {
     const char *scene;
     spn_precond precond;
@@ -64,7 +52,7 @@ static double run(spn_world *w, const figure *f, double t0, spn_vec3 load, doubl
     d.force_scale = t0;
     d.load = load;
     spn_equilibrium_report r;
-    double machine_load = load_average(), c0 = bench_cpu_now(), s0 = bench_now();
+    double machine_load = bench_load_average(), c0 = bench_cpu_now(), s0 = bench_now();
     spn_status st = spn_world_equilibrium(w, &d, &r);
     double s1 = bench_now(), c1 = bench_cpu_now();
     if (st != SPN_OK) {
@@ -113,7 +101,7 @@ static void orb(const bench_orb_size *size, bool reference, const figure *figs, 
                "\"tolerance\":%g,\"newton\":%d,\"seconds\":%.3f,\"cpu_seconds\":%.3f,\"residual_over_t0\":%.3g,"
                "\"sag_m\":%.9g,\"load\":%.2f}\n",
                size->name, tols[k], it, s1 - s0, c1 - c0, bench_residual(w, load) / t0, spn_world_position(w, 0).z,
-               load_average());
+               bench_load_average());
         fflush(stdout);
         spn_world_destroy(w);
     }

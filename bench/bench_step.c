@@ -23,6 +23,8 @@
  * "lattice", the stencil step of a regular web, see src/physics/lattice.c)
  * and with the lattice forbidden ("path":"general", the spring-record loops
  * any world takes). */
+#include "common/bench_common.h"
+
 #include <spinneret/spinneret.h>
 
 #include <stdio.h>
@@ -40,26 +42,6 @@ static const size_case cases[] = {
     {400, 250, {40, 40, 10, 4, 1}},
     {1000, 1000, {8, 8, 3, 2, 1}},
 };
-
-static double clock_of(clockid_t id)
-{
-    struct timespec ts;
-    clock_gettime(id, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* One-minute load average: on a shared machine the wall-clock figures mean
- * little when it exceeds the core count. */
-static double load_average(void)
-{
-    double load = -1;
-    FILE *fp = fopen("/proc/loadavg", "r");
-    if (fp) {
-        if (fscanf(fp, "%lf", &load) != 1) load = -1;
-        fclose(fp);
-    }
-    return load;
-}
 
 static double step_size(spn_integrator integ)
 {
@@ -95,7 +77,7 @@ static int bench_one(const size_case *c, spn_integrator integ, int threads, bool
     }
     long substeps = 0, cg = 0;
     const int steps = c->steps[integ];
-    double t0 = clock_of(CLOCK_MONOTONIC), c0 = clock_of(CLOCK_PROCESS_CPUTIME_ID);
+    double t0 = bench_now(), c0 = bench_cpu_now();
     if (spn_world_advance(w, dt, steps) != SPN_OK) {
         fprintf(stderr, "bench_step: %s\n", spn_last_error());
         spn_world_destroy(w);
@@ -104,14 +86,14 @@ static int bench_one(const size_case *c, spn_integrator integ, int threads, bool
     spn_step_report r = spn_world_last_step(w);
     substeps += r.substeps;
     cg += r.cg_iterations;
-    double sec = clock_of(CLOCK_MONOTONIC) - t0, cpu = clock_of(CLOCK_PROCESS_CPUTIME_ID) - c0;
+    double sec = bench_now() - t0, cpu = bench_cpu_now() - c0;
     double per = 1e9 / ((double)steps * spn_world_spring_count(w));
     double ns_spring_step = sec * per;
     printf("{\"bench\":\"step\",\"scene\":\"orb\",\"integrator\":\"%s\",\"particles\":%u,\"springs\":%u,"
            "\"threads\":%d,\"steps\":%d,\"dt\":%g,\"ns_per_spring_step\":%.3f,\"cpu_ns_per_spring_step\":%.3f,"
            "\"load\":%.2f,\"path\":\"%s\"",
            spn_integrator_name(integ), spn_world_particle_count(w), spn_world_spring_count(w), threads, steps, dt,
-           ns_spring_step, cpu * per, load_average(), spn_world_step_path(w));
+           ns_spring_step, cpu * per, bench_load_average(), spn_world_step_path(w));
     if (integ == SPN_INTEGRATOR_ADAPTIVE)
         printf(",\"substeps_per_step\":%.1f,\"ns_per_spring_substep\":%.3f", (double)substeps / steps,
                ns_spring_step * steps / (double)substeps);

@@ -61,6 +61,17 @@ double bench_cpu_now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+double bench_load_average(void)
+{
+    double load = -1;
+    FILE *fp = fopen("/proc/loadavg", "r");
+    if (fp) {
+        if (fscanf(fp, "%lf", &load) != 1) load = -1;
+        fclose(fp);
+    }
+    return load;
+}
+
 double bench_residual(const spn_world *w, spn_vec3 load)
 {
     uint32_t np = spn_world_particle_count(w), ns = spn_world_spring_count(w);

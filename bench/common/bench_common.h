@@ -25,6 +25,10 @@ spn_world *bench_chain(int threads);
 /// Monotonic seconds.
 double bench_now(void);
 
+/// One-minute load average, -1 if unknown: on a shared machine the wall-clock
+/// figures mean little when it exceeds the core count.
+double bench_load_average(void);
+
 /// CPU seconds of this process (all threads): on a shared machine the
 /// single-thread figure that wall time would give on an idle one.
 double bench_cpu_now(void);
