@@ -14,12 +14,6 @@
 
 #include "physics_util.h"
 
-static spn_vec3 breeze(void *user, double t, spn_vec3 p)
-{
-    (void)user;
-    return spn_v3(0.1 * sin(3 * p.x), 0, 0.8 + 0.3 * sin(5 * t + 7 * p.y));
-}
-
 static void poke(void *user, const spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v, spn_vec3 *f)
 {
     (void)user, (void)x, (void)v;
@@ -30,27 +24,12 @@ static void poke(void *user, const spn_world *w, double t, const spn_vec3 *x, co
 /* Final state of 12 steps of the 50 x 50 standard web (2,501 particles). */
 static spn_vec3 *run(spn_integrator integ, int threads)
 {
-    spn_world_def def = spn_world_def_default();
-    def.integrator = integ;
-    def.threads = threads;
-    def.parallel_min = 256; /* split even this small web across threads */
-    spn_orb_scene_def od = spn_orb_scene_def_default();
-    od.rings = 50;
-    od.radials = 50;
-    spn_world *w;
-    assert_int_equal(spn_scene_orb(&def, &od, &w), SPN_OK);
-    spn_world_set_air(w, breeze, NULL, 1.2, 1.8e-5);
-    spn_world_set_tag_diameter(w, SPN_THREAD_CAPTURE, 3e-6);
-    spn_world_set_tag_diameter(w, SPN_THREAD_RADIUS, 4e-6);
+    spn_world *w = util_breezy_orb(integ, threads);
+    assert_non_null(w);
     spn_world_set_force_callback(w, poke, NULL);
     double dt = integ == SPN_INTEGRATOR_IMPLICIT ? 2e-5 : integ == SPN_INTEGRATOR_ADAPTIVE ? 5e-6 : 2e-6;
     for (int i = 0; i < 12; i++) assert_int_equal(spn_world_step(w, dt), SPN_OK);
-    uint32_t n = spn_world_particle_count(w);
-    spn_vec3 *out = malloc(2 * n * sizeof *out);
-    memcpy(out, spn_world_positions(w), n * sizeof *out);
-    memcpy(out + n, spn_world_velocities(w), n * sizeof *out);
-    spn_world_destroy(w);
-    return out;
+    return util_take_state(w);
 }
 
 static void test_bit_identical(void **state)

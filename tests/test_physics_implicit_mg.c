@@ -17,28 +17,12 @@
 
 #include "physics_util.h"
 
-static spn_vec3 breeze(void *user, double t, spn_vec3 p)
-{
-    (void)user;
-    return spn_v3(0.1 * sin(3 * p.x), 0, 0.8 + 0.3 * sin(5 * t + 7 * p.y));
-}
-
 enum { PLAIN, CONTACT, BREAK };
 
 static spn_world *make(spn_precond pc, int threads, int what)
 {
-    spn_world_def def = spn_world_def_default();
-    def.integrator = SPN_INTEGRATOR_IMPLICIT;
-    def.threads = threads;
-    def.parallel_min = 256; /* split even this small web across threads */
-    spn_orb_scene_def od = spn_orb_scene_def_default();
-    od.rings = 50;
-    od.radials = 50;
-    spn_world *w;
-    assert_int_equal(spn_scene_orb(&def, &od, &w), SPN_OK);
-    spn_world_set_air(w, breeze, NULL, 1.2, 1.8e-5);
-    spn_world_set_tag_diameter(w, SPN_THREAD_CAPTURE, 3e-6);
-    spn_world_set_tag_diameter(w, SPN_THREAD_RADIUS, 4e-6);
+    spn_world *w = util_breezy_orb(SPN_INTEGRATOR_IMPLICIT, threads);
+    assert_non_null(w);
     assert_int_equal(spn_world_set_implicit_preconditioner(w, pc), SPN_OK);
     assert_int_equal(spn_world_set_solver_tolerance(w, 1e-10, 1000), SPN_OK);
     if (what == CONTACT) { /* a 0.2 g body pressing on the middle of spring 1200 */
@@ -66,12 +50,7 @@ static spn_vec3 *run(spn_precond pc, int threads, int what, long *cg)
         assert_int_equal(spn_world_step(w, 0.05), SPN_OK);
         *cg += spn_world_last_step(w).cg_iterations;
     }
-    uint32_t n = spn_world_particle_count(w);
-    spn_vec3 *out = malloc(2 * n * sizeof *out);
-    memcpy(out, spn_world_positions(w), n * sizeof *out);
-    memcpy(out + n, spn_world_velocities(w), n * sizeof *out);
-    spn_world_destroy(w);
-    return out;
+    return util_take_state(w);
 }
 
 static void compare(int what)
