@@ -132,6 +132,9 @@ SPN_API spn_vec3 spn_world_velocity(const spn_world *w, uint32_t i);
 SPN_API double spn_world_mass(const spn_world *w, uint32_t i);
 SPN_API bool spn_world_is_fixed(const spn_world *w, uint32_t i);
 SPN_API uint32_t spn_world_particle_tag(const spn_world *w, uint32_t i);
+/// The definition that adds particle i again as it is now (position,
+/// velocity, mass, fixed, tag): for copying a world's particles into another.
+SPN_API spn_particle_def spn_world_particle_def(const spn_world *w, uint32_t i);
 SPN_API void spn_world_set_position(spn_world *w, uint32_t i, spn_vec3 p);
 SPN_API void spn_world_set_velocity(spn_world *w, uint32_t i, spn_vec3 v);
 /// Pin (fixed = true) or free a particle. Freeing one with mass 0 keeps it fixed.

@@ -125,12 +125,7 @@ void spn__web_bounds(const spn_world *w, spn_vec3 *lo, spn_vec3 *hi)
 static spn_status copy_particles(const spn_world *w, spn_world *c)
 {
     for (uint32_t i = 0; i < spn_world_particle_count(w); i++) {
-        spn_particle_def p = spn_particle_def_default();
-        p.position = spn_world_position(w, i);
-        p.velocity = spn_world_velocity(w, i);
-        p.mass = spn_world_mass(w, i);
-        p.fixed = spn_world_is_fixed(w, i);
-        p.tag = spn_world_particle_tag(w, i);
+        spn_particle_def p = spn_world_particle_def(w, i);
         spn_status st = spn_world_add_particle(c, &p, NULL);
         if (st != SPN_OK) return st;
     }

@@ -188,12 +188,7 @@ static spn_status compact(const spn_world *w, const bool *dead, const bool *drop
     spn_status st = map && c ? SPN_OK : spn_error(SPN_ERR_NOMEM, "out of memory");
     for (uint32_t i = 0; i < np && st == SPN_OK; i++) {
         if (drop[i]) continue;
-        spn_particle_def p = spn_particle_def_default();
-        p.position = spn_world_position(w, i);
-        p.velocity = spn_world_velocity(w, i);
-        p.mass = spn_world_mass(w, i);
-        p.fixed = spn_world_is_fixed(w, i);
-        p.tag = spn_world_particle_tag(w, i);
+        spn_particle_def p = spn_world_particle_def(w, i);
         st = spn_world_add_particle(c, &p, &map[i]);
     }
     for (uint32_t s = 0; s < ns && st == SPN_OK; s++) {

@@ -226,6 +226,16 @@ spn_vec3 spn_world_velocity(const spn_world *w, uint32_t i) { return w->v[i]; }
 double spn_world_mass(const spn_world *w, uint32_t i) { return w->mass[i]; }
 bool spn_world_is_fixed(const spn_world *w, uint32_t i) { return w->inv_mass[i] == 0; }
 uint32_t spn_world_particle_tag(const spn_world *w, uint32_t i) { return w->ptag[i]; }
+spn_particle_def spn_world_particle_def(const spn_world *w, uint32_t i)
+{
+    spn_particle_def p = spn_particle_def_default();
+    p.position = w->x[i];
+    p.velocity = w->v[i];
+    p.mass = w->mass[i];
+    p.fixed = spn_world_is_fixed(w, i);
+    p.tag = w->ptag[i];
+    return p;
+}
 void spn_world_set_position(spn_world *w, uint32_t i, spn_vec3 p) { w->x[i] = p; }
 void spn_world_set_velocity(spn_world *w, uint32_t i, spn_vec3 v) { w->v[i] = v; }
 void spn_world_set_particle_tag(spn_world *w, uint32_t i, uint32_t tag) { w->ptag[i] = tag; }
