@@ -50,6 +50,7 @@ static void lattice_free(spn__lattice *L)
     if (!L) return;
     free(L->rk), free(L->rkd), free(L->rrest), free(L->gk), free(L->gkd), free(L->grest);
     free(L->cut), free(L->partial), free(L->rk4);
+    spn__lat32_free(L->f32);
     for (int t = 0; t < L->nws; t++) free(L->ws[t]);
     free(L->ws);
     free(L);
@@ -57,6 +58,7 @@ static void lattice_free(spn__lattice *L)
 
 void spn__lattice_drop(spn_world *w)
 {
+    spn__lattice_sync(w);
     lattice_free(w->lat);
     w->lat = NULL;
 }
@@ -82,6 +84,7 @@ static void store(spn__lattice *L, bool radial, size_t slot, spn__spring h)
     double *k = radial ? L->rk : L->gk, *kd = radial ? L->rkd : L->gkd, *rest = radial ? L->rrest : L->grest;
     k[slot] = h.k, kd[slot] = h.kd;
     rest[slot] = spn__tension_only(h) ? -h.rest : h.rest;
+    spn__lat32_params_changed(L->f32);
 }
 
 void spn__lattice_build(spn_world *w)
@@ -309,7 +312,9 @@ static lat_args args_of(spn_world *w)
 
 static bool applies(const spn_world *w)
 {
-    return w->compiled && w->lat && !w->lattice_off && !w->force_fn && !spn__air_active(w);
+    /* (hysteresis sets each spring's damping per step in the spring records,
+     * which the lattice's slots do not follow) */
+    return w->compiled && w->lat && !w->lattice_off && !w->force_fn && !spn__air_active(w) && !w->nhyst;
 }
 
 const char *spn_world_step_path(const spn_world *w)
@@ -335,7 +340,11 @@ static int ready(spn_world *w)
 bool spn__lattice_explicit(spn_world *w, double dt, bool symplectic, spn__step_result *r)
 {
     const int threads = ready(w);
-    if (!threads) return false;
+    if (!threads) {
+        spn__lattice_sync(w);
+        return false;
+    }
+    if (w->precision == SPN_PRECISION_FLOAT32) return spn__lat32_explicit(w, threads, dt, symplectic, r);
     lat_args a = args_of(w);
     a.dt = dt;
     a.mode = symplectic ? MODE_SYMPLECTIC : MODE_EULER;

@@ -33,6 +33,15 @@ enum {
     WS_COUNT = 36
 };
 
+/* The float32 step's state and arrays (lattice_f32.c). */
+typedef struct spn__lat32 spn__lat32;
+void spn__lat32_free(spn__lat32 *F);
+/* A slot's k, kd or rest changed: convert them again before the next step. */
+void spn__lat32_params_changed(spn__lat32 *F);
+/* One float32 Euler or symplectic step over the lattice on `threads`
+ * threads; false (nothing done, w->x and w->v up to date) when out of memory. */
+bool spn__lat32_explicit(spn_world *w, int threads, double dt, bool symplectic, spn__step_result *r);
+
 struct spn__lattice {
     uint32_t rings, radials;
     double *rk, *rkd, *rrest; /* radial slots: ring * N + i, (ring - 1, i) -> (ring, i) */
@@ -44,6 +53,7 @@ struct spn__lattice {
     double **ws;
     size_t stride;   /* doubles per workspace array (N rounded up) */
     double *rk4;     /* RK4: 12 arrays of np (xt, vt, ax, av by component), on first use */
+    spn__lat32 *f32; /* the float32 step (on first use) */
 };
 
 /* What an update does with a row once its forces are complete. */

@@ -153,6 +153,7 @@ spn_status spn_world_advance(spn_world *w, double dt, int n)
     for (int j = 0; j < n; j++) {
         st = step_once(w, dt);
         if (st == SPN_ERR_UNSTABLE && w->no_backup) {
+            spn__lattice_discard(w);
             memcpy(w->x, w->x0, w->np * sizeof *w->x);
             memcpy(w->v, w->v0, w->np * sizeof *w->v);
             w->t = t0, w->external_work = work0, w->dissipated = diss0, w->steps = steps0;
@@ -166,6 +167,7 @@ spn_status spn_world_advance(spn_world *w, double dt, int n)
         total.cg_iterations += w->last.cg_iterations;
         total.breaks += w->last.breaks;
     }
+    spn__lattice_sync(w);
     w->no_backup = false;
     w->last = total;
     return st;

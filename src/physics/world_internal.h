@@ -132,6 +132,7 @@ struct spn_world {
     spn_vec3 *facc;                  /* per-particle spring force accumulator */
     spn__lattice *lat;               /* the stencil step of a regular orb web (NULL: none) */
     bool lattice_off;                /* spn_world_set_lattice(w, false) */
+    uint8_t precision;               /* spn_precision: float32 lattice steps when set */
     spn_vec3 *tmp[SPN_TMP_COUNT]; /* per-particle scratch, allocated on demand */
     spn_vec3 *fair;       /* per-spring air force (on demand) */
     spn_vec3 *wind;       /* per-spring air velocity at the midpoint (on demand) */
@@ -295,6 +296,12 @@ void spn__lattice_spring_changed(spn_world *w, uint32_t s);
  * of memory for its buffers. */
 bool spn__lattice_explicit(spn_world *w, double dt, bool symplectic, spn__step_result *r);
 bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r);
+/* The float32 lattice step (lattice_f32.c) keeps its own state during an
+ * spn_world_advance call; w->x and w->v are behind it until this writes them
+ * back (a no-op when it holds nothing). Called at the end of every call. */
+void spn__lattice_sync(spn_world *w);
+/* Forget the float32 state without writing it (the caller restores x, v). */
+void spn__lattice_discard(spn_world *w);
 
 /* ---- integrators (explicit.c, adaptive.c, implicit.c) ---- */
 
