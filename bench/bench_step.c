@@ -7,6 +7,7 @@
  *   bench_step --quick    the 5,000-particle web only
  *   bench_step --parallel-min N   def.parallel_min = N (default 32,768): the
  *                         size from which loops, and the lattice, use threads
+ *   bench_step --integrator NAME  that integrator only
  *
  * Explicit steps use dt = 1e-7 s (inside the stability limit of the finest
  * web); the adaptive stepper an outer step of 1e-6 s (its sub-step count is
@@ -22,7 +23,9 @@
  * Euler, symplectic Euler and RK4 run twice: on the default path ("path":
  * "lattice", the stencil step of a regular web, see src/physics/lattice.c)
  * and with the lattice forbidden ("path":"general", the spring-record loops
- * any world takes). */
+ * any world takes). Symplectic Euler runs a third time on the float32 lattice
+ * step ("precision":"float32", spn_world_set_precision; every other row is
+ * "float64"). */
 #include "common/bench_common.h"
 
 #include <spinneret/spinneret.h>
@@ -53,7 +56,8 @@ static double step_size(spn_integrator integ)
 }
 
 /* Time `steps` steps of one integrator on 1 or 2 threads; print one line. */
-static int bench_one(const size_case *c, spn_integrator integ, int threads, bool lattice, long parallel_min)
+static int bench_one(const size_case *c, spn_integrator integ, int threads, bool lattice, spn_precision prec,
+                     long parallel_min)
 {
     spn_world_def def = spn_world_def_default();
     if (parallel_min > 0) def.parallel_min = (uint32_t)parallel_min;
@@ -69,6 +73,7 @@ static int bench_one(const size_case *c, spn_integrator integ, int threads, bool
         return 1;
     }
     spn_world_set_lattice(w, lattice);
+    spn_world_set_precision(w, prec);
     const double dt = step_size(integ);
     if (spn_world_step(w, dt) != SPN_OK) {
         fprintf(stderr, "bench_step: %s\n", spn_last_error());
@@ -91,9 +96,10 @@ static int bench_one(const size_case *c, spn_integrator integ, int threads, bool
     double ns_spring_step = sec * per;
     printf("{\"bench\":\"step\",\"scene\":\"orb\",\"integrator\":\"%s\",\"particles\":%u,\"springs\":%u,"
            "\"threads\":%d,\"steps\":%d,\"dt\":%g,\"ns_per_spring_step\":%.3f,\"cpu_ns_per_spring_step\":%.3f,"
-           "\"load\":%.2f,\"path\":\"%s\"",
+           "\"load\":%.2f,\"path\":\"%s\",\"precision\":\"%s\"",
            spn_integrator_name(integ), spn_world_particle_count(w), spn_world_spring_count(w), threads, steps, dt,
-           ns_spring_step, cpu * per, bench_load_average(), spn_world_step_path(w));
+           ns_spring_step, cpu * per, bench_load_average(), spn_world_step_path(w),
+           prec == SPN_PRECISION_FLOAT32 ? "float32" : "float64");
     if (integ == SPN_INTEGRATOR_ADAPTIVE)
         printf(",\"substeps_per_step\":%.1f,\"ns_per_spring_substep\":%.3f", (double)substeps / steps,
                ns_spring_step * steps / (double)substeps);
@@ -112,22 +118,35 @@ int main(int argc, char **argv)
 {
     int ncases = 3;
     long parallel_min = 0; /* 0: the world's default */
+    int only = -1;         /* one integrator, or all */
     for (int i = 1; i < argc; i++) {
         char *end = NULL;
         if (strcmp(argv[i], "--quick") == 0) ncases = 1;
         else if (strcmp(argv[i], "--parallel-min") == 0 && i + 1 < argc &&
                  (parallel_min = strtol(argv[++i], &end, 10)) >= 1 && parallel_min <= 0x7fffffffL && *end == 0)
             continue;
-        else {
-            fprintf(stderr, "usage: bench_step [--quick] [--parallel-min N (1..2^31-1)]\n");
+        else if (strcmp(argv[i], "--integrator") == 0 && i + 1 < argc) {
+            spn_integrator in;
+            if (spn_integrator_parse(argv[++i], &in) != SPN_OK) {
+                fprintf(stderr, "bench_step: --integrator: %s\n", spn_last_error());
+                return 2;
+            }
+            only = (int)in;
+        } else {
+            fprintf(stderr, "usage: bench_step [--quick] [--parallel-min N (1..2^31-1)] [--integrator NAME]\n");
             return 2;
         }
     }
     for (int c = 0; c < ncases; c++)
         for (int integ = 0; integ < SPN_INTEGRATOR_COUNT; integ++)
-            for (int threads = 1; threads <= 2; threads++) {
-                if (bench_one(&cases[c], (spn_integrator)integ, threads, true, parallel_min)) return 1;
-                if (integ <= SPN_INTEGRATOR_RK4 && bench_one(&cases[c], (spn_integrator)integ, threads, false, parallel_min))
+            for (int threads = 1; threads <= 2 && (only < 0 || only == integ); threads++) {
+                const spn_integrator in = (spn_integrator)integ;
+                if (bench_one(&cases[c], in, threads, true, SPN_PRECISION_FLOAT64, parallel_min)) return 1;
+                if (in == SPN_INTEGRATOR_SYMPLECTIC &&
+                    bench_one(&cases[c], in, threads, true, SPN_PRECISION_FLOAT32, parallel_min))
+                    return 1;
+                if (integ <= SPN_INTEGRATOR_RK4 &&
+                    bench_one(&cases[c], in, threads, false, SPN_PRECISION_FLOAT64, parallel_min))
                     return 1;
             }
     return 0;

@@ -22,7 +22,8 @@ def step_table(rows):
     def label(r):
         # the general path of an integrator that also has the lattice (stencil) one
         general = r.get("path") == "general" and r["integrator"] in stencil
-        return r["integrator"] + (" (general path)" if general else "")
+        f32 = r.get("precision") == "float32"  # the opt-in float32 lattice step
+        return r["integrator"] + (" float32" if f32 else "") + (" (general path)" if general else "")
     integrators = []
     for r in steps:
         if label(r) not in integrators:
