@@ -23,9 +23,9 @@
  * Euler, symplectic Euler and RK4 run twice: on the default path ("path":
  * "lattice", the stencil step of a regular web, see src/physics/lattice.c)
  * and with the lattice forbidden ("path":"general", the spring-record loops
- * any world takes). Symplectic Euler runs a third time on the float32 lattice
- * step ("precision":"float32", spn_world_set_precision; every other row is
- * "float64"). */
+ * any world takes). Symplectic Euler and RK4 run a third time on the float32
+ * lattice step ("precision":"float32", spn_world_set_precision; every other
+ * row is "float64"). */
 #include "common/bench_common.h"
 
 #include <spinneret/spinneret.h>
@@ -142,7 +142,7 @@ int main(int argc, char **argv)
             for (int threads = 1; threads <= 2 && (only < 0 || only == integ); threads++) {
                 const spn_integrator in = (spn_integrator)integ;
                 if (bench_one(&cases[c], in, threads, true, SPN_PRECISION_FLOAT64, parallel_min)) return 1;
-                if (in == SPN_INTEGRATOR_SYMPLECTIC &&
+                if ((in == SPN_INTEGRATOR_SYMPLECTIC || in == SPN_INTEGRATOR_RK4) &&
                     bench_one(&cases[c], in, threads, true, SPN_PRECISION_FLOAT32, parallel_min))
                     return 1;
                 if (integ <= SPN_INTEGRATOR_RK4 &&

@@ -2,12 +2,12 @@
  * float64 and against an analytic answer:
  *  - the standard orb web stepped both ways stays within the bound its
  *    force error gives (positions relative to the web's size and to the
- *    distance moved, total energy);
+ *    distance moved, total energy), with symplectic Euler and with RK4;
  *  - a mass on eight pre-strained springs oscillates at the frequency of its
  *    small-amplitude stiffness, sum k cos^2 + (T / L) sin^2, in float32 as in
  *    float64;
  *  - same bits on 1 and 2 threads and run to run; a blow-up leaves the state
- *    spn_world_advance promises; RK4, the general path and the default are
+ *    spn_world_advance promises; the general path and the default are
  *    untouched (bit-identical to float64).
  *
  * The bound on the web. A spring's difference vector is exact to 2^-24 of
@@ -65,11 +65,10 @@ static bool same_bits(const spn_world *a, const spn_world *b)
 /* The 961-particle web (20 rings x 48 radials, radius 0.15 m) sagging and
  * ringing under gravity from its flat pre-strained start, 2,000 steps of
  * 1e-7 s in calls of 250 (so with rebases inside and between calls). */
-static void test_orb_against_float64(void **state)
+static void orb_against_float64(spn_integrator integ)
 {
-    (void)state;
-    spn_world *w64 = orb(SPN_INTEGRATOR_SYMPLECTIC, 20, 48, 1, 0, SPN_PRECISION_FLOAT64);
-    spn_world *w32 = orb(SPN_INTEGRATOR_SYMPLECTIC, 20, 48, 1, 0, SPN_PRECISION_FLOAT32);
+    spn_world *w64 = orb(integ, 20, 48, 1, 0, SPN_PRECISION_FLOAT64);
+    spn_world *w32 = orb(integ, 20, 48, 1, 0, SPN_PRECISION_FLOAT32);
     spn_world *start = spn_world_clone(w64);
     assert_int_equal(spn_world_precision(w32), SPN_PRECISION_FLOAT32);
     for (int k = 0; k < 8; k++) {
@@ -92,14 +91,22 @@ static void test_orb_against_float64(void **state)
     spn_world_destroy(w32);
 }
 
+static void test_orb_against_float64(void **state)
+{
+    (void)state;
+    orb_against_float64(SPN_INTEGRATOR_SYMPLECTIC);
+    orb_against_float64(SPN_INTEGRATOR_RK4);
+}
+
 /* One ring of 8 fixed particles at 0.15 m, the hub free on its 8 radials
  * (2% pre-strain, no damping, no gravity), pushed by delta along x. Small
  * in-plane motion of the hub sees the stiffness K = sum over its springs of
  * k cos^2(theta) + (T / L) sin^2(theta); x(t) = delta cos(sqrt(K / m) t). */
-static void run_star(spn_precision precision, double *x_out, int samples, int per_sample, double *omega, double *dt)
+static void run_star(spn_integrator integ, spn_precision precision, double *x_out, int samples, int per_sample, double *omega, double *dt)
 {
     spn_world_def def = spn_world_def_default();
     def.gravity = spn_v3(0, 0, 0);
+    def.integrator = integ;
     spn_orb_scene_def od = spn_orb_scene_def_default();
     od.rings = 1;
     od.radials = 8;
@@ -133,8 +140,8 @@ static void test_mass_on_springs(void **state)
     (void)state;
     enum { SAMPLES = 200, PER = 50 }; /* 5 periods of 2,000 steps */
     double x32[SAMPLES], x64[SAMPLES], omega, dt;
-    run_star(SPN_PRECISION_FLOAT64, x64, SAMPLES, PER, &omega, &dt);
-    run_star(SPN_PRECISION_FLOAT32, x32, SAMPLES, PER, &omega, &dt);
+    run_star(SPN_INTEGRATOR_SYMPLECTIC, SPN_PRECISION_FLOAT64, x64, SAMPLES, PER, &omega, &dt);
+    run_star(SPN_INTEGRATOR_SYMPLECTIC, SPN_PRECISION_FLOAT32, x32, SAMPLES, PER, &omega, &dt);
     const double delta = 1e-3 * 0.15;
     double worst64 = 0, worst32 = 0, apart = 0;
     for (int k = 0; k < SAMPLES; k++) {
@@ -152,6 +159,11 @@ static void test_mass_on_springs(void **state)
      * hub's equilibrium by ~2^-24 L k / K = 3e-9 m, 2e-5 of delta: measured
      * 2.6e-5 */
     assert_true(apart < 1e-4 * delta);
+    /* RK4's own error is ~(omega dt)^4: what is left is float32's */
+    run_star(SPN_INTEGRATOR_RK4, SPN_PRECISION_FLOAT32, x32, SAMPLES, PER, &omega, &dt);
+    worst32 = 0;
+    for (int k = 0; k < SAMPLES; k++) worst32 = fmax(worst32, fabs(x32[k] - delta * cos(omega * dt * PER * (k + 1))));
+    assert_true(worst32 < 1e-4 * delta); /* measured 7e-6 */
 }
 
 /* Bands on two threads (parallel_min 256: bands of 2 rows of 20 x 16) give
@@ -169,6 +181,13 @@ static void test_threads_and_runs(void **state)
     }
     assert_true(same_bits(a, b));
     assert_true(same_bits(a, c));
+    spn_world *r1 = orb(SPN_INTEGRATOR_RK4, 20, 16, 1, 256, SPN_PRECISION_FLOAT32);
+    spn_world *r2 = orb(SPN_INTEGRATOR_RK4, 20, 16, 2, 256, SPN_PRECISION_FLOAT32);
+    assert_int_equal(spn_world_advance(r1, 1e-7, 150), SPN_OK);
+    assert_int_equal(spn_world_advance(r2, 1e-7, 150), SPN_OK);
+    assert_true(same_bits(r1, r2));
+    spn_world_destroy(r1);
+    spn_world_destroy(r2);
     /* forward Euler takes the float32 path too */
     spn_world *e64 = orb(SPN_INTEGRATOR_EULER, 20, 16, 1, 0, SPN_PRECISION_FLOAT64);
     spn_world *e32 = orb(SPN_INTEGRATOR_EULER, 20, 16, 1, 0, SPN_PRECISION_FLOAT32);
@@ -214,7 +233,7 @@ static void test_calls_and_blow_up(void **state)
     spn_world_destroy(d);
 }
 
-/* What float32 does not touch: the default, RK4, the general path. */
+/* What float32 does not touch: the default, the general path. */
 static void test_untouched(void **state)
 {
     (void)state;
@@ -226,10 +245,8 @@ static void test_untouched(void **state)
     for (int k = 0; k < 2; k++) {
         spn_world *a = orb(integ[k], 10, 16, 1, 0, SPN_PRECISION_FLOAT64);
         spn_world *b = orb(integ[k], 10, 16, 1, 0, SPN_PRECISION_FLOAT32);
-        if (integ[k] == SPN_INTEGRATOR_SYMPLECTIC) {
-            spn_world_set_lattice(a, false);
-            spn_world_set_lattice(b, false);
-        }
+        spn_world_set_lattice(a, false);
+        spn_world_set_lattice(b, false);
         assert_int_equal(spn_world_advance(a, 1e-7, 100), SPN_OK);
         assert_int_equal(spn_world_advance(b, 1e-7, 100), SPN_OK);
         assert_true(same_bits(a, b));

@@ -119,14 +119,14 @@ SPN_API const char *spn_world_step_path(const spn_world *w);
 /// Allow (the default) or forbid the lattice stencil, e.g. to measure or test
 /// the general path on a regular web.
 SPN_API void spn_world_set_lattice(spn_world *w, bool allow);
-/// Arithmetic of the lattice path's Euler and symplectic steps.
+/// Arithmetic of the lattice path's Euler, symplectic and RK4 steps.
 typedef enum spn_precision {
     SPN_PRECISION_FLOAT64 = 0, ///< the default: every step in double precision
     SPN_PRECISION_FLOAT32      ///< float32 springs and state, float64 differences (docs/physics-lattice.md)
 } spn_precision;
 /// Opt in to (or out of) the float32 lattice step. It applies only where
-/// spn_world_step_path says "lattice" and the integrator is Euler or
-/// symplectic; everything else stays float64. Positions are kept as float32
+/// spn_world_step_path says "lattice" and the integrator is Euler,
+/// symplectic or RK4; everything else stays float64. Positions are kept as float32
 /// displacements from the float64 positions, which are brought up to date
 /// every 64 steps and at the end of every spn_world_step / spn_world_advance
 /// call; spring differences carry the float64 geometry (relative error

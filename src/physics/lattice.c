@@ -363,7 +363,11 @@ bool spn__lattice_explicit(spn_world *w, double dt, bool symplectic, spn__step_r
 bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r)
 {
     const int threads = ready(w);
-    if (!threads) return false;
+    if (!threads) {
+        spn__lattice_sync(w);
+        return false;
+    }
+    if (w->precision == SPN_PRECISION_FLOAT32) return spn__lat32_rk4(w, threads, dt, r);
     spn__lattice *L = w->lat;
     const size_t np = w->np;
     if (!L->rk4 && !(L->rk4 = calloc(12 * np, sizeof *L->rk4))) return false;

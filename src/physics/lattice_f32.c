@@ -1,6 +1,7 @@
-/* The float32 lattice step: Euler and symplectic Euler (Mehla 2005, eq. 4.5)
- * over a hub + rings x radials web, as lattice.c's sweep, with the springs
- * (eq. 4.14), the force assembly and the update in float32 from end to end.
+/* The float32 lattice step: Euler, symplectic Euler (Mehla 2005, eq. 4.5)
+ * and RK4 (eqs. 4.16-4.19) over a hub + rings x radials web, as lattice.c's
+ * sweep, with the springs (eq. 4.14), the force assembly and the updates in
+ * float32 from end to end (kernels in lattice_rows32.h).
  * Opt-in (spn_world_set_precision); docs/physics-lattice.md has the accuracy
  * and the measurements.
  *
@@ -28,7 +29,7 @@
  * been computed. Every operation is a correctly rounded float32 or float64
  * operation (no FMA: -ffp-contract=off, no approximate reciprocal), so the
  * bits are the same on any thread count and vector width. */
-#include "lattice_rows.h"
+#include "lattice_rows32.h"
 #include "world_internal.h"
 
 #include <math.h>
@@ -48,7 +49,8 @@ enum {
     F_E = 18,    /* per-spring elastic energy */
     F_P = 19,    /* per-spring damping power */
     F_T = 20,    /* 3: per-particle sum terms */
-    F_COUNT = 23
+    F_F = 23,    /* 3: RK4: the assembled force on the row being moved */
+    F_COUNT = 26
 };
 
 struct spn__lat32 {
@@ -63,173 +65,90 @@ struct spn__lat32 {
     float **ws;
     int nws;
     size_t stride;
+    float *rk4;           /* RK4 (on first use): two trial states, 6 x np each, ax, av */
+    float *trial[2][6];   /* trial displacement and velocity, by component */
+    float *ax[3], *av[3]; /* weighted sums of the stages' velocities and forces */
     bool live;            /* the state above is ahead of w->x, w->v */
     bool params_ok;       /* rk .. gr match the lattice's float64 slots */
     uint32_t since;       /* steps since the last rebase */
 };
 
+/* What a sweep does with a row once its forces are complete. */
+enum { M_EULER, M_SYMPLECTIC, M_RK4_STAGE, M_RK4_LAST };
+
 typedef struct a32 {
     const spn__lattice *L;
     spn__lat32 *F;
-    float g[3], drag, dt;
-    bool sym;
+    const float *ed[3], *eu[3]; /* the state the forces are evaluated at */
+    float *td[3], *tu[3];       /* RK4 stage: the next trial state */
+    float g[3], drag, dt, h, weight;
+    int mode;
+    bool first;                 /* RK4: stage 0 */
 } a32;
 
 void spn__lat32_free(spn__lat32 *F)
 {
     if (!F) return;
     for (int t = 0; t < F->nws; t++) free(F->ws[t]);
-    free(F->ws), free(F->cut), free(F->block);
+    free(F->ws), free(F->cut), free(F->block), free(F->rk4);
     free(F);
-}
-
-/* ---- kernels ---- */
-
-/* Springs j = 0..n-1 from a to b: chunk.h's expression in float32, the
- * difference as L + (d_a - d_b); force on end a into f, energy and damping
- * power into e, p. */
-LAT_INLINE void springs32(uint32_t n, const float *restrict dax, const float *restrict day,
-                          const float *restrict daz, const float *restrict dbx, const float *restrict dby,
-                          const float *restrict dbz, const float *restrict uax, const float *restrict uay,
-                          const float *restrict uaz, const float *restrict ubx, const float *restrict uby,
-                          const float *restrict ubz, const float *restrict Lx, const float *restrict Ly,
-                          const float *restrict Lz, const float *restrict kk, const float *restrict kkd,
-                          const float *restrict rr, float *restrict fx, float *restrict fy, float *restrict fz,
-                          float *restrict e, float *restrict p)
-{
-    for (uint32_t j = 0; j < n; j++) {
-        const float lx = Lx[j] + (dax[j] - dbx[j]), ly = Ly[j] + (day[j] - dby[j]), lz = Lz[j] + (daz[j] - dbz[j]);
-        const float ux = uax[j] - ubx[j], uy = uay[j] - uby[j], uz = uaz[j] - ubz[j];
-        const float len = sqrtf(lx * lx + ly * ly + lz * lz);
-        const float rs = rr[j];
-        const float stretch = len - fabsf(rs);
-        const bool on = len > 0 && !(stretch < 0 && rs < 0);
-        const float inv = on ? 1.0f / len : 0.0f;
-        const float rate = (ux * lx + uy * ly + uz * lz) * inv;
-        const float k = on ? kk[j] : 0.0f, kd = kkd[j];
-        const float s = -(k * stretch + kd * rate) * inv;
-        e[j] = 0.5f * k * stretch * stretch;
-        p[j] = kd * rate * rate;
-        fx[j] = s * lx, fy[j] = s * ly, fz[j] = s * lz;
-    }
-}
-
-LAT_INLINE void lane_add32(double *restrict acc, const float *restrict e, uint32_t n)
-{
-    uint32_t i = 0;
-    for (; i + LANES <= n; i += LANES)
-        for (int l = 0; l < LANES; l++) acc[l] += (double)e[i + l];
-    for (; i < n; i++) acc[i % LANES] += (double)e[i];
-}
-
-/* Springs between rows (3 arrays each, already offset) a and b. */
-LAT_INLINE void spring_rows(uint32_t n, float *const *da, float *const *ua, float *const *db, float *const *ub,
-                            float *const *L, size_t s0, const float *k, const float *kd, const float *rest,
-                            float *const *f, size_t off_f, float *e, float *p, double *acc_e, double *acc_p)
-{
-    springs32(n, da[0], da[1], da[2], db[0], db[1], db[2], ua[0], ua[1], ua[2], ub[0], ub[1], ub[2], L[0] + s0,
-              L[1] + s0, L[2] + s0, k + s0, kd + s0, rest + s0, f[0] + off_f, f[1] + off_f, f[2] + off_f, e, p);
-    lane_add32(acc_e, e, n);
-    lane_add32(acc_p, p, n);
-}
-
-typedef struct moved32 {
-    float d[3], u[3], mv2, gain, mvn2;
-} moved32;
-
-/* explicit_one (lattice_rows.h) in float32. */
-LAT_INLINE moved32 one32(float fx, float fy, float fz, float im, float m, float dx, float dy, float dz, float vx,
-                         float vy, float vz, bool sym, float dt, const float *g)
-{
-    moved32 o;
-    const float s = dt * im;
-    const bool fr = im != 0;
-    const float mf = fr ? m : 0.0f;
-    const float nx = vx + fx * s, ny = vy + fy * s, nz = vz + fz * s;
-    const float ex = (sym ? nx : vx) * dt, ey = (sym ? ny : vy) * dt, ez = (sym ? nz : vz) * dt;
-    o.d[0] = fr ? dx + ex : dx, o.d[1] = fr ? dy + ey : dy, o.d[2] = fr ? dz + ez : dz;
-    o.u[0] = fr ? nx : vx, o.u[1] = fr ? ny : vy, o.u[2] = fr ? nz : vz;
-    o.mv2 = mf * (vx * vx + vy * vy + vz * vz);
-    o.mvn2 = mf * (nx * nx + ny * ny + nz * nz);
-    o.gain = mf * (0.5f * ((nx - vx) * (nx + vx) + (ny - vy) * (ny + vy) + (nz - vz) * (nz + vz)) -
-                   (g[0] * ex + g[1] * ey + g[2] * ez));
-    return o;
-}
-
-#define STORE32(i, o)                                                                                           \
-    do {                                                                                                        \
-        dx[i] = (o).d[0], dy[i] = (o).d[1], dz[i] = (o).d[2];                                                   \
-        ux[i] = (o).u[0], uy[i] = (o).u[1], uz[i] = (o).u[2];                                                   \
-        t_mv2[i] = (o).mv2, t_gain[i] = (o).gain, t_mvn2[i] = (o).mvn2;                                         \
-    } while (0)
-
-/* A row with its forces complete (radial in, ring, radial out or NULL),
- * assembled in explicit_row's order, moved in place. The two ends (the wrap
- * spring) go after the loop, from forces formed before it. */
-LAT_INLINE void row32(uint32_t n, bool sym, float dt, const float *g, float drag, const float *restrict mass,
-                      const float *restrict inv_mass, float *restrict dx, float *restrict dy, float *restrict dz,
-                      float *restrict ux, float *restrict uy, float *restrict uz, const float *restrict ix,
-                      const float *restrict iy, const float *restrict iz, const float *restrict rx,
-                      const float *restrict ry, const float *restrict rz, const float *restrict ox,
-                      const float *restrict oy, const float *restrict oz, float *restrict t_mv2,
-                      float *restrict t_gain, float *restrict t_mvn2)
-{
-    const uint32_t l = n - 1;
-    float e0[3], el[3];
-    const float *V[3] = {ux, uy, uz}, *I[3] = {ix, iy, iz}, *R[3] = {rx, ry, rz}, *O[3] = {ox, oy, oz};
-    for (int c = 0; c < 3; c++) {
-        float f0 = mass[0] * g[c] - (drag * mass[0]) * V[c][0], fl = mass[l] * g[c] - (drag * mass[l]) * V[c][l];
-        if (ox) f0 += O[c][0], fl += O[c][l];
-        e0[c] = ((f0 + R[c][0]) + R[c][l]) - I[c][0];
-        el[c] = ((fl - I[c][l]) - R[c][l]) - R[c][l - 1];
-    }
-    if (ox)
-        for (uint32_t i = 1; i < l; i++) {
-            const float m = mass[i], dm = drag * m;
-            const float fx = ((((m * g[0] - dm * ux[i]) + ox[i]) + rx[i]) - ix[i]) - rx[i - 1];
-            const float fy = ((((m * g[1] - dm * uy[i]) + oy[i]) + ry[i]) - iy[i]) - ry[i - 1];
-            const float fz = ((((m * g[2] - dm * uz[i]) + oz[i]) + rz[i]) - iz[i]) - rz[i - 1];
-            const moved32 o = one32(fx, fy, fz, inv_mass[i], m, dx[i], dy[i], dz[i], ux[i], uy[i], uz[i], sym, dt, g);
-            STORE32(i, o);
-        }
-    else
-        for (uint32_t i = 1; i < l; i++) {
-            const float m = mass[i], dm = drag * m;
-            const float fx = (((m * g[0] - dm * ux[i]) + rx[i]) - ix[i]) - rx[i - 1];
-            const float fy = (((m * g[1] - dm * uy[i]) + ry[i]) - iy[i]) - ry[i - 1];
-            const float fz = (((m * g[2] - dm * uz[i]) + rz[i]) - iz[i]) - rz[i - 1];
-            const moved32 o = one32(fx, fy, fz, inv_mass[i], m, dx[i], dy[i], dz[i], ux[i], uy[i], uz[i], sym, dt, g);
-            STORE32(i, o);
-        }
-    const uint32_t ends[2] = {0, l};
-    for (int k = 0; k < 2; k++) {
-        const uint32_t i = ends[k];
-        const float *f = k ? el : e0;
-        const moved32 o =
-            one32(f[0], f[1], f[2], inv_mass[i], mass[i], dx[i], dy[i], dz[i], ux[i], uy[i], uz[i], sym, dt, g);
-        STORE32(i, o);
-    }
 }
 
 /* ---- the sweep ---- */
 
-LAT_INLINE void state_rows(const spn__lat32 *F, size_t p0, float **D, float **U)
+/* Row p0 of the evaluated state. */
+LAT_INLINE void eval_rows(const a32 *a, size_t p0, float **D, float **U)
 {
-    for (int c = 0; c < 3; c++) D[c] = F->d[c] + p0, U[c] = F->u[c] + p0;
+    for (int c = 0; c < 3; c++) D[c] = (float *)a->ed[c] + p0, U[c] = (float *)a->eu[c] + p0;
+}
+
+/* Particles p0 .. p0+n-1 of an RK4 stage, their force F (3 arrays) known. */
+LAT_INLINE void rk4_update(const a32 *a, size_t p0, uint32_t n, float *const *F, float *const *t,
+                           double (*acc)[LANES])
+{
+    const spn__lat32 *S = a->F;
+    const float *m = S->mass + p0, *im = S->inv_mass + p0;
+    const float *V[3] = {a->eu[0] + p0, a->eu[1] + p0, a->eu[2] + p0};
+    if (a->mode == M_RK4_STAGE) {
+        rk4_mv2_32(n, m, im, V[0], V[1], V[2], t[0], t[1], t[2]);
+        /* (three calls, not a loop, as in lattice_rows.h's update) */
+        rk4_stage32(n, a->first, a->h, a->weight, im, V[0], F[0], S->d[0] + p0, S->u[0] + p0, a->td[0] + p0,
+                    a->tu[0] + p0, S->ax[0] + p0, S->av[0] + p0);
+        rk4_stage32(n, a->first, a->h, a->weight, im, V[1], F[1], S->d[1] + p0, S->u[1] + p0, a->td[1] + p0,
+                    a->tu[1] + p0, S->ax[1] + p0, S->av[1] + p0);
+        rk4_stage32(n, a->first, a->h, a->weight, im, V[2], F[2], S->d[2] + p0, S->u[2] + p0, a->td[2] + p0,
+                    a->tu[2] + p0, S->ax[2] + p0, S->av[2] + p0);
+    } else {
+        rk4_sums32(n, a->h, a->g, m, im, V[0], V[1], V[2], F[0], F[1], F[2], S->ax[0] + p0, S->ax[1] + p0,
+                   S->ax[2] + p0, S->av[0] + p0, S->av[1] + p0, S->av[2] + p0, S->u[0] + p0, S->u[1] + p0,
+                   S->u[2] + p0, t[0], t[1], t[2]);
+        rk4_last32(n, a->h, im, V[0], F[0], S->ax[0] + p0, S->av[0] + p0, S->d[0] + p0, S->u[0] + p0);
+        rk4_last32(n, a->h, im, V[1], F[1], S->ax[1] + p0, S->av[1] + p0, S->d[1] + p0, S->u[1] + p0);
+        rk4_last32(n, a->h, im, V[2], F[2], S->ax[2] + p0, S->av[2] + p0, S->d[2] + p0, S->u[2] + p0);
+    }
+    lane_add32(acc[L_MV2], t[0], n);
+    lane_add32(acc[L_GAIN], t[1], n);
+    lane_add32(acc[L_MVN2], t[2], n);
 }
 
 LAT_INLINE void finish32(const a32 *a, size_t p0, uint32_t n, float *const *ri, float *const *rg,
-                         float *const *ro, float *const *t, double (*acc)[LANES])
+                         float *const *ro, float *const *t, float *const *Fw, double (*acc)[LANES])
 {
     const spn__lat32 *F = a->F;
+    if (a->mode == M_RK4_STAGE || a->mode == M_RK4_LAST) {
+        for (int c = 0; c < 3; c++)
+            assemble32(n, a->g[c], a->drag, F->mass + p0, a->eu[c] + p0, ri[c], rg[c], ro ? ro[c] : NULL, Fw[c]);
+        rk4_update(a, p0, n, Fw, t, acc);
+        return;
+    }
     float *D[3], *U[3];
-    state_rows(F, p0, D, U);
+    for (int c = 0; c < 3; c++) D[c] = F->d[c] + p0, U[c] = F->u[c] + p0;
     /* (sym a constant in each call: GCC 12 does not vectorise a select on a
      * run-time bool between floats) */
 #define ROW32(sym)                                                                                              \
     row32(n, sym, a->dt, a->g, a->drag, F->mass + p0, F->inv_mass + p0, D[0], D[1], D[2], U[0], U[1], U[2], ri[0], \
           ri[1], ri[2], rg[0], rg[1], rg[2], ro ? ro[0] : NULL, ro ? ro[1] : NULL, ro ? ro[2] : NULL, t[0], t[1], t[2])
-    if (a->sym) ROW32(true);
+    if (a->mode == M_SYMPLECTIC) ROW32(true);
     else ROW32(false);
 #undef ROW32
     lane_add32(acc[L_MV2], t[0], n);
@@ -238,18 +157,23 @@ LAT_INLINE void finish32(const a32 *a, size_t p0, uint32_t n, float *const *ri, 
 }
 
 /* The hub: its radial forces in radial order, then its update. */
-static void hub32(const a32 *a, float *const *rad, double (*acc)[LANES])
+static void hub32(const a32 *a, float *const *rad, float *const *t, double (*acc)[LANES])
 {
     spn__lat32 *F = a->F;
     const uint32_t n = a->L->radials;
     const float m = F->mass[0], dm = a->drag * m;
     float f[3];
     for (int c = 0; c < 3; c++) {
-        f[c] = m * a->g[c] - dm * F->u[c][0];
+        f[c] = m * a->g[c] - dm * a->eu[c][0];
         for (uint32_t i = 0; i < n; i++) f[c] += rad[c][i];
     }
+    if (a->mode == M_RK4_STAGE || a->mode == M_RK4_LAST) {
+        float *Fp[3] = {f, f + 1, f + 2};
+        rk4_update(a, 0, 1, Fp, t, acc);
+        return;
+    }
     const moved32 o = one32(f[0], f[1], f[2], F->inv_mass[0], m, F->d[0][0], F->d[1][0], F->d[2][0], F->u[0][0],
-                            F->u[1][0], F->u[2][0], a->sym, a->dt, a->g);
+                            F->u[1][0], F->u[2][0], a->mode == M_SYMPLECTIC, a->dt, a->g);
     for (int c = 0; c < 3; c++) F->d[c][0] = o.d[c], F->u[c][0] = o.u[c];
     acc[L_MV2][0] += o.mv2, acc[L_GAIN][0] += o.gain, acc[L_MVN2][0] += o.mvn2;
 }
@@ -261,8 +185,8 @@ SPN__KERNEL static void cut32(const a32 *a, float *ws, uint32_t b)
     const spn__lat32 *F = a->F;
     const uint32_t n = L->radials, j = b * L->band_rows;
     float *Da[3], *Ua[3], *Db[3], *Ub[3], *f[3];
-    state_rows(F, 1 + (size_t)(j - 1) * n, Da, Ua);
-    state_rows(F, 1 + (size_t)j * n, Db, Ub);
+    eval_rows(a, 1 + (size_t)(j - 1) * n, Da, Ua);
+    eval_rows(a, 1 + (size_t)j * n, Db, Ub);
     for (int c = 0; c < 3; c++) f[c] = F->cut + ((size_t)b * 3 + c) * n;
     double acc_e[LANES] = {0}, acc_p[LANES] = {0};
     spring_rows(n, Da, Ua, Db, Ub, (float *const *)F->rl, (size_t)j * n, F->rk, F->rkd, F->rr, f, 0,
@@ -279,11 +203,11 @@ SPN__KERNEL static void band32(const a32 *a, float *ws, uint32_t b)
     const uint32_t n = L->radials, lo = b * L->band_rows;
     const uint32_t hi = lo + L->band_rows < L->rings ? lo + L->band_rows : L->rings;
     const size_t st = F->stride;
-    float *RAD[2][3], *RING[2][3], *H[6], *t[3], *cut[3], *next_cut[3];
+    float *RAD[2][3], *RING[2][3], *H[6], *t[3], *Fw[3], *cut[3], *next_cut[3];
     for (int c = 0; c < 3; c++) {
         RAD[0][c] = ws + (F_RAD + c) * st, RAD[1][c] = ws + (F_RAD + 3 + c) * st;
         RING[0][c] = ws + (F_RING + c) * st, RING[1][c] = ws + (F_RING + 3 + c) * st;
-        t[c] = ws + (F_T + c) * st;
+        t[c] = ws + (F_T + c) * st, Fw[c] = ws + (F_F + c) * st;
         cut[c] = F->cut + ((size_t)b * 3 + c) * n;
         next_cut[c] = F->cut + ((size_t)(b + 1) * 3 + c) * n;
     }
@@ -295,36 +219,36 @@ SPN__KERNEL static void band32(const a32 *a, float *ws, uint32_t b)
     for (uint32_t j = lo; j < hi; j++, cur ^= 1) {
         const size_t s0 = (size_t)j * n, p0 = 1 + s0;
         float *D[3], *U[3];
-        state_rows(F, p0, D, U);
+        eval_rows(a, p0, D, U);
         if (j == lo && j > 0) {
             rad_cur = cut; /* computed by cut32; its sums are in the band's partial */
         } else if (j == 0) {
             for (int c = 0; c < 3; c++) {
-                const float hd = F->d[c][0], hu = F->u[c][0];
+                const float hd = a->ed[c][0], hu = a->eu[c][0];
                 for (uint32_t i = 0; i < n; i++) H[c][i] = hd, H[3 + c][i] = hu;
             }
             spring_rows(n, H, H + 3, D, U, (float *const *)F->rl, 0, F->rk, F->rkd, F->rr, RAD[cur], 0, e, p, acc_e,
                         acc_p);
             rad_cur = RAD[cur];
-            hub32(a, rad_cur, acc);
+            hub32(a, rad_cur, t, acc);
         } else {
             float *Dp[3], *Up[3];
-            state_rows(F, p0 - n, Dp, Up);
+            eval_rows(a, p0 - n, Dp, Up);
             spring_rows(n, Dp, Up, D, U, (float *const *)F->rl, s0, F->rk, F->rkd, F->rr, RAD[cur], 0, e, p, acc_e,
                         acc_p);
             rad_cur = RAD[cur];
         }
         float *D1[3], *U1[3], *Dl[3], *Ul[3];
-        state_rows(F, p0 + 1, D1, U1);
-        state_rows(F, p0 + n - 1, Dl, Ul);
+        eval_rows(a, p0 + 1, D1, U1);
+        eval_rows(a, p0 + n - 1, Dl, Ul);
         spring_rows(n - 1, D, U, D1, U1, (float *const *)F->gl, s0, F->gk, F->gkd, F->gr, RING[cur], 0, e, p, acc_e,
                     acc_p);
         spring_rows(1, D, U, Dl, Ul, (float *const *)F->gl, s0 + n - 1, F->gk, F->gkd, F->gr, RING[cur], n - 1, e, p,
                     acc_e, acc_p);
-        if (j > lo) finish32(a, p0 - n, n, rad_prev, RING[cur ^ 1], rad_cur, t, acc);
+        if (j > lo) finish32(a, p0 - n, n, rad_prev, RING[cur ^ 1], rad_cur, t, Fw, acc);
         rad_prev = rad_cur;
     }
-    finish32(a, 1 + (size_t)(hi - 1) * n, n, rad_prev, RING[cur ^ 1], hi < L->rings ? next_cut : NULL, t, acc);
+    finish32(a, 1 + (size_t)(hi - 1) * n, n, rad_prev, RING[cur ^ 1], hi < L->rings ? next_cut : NULL, t, Fw, acc);
     double *out = L->partial + (size_t)b * L_NSUMS;
     if (b == 0) out[L_ELASTIC] = out[L_DAMP] = 0;
     out[L_ELASTIC] += lane_total(acc_e), out[L_DAMP] += lane_total(acc_p);
@@ -465,7 +389,10 @@ static bool prepare32(spn__lattice *L, int threads)
     return true;
 }
 
-bool spn__lat32_explicit(spn_world *w, int threads, double dt, bool symplectic, spn__step_result *r)
+/* The float32 state ready for a step (loaded unless a call already holds
+ * it), the workspaces and, for RK4, its arrays; the step's arguments in a.
+ * False, with w->x and w->v up to date, when out of memory. */
+static bool begin(spn_world *w, int threads, double dt, bool rk4, a32 *a)
 {
     spn__lattice *L = w->lat;
     if (!w->no_backup) spn__lattice_sync(w); /* a step with a backup starts from w->x */
@@ -477,12 +404,39 @@ bool spn__lat32_explicit(spn_world *w, int threads, double dt, bool symplectic, 
         if (!load(w, threads)) return false;
     }
     spn__lat32 *F = L->f32;
+    if (rk4 && !F->rk4) {
+        if (!(F->rk4 = calloc(18 * F->np, sizeof *F->rk4))) {
+            spn__lattice_sync(w);
+            return false;
+        }
+        for (int k = 0; k < 6; k++) F->trial[0][k] = F->rk4 + k * F->np, F->trial[1][k] = F->rk4 + (6 + k) * F->np;
+        for (int c = 0; c < 3; c++) F->ax[c] = F->rk4 + (12 + c) * F->np, F->av[c] = F->rk4 + (15 + c) * F->np;
+    }
     if (!prepare32(L, threads)) {
         spn__lattice_sync(w);
         return false;
     }
-    a32 a = {L, F, {(float)w->def.gravity.x, (float)w->def.gravity.y, (float)w->def.gravity.z},
-             (float)w->def.drag, (float)dt, symplectic};
+    memset(a, 0, sizeof *a);
+    a->L = L, a->F = F;
+    a->g[0] = (float)w->def.gravity.x, a->g[1] = (float)w->def.gravity.y, a->g[2] = (float)w->def.gravity.z;
+    a->drag = (float)w->def.drag, a->dt = (float)dt;
+    for (int c = 0; c < 3; c++) a->ed[c] = F->d[c], a->eu[c] = F->u[c];
+    return true;
+}
+
+/* After a step: rebase every REBASE steps, write back after a step with a
+ * backup (spn_world_step, or a run that does not replay). */
+static void end(spn_world *w, int threads)
+{
+    spn__lat32 *F = w->lat->f32;
+    if (++F->since >= REBASE || !w->no_backup) write_back(w, threads, w->no_backup);
+}
+
+bool spn__lat32_explicit(spn_world *w, int threads, double dt, bool symplectic, spn__step_result *r)
+{
+    a32 a;
+    if (!begin(w, threads, dt, false, &a)) return false;
+    a.mode = symplectic ? M_SYMPLECTIC : M_EULER;
     double sum[L_NSUMS];
     sweep32(&a, threads, sum);
     r->elastic = sum[L_ELASTIC];
@@ -491,7 +445,41 @@ bool spn__lat32_explicit(spn_world *w, int threads, double dt, bool symplectic, 
     r->work = 0;
     r->dissipated = dt * (sum[L_DAMP] + w->def.drag * sum[L_MV2]);
     r->kinetic = 0.5 * sum[L_MVN2];
-    if (++F->since >= REBASE || !w->no_backup) write_back(w, threads, w->no_backup);
+    end(w, threads);
+    return true;
+}
+
+/* RK4 as lattice.c's: four sweeps, stage s evaluated at the trial state of
+ * stage s - 1 and writing the next one into the other trial array. */
+bool spn__lat32_rk4(spn_world *w, int threads, double dt, spn__step_result *r)
+{
+    a32 a;
+    if (!begin(w, threads, dt, true, &a)) return false;
+    spn__lat32 *F = w->lat->f32;
+    static const float weight[4] = {1, 2, 2, 1}, frac[4] = {0, 0.5f, 0.5f, 1};
+    double damp = 0, sum[L_NSUMS];
+    for (int stage = 0; stage < 4; stage++) {
+        float *const *from = F->trial[(stage + 1) % 2], *const *to = F->trial[stage % 2];
+        for (int c = 0; c < 3; c++) {
+            a.ed[c] = stage ? from[c] : F->d[c], a.eu[c] = stage ? from[3 + c] : F->u[c];
+            a.td[c] = to[c], a.tu[c] = to[3 + c];
+        }
+        a.mode = stage < 3 ? M_RK4_STAGE : M_RK4_LAST;
+        a.first = stage == 0;
+        a.weight = weight[stage];
+        a.h = stage < 3 ? frac[stage + 1] * (float)dt : (float)dt / 6;
+        sweep32(&a, threads, sum);
+        if (stage == 0) {
+            r->e_before = 0.5 * sum[L_MV2] + sum[L_ELASTIC];
+            r->elastic = sum[L_ELASTIC];
+        }
+        damp += weight[stage] * (sum[L_DAMP] + w->def.drag * sum[L_MV2]);
+    }
+    r->gain_kp = sum[L_GAIN];
+    r->kinetic = 0.5 * sum[L_MVN2];
+    r->work = 0;
+    r->dissipated = dt / 6 * damp;
+    end(w, threads);
     return true;
 }
 

@@ -41,6 +41,8 @@ void spn__lat32_params_changed(spn__lat32 *F);
 /* One float32 Euler or symplectic step over the lattice on `threads`
  * threads; false (nothing done, w->x and w->v up to date) when out of memory. */
 bool spn__lat32_explicit(spn_world *w, int threads, double dt, bool symplectic, spn__step_result *r);
+/* One float32 RK4 step over the lattice, likewise. */
+bool spn__lat32_rk4(spn_world *w, int threads, double dt, spn__step_result *r);
 
 struct spn__lattice {
     uint32_t rings, radials;
