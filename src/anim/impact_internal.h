@@ -16,7 +16,7 @@ typedef struct spn__tether {
     double u, rest;
     double strength; /* it lets go past this pull [N]: glue over its contact length */
     double k;        /* strength / SPN_GLUE_STRETCH [N/m] */
-    bool listed; /* handed to the implicit solver for the step just taken */
+    int slot;    /* its index in the implicit solver's contact list of the step just taken; -1: not in it */
 } spn__tether;
 
 #define MAX_PREY 8
