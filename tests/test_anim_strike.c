@@ -18,6 +18,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 #include <spinneret/spinneret.h>
 
 /* A 10 cm dragline thread (EA 0.07 N, 2% pre-strain) of 20 segments of
@@ -204,12 +205,31 @@ static void test_fast_prey_breaks_locally_and_passes(void **state)
     spn_world_destroy(w);
 }
 
+/* A glue outline smaller than the prey, or absurdly large, is refused with
+ * the field named. */
+static void test_bad_glue_outline_refused(void **state)
+{
+    (void)state;
+    spn_world *w = thread();
+    spn_prey_def prey = {{0.012, 0, 0.01}, {0, 0, -0.5}, 3e-4, 0.004};
+    spn_impact_def d = spn_impact_def_default();
+    spn_impact *im = NULL;
+    d.glue_outline = 0.5;
+    assert_int_equal(spn_impact_create(&w, &prey, 1, &d, &im), SPN_ERR_INVALID);
+    assert_non_null(strstr(spn_last_error(), "glue outline"));
+    d.glue_outline = NAN;
+    assert_int_equal(spn_impact_create(&w, &prey, 1, &d, &im), SPN_ERR_INVALID);
+    assert_null(im);
+    spn_world_destroy(w);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_slow_prey_on_a_thread),
         cmocka_unit_test(test_slow_prey_is_caught_and_held),
         cmocka_unit_test(test_fast_prey_breaks_locally_and_passes),
+        cmocka_unit_test(test_bad_glue_outline_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

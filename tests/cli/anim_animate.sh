@@ -50,6 +50,7 @@ expect 2 "--fps" "$WEB" -o "$T/bad1" --fps 0
 expect 2 "--wind" "$WEB" -o "$T/bad2" --wind storm
 expect 2 "--impact" "$WEB" -o "$T/bad3" --impact "1,2;3"
 expect 2 "--impact" "$WEB" -o "$T/bad3" --impact "0,0,0.01;0,0,-1;-1;0.01"
+expect 2 "--glue-outline" "$WEB" -o "$T/bad3" --glue-outline 0.5
 expect 2 "--frame-range" "$WEB" -o "$T/bad4" --frame-range 5-2
 expect 2 "--report" "$WEB" -o "$T/bad5" --report "$T/r2.json"
 expect 2 "missing -o" "$WEB"
