@@ -13,6 +13,13 @@
  * Breakage: each thread kind breaks at its strain (web_util.c); the world
  * does the breaking (break_max) and tells us through its break callback.
  *
+ * Glue: once a prey has touched the web, capture thread within its sticky
+ * outline (legs, wings: glue_outline radii) is tethered to it, with a
+ * strength of the adhesion per length of thread in the outline (Opell &
+ * Hendricks 2009); a tether pulled past it lets go and its stretch energy is
+ * the ledger's glue term. Tethers are what hold a caught prey (glue_segment,
+ * spn__impact_glue_update; docs/wind-and-prey.md, "Capture").
+ *
  * The energy ledger (spn_impact_after_step) follows what becomes of the prey's
  * kinetic energy: elastic energy per thread kind, dissipation by the springs'
  * damping per kind (kd (l' . l/|l|)^2 integrated by the trapezoid rule over

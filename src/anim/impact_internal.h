@@ -9,7 +9,7 @@
 
 /* The glue holding prey p to segment s, attached at point u: tension-only,
  * rest length `rest` from the prey's centre. It stands for all the droplets
- * of the segment's length that touched the prey. */
+ * of the segment's length within the prey's sticky outline (impact.c). */
 typedef struct spn__tether {
     int prey;
     uint32_t s;
