@@ -3,12 +3,8 @@
 # the impact report reads as JSON with the outcome, bad options are refused
 # with the option named and nothing written, and an interrupt keeps finished
 # frames and leaves no partial video.
-set -u
-SPN=$1
+. "$(dirname "$0")/lib/common.sh" "$@"
 WEB=$SPN_TEST_DATA/anim/orb.json
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
 
 common=(--wind thesis --thesis-gain 300 --duration 1 --fps 10 --size 160x160 --quiet --camera persp --eye 0.3,0.15,0.35)
 "$SPN" animate "$WEB" -o "$T/whole" "${common[@]}" || fail "whole run"
