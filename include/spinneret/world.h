@@ -126,13 +126,16 @@ typedef enum spn_precision {
 } spn_precision;
 /// Opt in to (or out of) the float32 lattice step. It applies only where
 /// spn_world_step_path says "lattice" and the integrator is Euler,
-/// symplectic or RK4; everything else stays float64. Positions are kept as float32
-/// displacements from the float64 positions, which are brought up to date
-/// every 64 steps and at the end of every spn_world_step / spn_world_advance
-/// call; spring differences carry the float64 geometry (relative error
+/// symplectic or RK4, and only inside spn_world_advance calls of 2 or more
+/// steps that keep one state copy per call (no callbacks, colliders, Provot
+/// limits or breakable springs): a single step pays more to load and write
+/// back the float32 state than it saves. Everything else stays float64.
+/// Positions are kept as float32 displacements from the float64 positions,
+/// which are brought up to date every 64 steps and at the end of the call;
+/// spring differences carry the float64 geometry (relative error
 /// ~1e-7 of a segment, so ~5e-6 of a 2% stretch). Same input, same bits on
 /// any thread count; not the float64 path's bits, and spn_world_advance(n)
-/// differs from n spn_world_step calls by float32 round-off.
+/// differs from n spn_world_step calls (float64) by float32 round-off.
 SPN_API void spn_world_set_precision(spn_world *w, spn_precision precision);
 SPN_API spn_precision spn_world_precision(const spn_world *w);
 

@@ -488,6 +488,8 @@ void spn__lattice_sync(spn_world *w)
     if (w->lat && w->lat->f32 && w->lat->f32->live) write_back(w, spn__threads(w, w->np), false);
 }
 
+bool spn__lat32_live(const spn__lat32 *F) { return F && F->live; }
+
 void spn__lat32_params_changed(spn__lat32 *F)
 {
     if (F) F->params_ok = false;

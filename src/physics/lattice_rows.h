@@ -38,6 +38,8 @@ typedef struct spn__lat32 spn__lat32;
 void spn__lat32_free(spn__lat32 *F);
 /* A slot's k, kd or rest changed: convert them again before the next step. */
 void spn__lat32_params_changed(spn__lat32 *F);
+/* The float32 state is ahead of w->x, w->v (inside an spn_world_advance call). */
+bool spn__lat32_live(const spn__lat32 *F);
 /* One float32 Euler or symplectic step over the lattice on `threads`
  * threads; false (nothing done, w->x and w->v up to date) when out of memory. */
 bool spn__lat32_explicit(spn_world *w, int threads, double dt, bool symplectic, spn__step_result *r);
