@@ -68,8 +68,10 @@ double spn__eq_slack_limit(const spn__eq *e, const double *p, double cap);
 /* y = A p over free particles; the _dot form also returns p . y. */
 void spn__eq_matvec(const spn__eq *e, const double *p, double *y);
 double spn__eq_matvec_dot(const spn__eq *e, const double *p, double *y);
-/* p += alpha d, r -= alpha q; returns r . r. */
-double spn__eq_update(const spn__eq *e, double alpha, const double *d, const double *q, double *p, double *r);
+/* p += alpha d, r -= alpha q; returns r . r and sets *rmax2 to the largest
+ * |r_i|^2 of a particle. */
+double spn__eq_update(const spn__eq *e, double alpha, const double *d, const double *q, double *p, double *r,
+                      double *rmax2);
 /* Fixed-order sum of a . b over 3 n entries. */
 double spn__eq_dot(const spn__eq *e, const double *a, const double *b);
 
@@ -86,7 +88,8 @@ void spn__precond_free(spn__precond *pc);
 /* Symmetric block Gauss-Seidel with the inverted diagonal blocks inv. */
 void spn__sgs_apply(const spn__eq *e, const double *inv, const double *r, double *z);
 
-/* Solve A p = f until |A p - f|_2 <= max(eta |f|_2, floor), p the first guess.
+/* Solve A p = f until |A p - f|_2 <= eta |f|_2 or every particle's
+ * |(A p - f)_i| <= floor, p the first guess.
  * Returns the iterations used, or -1 when A showed non-positive curvature. */
 int spn__eq_pcg(const spn__eq *e, const spn__precond *pc, double *p, double eta, double floor, int max_iter,
                 double *work);
