@@ -32,7 +32,15 @@
  * blocks of the line's springs) by the block Thomas algorithm, factored once
  * per Newton step. Lines of a colour go in groups of GROUP, a step along all
  * of them at a time: a radial of a ring-major web strides through memory,
- * but neighbouring radials step through neighbouring memory together. */
+ * but neighbouring radials step through neighbouring memory together.
+ *
+ * Precision: the sweep reads float32 copies of the level-0 blocks (6 numbers
+ * each: every block of a spring system is symmetric) and of the factors,
+ * factored in float64 and rounded once; the sums and the vectors stay
+ * float64. The smoother only preconditions (CG and its residuals are
+ * float64), and a 1e-7 relative change of it does not change the iteration
+ * counts (5k and 100k webs: 25 and 54 CG either way). It reads 40% of the
+ * bytes: the 100k web's solve went from 4.2 to 3.3 s CPU. */
 #include "equilibrium_bsr.h"
 #include "equilibrium_internal.h"
 
