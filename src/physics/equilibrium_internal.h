@@ -117,5 +117,16 @@ bool spn__lines_factor(spn__lines *L, const struct spn__bsr *a0);
 void spn__lines_sweep(const spn__lines *L, const struct spn__bsr *a0, const double *b, double *x, bool forward,
                       int threads);
 void spn__lines_free(spn__lines *L);
+/* The lines' particles: line l is node[start[l] .. start[l + 1]). */
+void spn__lines_nodes(const spn__lines *L, uint32_t *count, const uint32_t **start, const uint32_t **node);
+
+/* Thread-slide correction (equilibrium_slide.c) on level 0 of the multigrid. */
+typedef struct spn__slide spn__slide;
+spn__slide *spn__slide_build(const spn__eq *e, const spn__lines *L);
+/* C = Z^T A Z from the spring system's blocks and shift; false if not positive definite. */
+bool spn__slide_factor(spn__slide *S, const spn__eq *e);
+/* x += Z C^-1 Z^T r. */
+void spn__slide_correct(const spn__slide *S, const spn__eq *e, const double *r, double *x);
+void spn__slide_free(spn__slide *S);
 
 #endif

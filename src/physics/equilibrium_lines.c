@@ -80,6 +80,13 @@ void spn__lines_free(spn__lines *L)
     free(L);
 }
 
+void spn__lines_nodes(const spn__lines *L, uint32_t *count, const uint32_t **start, const uint32_t **node)
+{
+    *count = L->count;
+    *start = L->start;
+    *node = L->node;
+}
+
 typedef struct pair_cand {
     double c;
     uint32_t a, b;
