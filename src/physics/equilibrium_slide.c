@@ -17,7 +17,7 @@
  * more particles: its particles displaced by 1 along the line's tangent. The
  * coarse matrix C = Z^T A Z (Z: the slide vectors as columns) is assembled
  * spring by spring from the projected Hessian blocks and factored densely
- * (lines: 165 on the 5k web, 650 at 100k, 2,000 at 1M). The correction
+ * (lines: 164 on the 5k web, 649 at 100k, 1,999 at 1M). The correction
  * x += Z C^-1 Z^T (b - A x) is applied before and after the aggregation
  * multigrid's coarse correction, so the V-cycle stays symmetric.
  * Sequential and in a fixed order: the same bits for any thread count. */
