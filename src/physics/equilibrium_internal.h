@@ -68,8 +68,10 @@ double spn__eq_slack_limit(const spn__eq *e, const double *p, double cap);
 /* y = A p over free particles; the _dot form also returns p . y. */
 void spn__eq_matvec(const spn__eq *e, const double *p, double *y);
 double spn__eq_matvec_dot(const spn__eq *e, const double *p, double *y);
-/* p += alpha d, r -= alpha q; returns r . r. */
-double spn__eq_update(const spn__eq *e, double alpha, const double *d, const double *q, double *p, double *r);
+/* p += alpha d, r -= alpha q; returns r . r and sets *rmax2 to the largest
+ * |r_i|^2 of a particle. */
+double spn__eq_update(const spn__eq *e, double alpha, const double *d, const double *q, double *p, double *r,
+                      double *rmax2);
 /* Fixed-order sum of a . b over 3 n entries. */
 double spn__eq_dot(const spn__eq *e, const double *a, const double *b);
 
@@ -86,7 +88,8 @@ void spn__precond_free(spn__precond *pc);
 /* Symmetric block Gauss-Seidel with the inverted diagonal blocks inv. */
 void spn__sgs_apply(const spn__eq *e, const double *inv, const double *r, double *z);
 
-/* Solve A p = f until |A p - f|_2 <= max(eta |f|_2, floor), p the first guess.
+/* Solve A p = f until |A p - f|_2 <= eta |f|_2 or every particle's
+ * |(A p - f)_i| <= floor, p the first guess.
  * Returns the iterations used, or -1 when A showed non-positive curvature. */
 int spn__eq_pcg(const spn__eq *e, const spn__precond *pc, double *p, double eta, double floor, int max_iter,
                 double *work);
@@ -114,5 +117,16 @@ bool spn__lines_factor(spn__lines *L, const struct spn__bsr *a0);
 void spn__lines_sweep(const spn__lines *L, const struct spn__bsr *a0, const double *b, double *x, bool forward,
                       int threads);
 void spn__lines_free(spn__lines *L);
+/* The lines' particles: line l is node[start[l] .. start[l + 1]). */
+void spn__lines_nodes(const spn__lines *L, uint32_t *count, const uint32_t **start, const uint32_t **node);
+
+/* Thread-slide correction (equilibrium_slide.c) on level 0 of the multigrid. */
+typedef struct spn__slide spn__slide;
+spn__slide *spn__slide_build(const spn__eq *e, const spn__lines *L);
+/* C = Z^T A Z from the spring system's blocks and shift; false if not positive definite. */
+bool spn__slide_factor(spn__slide *S, const spn__eq *e);
+/* x += Z C^-1 Z^T r. */
+void spn__slide_correct(const spn__slide *S, const spn__eq *e, const double *r, double *x);
+void spn__slide_free(spn__slide *S);
 
 #endif

@@ -506,21 +506,33 @@ double spn__eq_dot(const spn__eq *e, const double *a, const double *b)
     return sum;
 }
 
-double spn__eq_update(const spn__eq *e, double alpha, const double *d, const double *q, double *p, double *r)
+double spn__eq_update(const spn__eq *e, double alpha, const double *d, const double *q, double *p, double *r,
+                      double *rmax2)
 {
-    const uint32_t nchunks = e->nchunks, n3 = 3 * e->n;
+    const uint32_t n = e->n, nchunks = e->nchunks;
     double *part = e->partial;
 #pragma omp parallel for schedule(static) num_threads(team(e, e->n))
     for (uint32_t c = 0; c < nchunks; c++) {
-        uint32_t lo = 3 * c * SPN__EQ_CHUNK, hi = 3 * (c + 1) * SPN__EQ_CHUNK < n3 ? 3 * (c + 1) * SPN__EQ_CHUNK : n3;
-        for (uint32_t i = lo; i < hi; i++) {
-            p[i] += alpha * d[i];
-            r[i] -= alpha * q[i];
+        uint32_t end = (c + 1) * SPN__EQ_CHUNK < n ? (c + 1) * SPN__EQ_CHUNK : n;
+        double rr = 0, big = 0;
+        for (uint32_t i = c * SPN__EQ_CHUNK; i < end; i++) {
+            size_t k = 3 * (size_t)i;
+            p[k] += alpha * d[k], p[k + 1] += alpha * d[k + 1], p[k + 2] += alpha * d[k + 2];
+            double r0 = r[k] - alpha * q[k], r1 = r[k + 1] - alpha * q[k + 1], r2 = r[k + 2] - alpha * q[k + 2];
+            r[k] = r0, r[k + 1] = r1, r[k + 2] = r2;
+            double ri = r0 * r0 + r1 * r1 + r2 * r2;
+            rr += ri;
+            big = ri > big ? ri : big;
         }
-        part[c] = chunk_dot(r, r, lo, hi);
+        part[2 * c] = rr;
+        part[2 * c + 1] = big;
     }
-    double sum = 0;
-    for (uint32_t c = 0; c < nchunks; c++) sum += part[c];
+    double sum = 0, big = 0;
+    for (uint32_t c = 0; c < nchunks; c++) {
+        sum += part[2 * c];
+        big = part[2 * c + 1] > big ? part[2 * c + 1] : big;
+    }
+    *rmax2 = big;
     return sum;
 }
 

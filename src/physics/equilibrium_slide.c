@@ -1,0 +1,190 @@
+/* Thread-slide correction for the equilibrium multigrid's finest level.
+ *
+ * Why: a taut net of threads without diagonals (rings x radials) has soft
+ * modes that no thread stretches in: a thread sliding along itself, which
+ * only shears the threads crossing it (their transverse stiffness T/l, about
+ * 1/prestrain = 50 times weaker than the axial EA/l). A ring sliding along
+ * itself is a rigid rotation of that ring, and rings rotating by different
+ * amounts twist the web. Measured (stationary V-cycles on A x = 0, 5k web,
+ * the last Newton system): the error the V-cycle leaves is exactly this,
+ * tangential, nearly uniform along each ring and smooth from ring to ring,
+ * reduced by only ~0.9 a cycle; with level 1 solved exactly, still 0.82.
+ * Aggregates that translate rigidly cannot follow a rotation without
+ * stretching the radials between neighbouring rings' aggregates, so the
+ * coarse levels do not see these modes as soft.
+ *
+ * What: one coarse unknown per thread line (equilibrium_lines.c) of two or
+ * more particles: its particles displaced by 1 along the line's tangent. The
+ * coarse matrix C = Z^T A Z (Z: the slide vectors as columns) is assembled
+ * spring by spring from the projected Hessian blocks and factored densely
+ * (lines: 164 on the 5k web, 649 at 100k, 1,999 at 1M). The correction
+ * x += Z C^-1 Z^T (b - A x) is applied before and after the aggregation
+ * multigrid's coarse correction, so the V-cycle stays symmetric.
+ * Sequential and in a fixed order: the same bits for any thread count. */
+#include "equilibrium_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Lines above which the dense C (8 N^2 bytes, N^3 / 3 to factor) costs
+ * more than it saves: 2,000 on the 1M web is 32 MB and ~3 GFlop once. */
+#define SLIDE_MAX 3000u
+
+struct spn__slide {
+    uint32_t nz;        /* coarse unknowns: lines of two or more particles */
+    uint32_t *pstart;   /* n + 1: a free particle's entries */
+    uint32_t *pcol;     /* per entry: its line's coarse unknown */
+    double *ptan;       /* 3 per entry: the line's unit tangent at the particle */
+    double *c;          /* nz x nz: C, then its Cholesky factor (lower, row-major) */
+    double *w;          /* nz */
+};
+
+void spn__slide_free(spn__slide *S)
+{
+    if (!S) return;
+    free(S->pstart), free(S->pcol), free(S->ptan), free(S->c), free(S->w);
+    free(S);
+}
+
+/* Unit tangent of line nodes [k0, k1) at node k, from its neighbours on the line. */
+static void tangent(const spn__eq *e, const uint32_t *node, uint32_t k0, uint32_t k1, uint32_t k, double *t)
+{
+    uint32_t a = node[k > k0 ? k - 1 : k], b = node[k + 1 < k1 ? k + 1 : k];
+    double len = 0;
+    for (int c = 0; c < 3; c++) {
+        t[c] = e->x[3 * (size_t)b + c] - e->x[3 * (size_t)a + c];
+        len += t[c] * t[c];
+    }
+    len = sqrt(len);
+    for (int c = 0; c < 3; c++) t[c] = len > 0 ? t[c] / len : 0;
+}
+
+spn__slide *spn__slide_build(const spn__eq *e, const spn__lines *L)
+{
+    uint32_t count, total, nz = 0;
+    const uint32_t *start, *node;
+    spn__lines_nodes(L, &count, &start, &node);
+    total = start[count];
+    spn__slide *S = calloc(1, sizeof *S);
+    if (!S) return NULL;
+    S->pstart = calloc((size_t)e->n + 1, sizeof *S->pstart);
+    S->pcol = malloc((total ? total : 1) * sizeof *S->pcol);
+    S->ptan = malloc(3 * (size_t)(total ? total : 1) * sizeof *S->ptan);
+    uint32_t *fill = calloc(e->n ? e->n : 1, sizeof *fill);
+    if (!S->pstart || !S->pcol || !S->ptan || !fill) {
+        free(fill);
+        spn__slide_free(S);
+        return NULL;
+    }
+    for (uint32_t l = 0; l < count; l++)
+        if (start[l + 1] - start[l] >= 2)
+            for (uint32_t k = start[l]; k < start[l + 1]; k++) S->pstart[node[k] + 1]++;
+    for (uint32_t i = 0; i < e->n; i++) S->pstart[i + 1] += S->pstart[i];
+    for (uint32_t l = 0; l < count; l++) {
+        if (start[l + 1] - start[l] < 2) continue;
+        for (uint32_t k = start[l]; k < start[l + 1]; k++) {
+            uint32_t q = S->pstart[node[k]] + fill[node[k]]++;
+            S->pcol[q] = nz;
+            tangent(e, node, start[l], start[l + 1], k, S->ptan + 3 * (size_t)q);
+        }
+        nz++;
+    }
+    free(fill);
+    S->nz = nz;
+    if (nz > SLIDE_MAX || nz == 0) {
+        spn__slide_free(S);
+        return NULL;
+    }
+    S->c = malloc((nz ? (size_t)nz * nz : 1) * sizeof *S->c);
+    S->w = malloc((nz ? nz : 1) * sizeof *S->w);
+    if (!S->c || !S->w) {
+        spn__slide_free(S);
+        return NULL;
+    }
+    return S;
+}
+
+/* C += sign * t_i^T H t_j over the entries of particles a (sign +) and b (sign -). */
+static void add_spring(spn__slide *S, const double *h, uint32_t a, int64_t b)
+{
+    const uint32_t nz = S->nz;
+    uint32_t ia0 = S->pstart[a], ia1 = S->pstart[a + 1];
+    uint32_t ib0 = b >= 0 ? S->pstart[b] : 0, ib1 = b >= 0 ? S->pstart[b + 1] : 0;
+    for (int side_i = 0; side_i < 2; side_i++) {
+        uint32_t i0 = side_i ? ib0 : ia0, i1 = side_i ? ib1 : ia1;
+        for (uint32_t i = i0; i < i1; i++) {
+            double ht[3];
+            spn__sym_mul(h, S->ptan + 3 * (size_t)i, ht);
+            double *row = S->c + (size_t)S->pcol[i] * nz;
+            for (int side_j = 0; side_j < 2; side_j++) {
+                uint32_t j0 = side_j ? ib0 : ia0, j1 = side_j ? ib1 : ia1;
+                double sign = side_i == side_j ? 1 : -1;
+                for (uint32_t j = j0; j < j1; j++) {
+                    const double *t = S->ptan + 3 * (size_t)j;
+                    row[S->pcol[j]] += sign * (ht[0] * t[0] + ht[1] * t[1] + ht[2] * t[2]);
+                }
+            }
+        }
+    }
+}
+
+bool spn__slide_factor(spn__slide *S, const spn__eq *e)
+{
+    const size_t N = S->nz;
+    double *f = S->c;
+    memset(f, 0, N * N * sizeof *f);
+    for (uint32_t s = 0; s < e->m; s++)
+        add_spring(S, e->hs + 6 * (size_t)s, e->sa[s], e->sb[s] < e->n ? (int64_t)e->sb[s] : -1);
+    if (e->lambda > 0)
+        for (uint32_t p = 0; p < e->n; p++) {
+            double h[6] = {e->lambda * e->kscale[p], e->lambda * e->kscale[p], e->lambda * e->kscale[p], 0, 0, 0};
+            add_spring(S, h, p, -1);
+        }
+    /* a line whose slide stretches nothing and shears nothing (a free thread
+     * end to end) would make C singular: a relative shift keeps it factorable */
+    double big = 0;
+    for (size_t k = 0; k < N; k++) big = fmax(big, f[k * N + k]);
+    for (size_t k = 0; k < N; k++) f[k * N + k] += 1e-12 * big;
+    for (size_t k = 0; k < N; k++) {
+        double d = f[k * N + k];
+        for (size_t q = 0; q < k; q++) d -= f[k * N + q] * f[k * N + q];
+        if (!(d > 0)) return false;
+        d = sqrt(d);
+        f[k * N + k] = d;
+        for (size_t i = k + 1; i < N; i++) {
+            double s = f[i * N + k];
+            for (size_t q = 0; q < k; q++) s -= f[i * N + q] * f[k * N + q];
+            f[i * N + k] = s / d;
+        }
+    }
+    return true;
+}
+
+void spn__slide_correct(const spn__slide *S, const spn__eq *e, const double *r, double *x)
+{
+    const size_t N = S->nz;
+    const double *f = S->c;
+    double *w = S->w;
+    memset(w, 0, N * sizeof *w);
+    for (uint32_t p = 0; p < e->n; p++)
+        for (uint32_t q = S->pstart[p]; q < S->pstart[p + 1]; q++) {
+            const double *t = S->ptan + 3 * (size_t)q, *rp = r + 3 * (size_t)p;
+            w[S->pcol[q]] += t[0] * rp[0] + t[1] * rp[1] + t[2] * rp[2];
+        }
+    for (size_t i = 0; i < N; i++) { /* L y = w, then L^T y' = y, in place */
+        double s = w[i];
+        for (size_t q = 0; q < i; q++) s -= f[i * N + q] * w[q];
+        w[i] = s / f[i * N + i];
+    }
+    for (size_t i = N; i-- > 0;) { /* by rows of L (contiguous), not its columns */
+        w[i] /= f[i * N + i];
+        for (size_t q = 0; q < i; q++) w[q] -= f[i * N + q] * w[i];
+    }
+    for (uint32_t p = 0; p < e->n; p++)
+        for (uint32_t q = S->pstart[p]; q < S->pstart[p + 1]; q++) {
+            const double *t = S->ptan + 3 * (size_t)q, y = w[S->pcol[q]];
+            double *xp = x + 3 * (size_t)p;
+            xp[0] += y * t[0], xp[1] += y * t[1], xp[2] += y * t[2];
+        }
+}
