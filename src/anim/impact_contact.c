@@ -7,8 +7,9 @@
  * Euler step carries the stiffness, so the prey and the 1e-10 kg thread
  * particles move together at the solver's step instead of the 1e-7 s an
  * explicit contact needs. A contact is found a step late, already some way
- * in (at most 3% of a radius: spn_impact_step_limit, below): the depth it first has becomes the contact's offset, so the penalty does not
- * create k depth^2 / 2 from nothing (the sphere is that much smaller for that
+ * in (at most 3% of a radius: spn_impact_step_limit, below): the depth it
+ * first has becomes the contact's offset, so the penalty does not create
+ * k depth^2 / 2 from nothing (the sphere is that much smaller for that
  * thread; the offset shrinks as the thread comes back out).
  *
  * Backward Euler removes energy by itself: for a quadratic energy one step

@@ -205,7 +205,8 @@ static spn_status advance_frame(runner *r, spn_world *w, int substeps, double dt
     for (int s = 0; s < substeps; s++) {
         double left = dt;
         while (left > 0) {
-            double h = left, limit = split ? fmin(spn_impact_step_limit(r->impact, w, dt), STEP_GROWTH * r->last_step) : dt;
+            double h = left, limit = dt;
+            if (split) limit = fmin(spn_impact_step_limit(r->impact, w, dt), STEP_GROWTH * r->last_step);
             int n = limit < left ? (int)fmin(1e6, ceil(left / limit)) : 1;
             if (n > 1) h = left / n;
             spn_status st = one_step(r, w, h, steps);
