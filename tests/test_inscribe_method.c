@@ -14,15 +14,7 @@
 #include <string.h>
 #include <spinneret/spinneret.h>
 
-static spn_world *orb(void)
-{
-    spn_world_def wd = spn_world_def_default();
-    wd.integrator = SPN_INTEGRATOR_SYMPLECTIC;
-    wd.drag = 200;
-    spn_world *w = NULL;
-    assert_int_equal(spn_scene_orb(&wd, NULL, &w), SPN_OK);
-    return w;
-}
+#include "inscribe_util.h"
 
 static spn_inscribe_def quick_def(void)
 {
@@ -60,7 +52,7 @@ static uint32_t count_tag(const spn_world *w, uint32_t tag, int side)
 static void test_half_target_removes_that_half_only(void **state)
 {
     (void)state;
-    spn_world *w = orb();
+    spn_world *w = inscribe_orb();
     spn_target *t = target_from(w, right_half);
     uint32_t ns = spn_world_spring_count(w);
     uint8_t *scores = malloc(ns);
@@ -96,7 +88,7 @@ static void test_half_target_removes_that_half_only(void **state)
 static void test_empty_target_removes_none(void **state)
 {
     (void)state;
-    spn_world *w = orb();
+    spn_world *w = inscribe_orb();
     spn_target *t = target_from(w, NULL);
     uint32_t ns = spn_world_spring_count(w), np = spn_world_particle_count(w);
     for (int e = 0; e < 4; e++) {
@@ -116,7 +108,7 @@ static void test_empty_target_removes_none(void **state)
 static void test_full_target_removes_all_above_threshold(void **state)
 {
     (void)state;
-    spn_world *w = orb();
+    spn_world *w = inscribe_orb();
     spn_target *t = target_from(w, everything);
     uint32_t capture = count_tag(w, SPN_THREAD_CAPTURE, 0);
     spn_inscribe_def d = quick_def();
@@ -201,7 +193,7 @@ static void test_emphasis_changes_only_the_message(void **state)
 {
     (void)state;
     for (int e = 0; e < 4; e++) {
-        spn_world *w = orb();
+        spn_world *w = inscribe_orb();
         spn_target *t = NULL;
         assert_int_equal(spn_target_create(w, 600, &t), SPN_OK);
         spn_text_def td = spn_text_def_default();

@@ -13,15 +13,7 @@
 #include <string.h>
 #include <spinneret/spinneret.h>
 
-static spn_world *orb(void)
-{
-    spn_world_def wd = spn_world_def_default();
-    wd.integrator = SPN_INTEGRATOR_SYMPLECTIC;
-    wd.drag = 200;
-    spn_world *w = NULL;
-    assert_int_equal(spn_scene_orb(&wd, NULL, &w), SPN_OK);
-    return w;
-}
+#include "inscribe_util.h"
 
 /* Every particle reaches a fixed one; every free particle has >= 2 threads. */
 static void check_hangs_whole(const spn_world *w)
@@ -53,7 +45,7 @@ static void test_inscribed_web_is_settled_and_whole(void **state)
     /* Fill adds the most (new masses, split threads); outline doubles threads. */
     const spn_emphasis modes[] = {SPN_EMPHASIS_FILL, SPN_EMPHASIS_OUTLINE};
     for (int m = 0; m < 2; m++) {
-        spn_world *w = orb();
+        spn_world *w = inscribe_orb();
         spn_target *t = NULL;
         assert_int_equal(spn_target_create(w, 600, &t), SPN_OK);
         spn_text_def td = spn_text_def_default();
@@ -108,7 +100,7 @@ static double left_third(void *user, double x, double y) { return (void)user, (v
 static void test_subdivided_segments_go_whole(void **state)
 {
     (void)state;
-    spn_world *w = orb();
+    spn_world *w = inscribe_orb();
     uint32_t mids = subdivide_capture(&w), np = spn_world_particle_count(w);
     spn_target *t = NULL;
     assert_int_equal(spn_target_create(w, 1200, &t), SPN_OK);
@@ -129,7 +121,7 @@ static void test_subdivided_segments_go_whole(void **state)
 static void test_failure_leaves_the_web_alone(void **state)
 {
     (void)state;
-    spn_world *w = orb(), *before = w;
+    spn_world *w = inscribe_orb(), *before = w;
     spn_target *t = NULL;
     assert_int_equal(spn_target_create(w, 200, &t), SPN_OK);
     spn_inscribe_def d = spn_inscribe_def_default();

@@ -213,3 +213,17 @@ bool cli_output_writable(const char *cmd, const char *path)
     spn_atomic_abort(&f);
     return true;
 }
+
+int cli_parse_options(const char *cmd, int argc, char **argv, const char *shortopts, const struct option *options,
+                      void (*usage)(FILE *), cli_option_fn one, void *ctx)
+{
+    opterr = 0;
+    for (int c; (c = getopt_long(argc, argv, shortopts, options, NULL)) != -1;) {
+        if (c == 'h') return usage(stdout), 0;
+        if (c == ':') return cli_usage(cmd, "%s: missing value", argv[optind - 1]);
+        int r = c == '?' ? 0 : one(c, optarg, ctx);
+        if (r == 0) return cli_usage(cmd, "unknown option '%s'", argv[optind - 1]);
+        if (r < 0) return CLI_EXIT_USAGE;
+    }
+    return -1;
+}

@@ -4,6 +4,9 @@
 #ifndef SPN_CLI_H
 #define SPN_CLI_H
 
+#include <getopt.h>
+#include <stdio.h>
+
 #include <spinneret/spinneret.h>
 
 #define CLI_EXIT_FAIL 1
@@ -50,6 +53,18 @@ int cli_report_interrupt(const char *cmd, uint64_t done, uint64_t total, const c
 /* Before a long computation: can `path` be written? (Makes and removes a
  * temporary beside it.) False after printing "cannot write: REASON". */
 bool cli_output_writable(const char *cmd, const char *path);
+
+/* One option for a subcommand's parser: `c` as getopt_long returned it,
+ * `arg` its value. Returns 1 when it took the option, 0 when it does not know
+ * it, -1 on a bad value (it has printed why). */
+typedef int (*cli_option_fn)(int c, const char *arg, void *ctx);
+/* The option loop the subcommands share: getopt_long over argv (the short
+ * options `shortopts` start with ':' so a missing value is told apart), -h
+ * and --help print `usage` to stdout, a missing value or an unknown option is
+ * a usage error naming it, everything else goes to `one`. Returns -1 to go on
+ * (optind at the first operand), 0 after --help, else the exit code. */
+int cli_parse_options(const char *cmd, int argc, char **argv, const char *shortopts, const struct option *options,
+                      void (*usage)(FILE *), cli_option_fn one, void *ctx);
 
 /* Lower-case file extension of a path ("png"), or "" when none. */
 const char *cli_extension(const char *path);

@@ -58,6 +58,8 @@ static void usage(FILE *out)
             "      --report FILE.json  with --impact: outcome, energy per thread kind, threads broken\n"
             "      --no-breakage       threads never break\n"
             "      --glue N            capture glue strength per droplet [N], in [0, 1]; default 4e-5\n"
+            "      --glue-outline F    the prey's sticky outline (legs, wings) in prey radii, in [1, 100];\n"
+            "                          capture thread that near its centre glues to it; default 2.5\n"
             "      --prey-gravity      prey fall like pellets (default: they fly)\n\n",
             MAX_IMPACTS);
     render_options_help(out);
@@ -102,7 +104,7 @@ static bool wind_model(const char *arg, spn_wind_kind *out)
 enum {
     OPT_DURATION = 256, OPT_FPS, OPT_SOLVER, OPT_SUBSTEPS, OPT_SEED, OPT_RANGE, OPT_STATES, OPT_QUIET, OPT_WIND,
     OPT_TMASS, OPT_TGAIN, OPT_TRANDOM, OPT_TPERIOD, OPT_TTICK, OPT_TRAD, OPT_TFALL, OPT_SPEED, OPT_DIR, OPT_GUST,
-    OPT_TURB, OPT_STOP, OPT_IMPACT, OPT_REPORT, OPT_NOBREAK, OPT_GLUE, OPT_PGRAV, OPT_PLAYBACK, OPT_SOLVER_TOL
+    OPT_TURB, OPT_STOP, OPT_IMPACT, OPT_REPORT, OPT_NOBREAK, OPT_GLUE, OPT_GLUE_OUTLINE, OPT_PGRAV, OPT_PLAYBACK, OPT_SOLVER_TOL
 };
 
 static bool sim_option(int c, const char *arg, animate_options *o)
@@ -165,6 +167,7 @@ static bool air_prey_option(int c, const char *arg, animate_options *o)
         return true;
     case OPT_NOBREAK: d->impact.breakage = false; return true;
     case OPT_GLUE: return cli_double(CMD, "--glue", arg, 0, 1, &d->impact.glue_strength);
+    case OPT_GLUE_OUTLINE: return cli_double(CMD, "--glue-outline", arg, 1, 100, &d->impact.glue_outline);
     case OPT_PGRAV: d->impact.prey_gravity = true; return true;
     default: return false;
     }
@@ -185,7 +188,8 @@ static const struct option long_options[] = {
     {"gust", required_argument, NULL, OPT_GUST}, {"turbulence", required_argument, NULL, OPT_TURB},
     {"wind-stop", required_argument, NULL, OPT_STOP}, {"impact", required_argument, NULL, OPT_IMPACT},
     {"report", required_argument, NULL, OPT_REPORT}, {"no-breakage", no_argument, NULL, OPT_NOBREAK},
-    {"glue", required_argument, NULL, OPT_GLUE}, {"prey-gravity", no_argument, NULL, OPT_PGRAV},
+    {"glue", required_argument, NULL, OPT_GLUE}, {"glue-outline", required_argument, NULL, OPT_GLUE_OUTLINE},
+    {"prey-gravity", no_argument, NULL, OPT_PGRAV},
     RENDER_LONG_OPTIONS,
     {"help", no_argument, NULL, 'h'},            {NULL, 0, NULL, 0}};
 

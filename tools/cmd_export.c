@@ -60,6 +60,13 @@ static int parse_own(int c, const char *arg, export_options *o)
     }
 }
 
+static int parse_one(int c, const char *arg, void *ctx)
+{
+    export_options *o = ctx;
+    int r = parse_own(c, arg, o);
+    return r != 0 ? r : render_options_parse(CMD, c, arg, &o->ro);
+}
+
 static int check_output(const export_options *o)
 {
     if (o->out && o->frames) return cli_usage(CMD, "give either -o or --frames, not both");
@@ -82,15 +89,8 @@ static int parse(int argc, char **argv, export_options *o)
                                             {"help", no_argument, NULL, 'h'},
                                             RENDER_LONG_OPTIONS,
                                             {NULL, 0, NULL, 0}};
-    opterr = 0;
-    for (int c; (c = getopt_long(argc, argv, ":o:h", options, NULL)) != -1;) {
-        if (c == 'h') return usage(stdout), 0;
-        if (c == ':') return cli_usage(CMD, "%s: missing value", argv[optind - 1]);
-        if (c == '?') return cli_usage(CMD, "unknown option '%s'", argv[optind - 1]);
-        int r = parse_own(c, optarg, o);
-        if (r == 0) r = render_options_parse(CMD, c, optarg, &o->ro);
-        if (r < 0) return CLI_EXIT_USAGE;
-    }
+    int r = cli_parse_options(CMD, argc, argv, ":o:h", options, usage, parse_one, o);
+    if (r >= 0) return r;
     if (optind >= argc) return cli_usage(CMD, "missing FILE");
     if (!o->frames && optind + 1 < argc) return cli_usage(CMD, "unexpected argument '%s'", argv[optind + 1]);
     return check_output(o);

@@ -74,36 +74,38 @@ enum {
     OPT_FILL, OPT_GAPS, OPT_SEED, OPT_SOLVER, OPT_DT, OPT_TOL, OPT_MAX_TIME, OPT_NO_SETTLE, OPT_RENDER, OPT_OVERLAY
 };
 
-static bool parse_one(int c, inscribe_options *o)
+static bool take_option(int c, const char *arg, inscribe_options *o)
 {
     long v;
     switch (c) {
-    case 'o': o->output = optarg; return true;
-    case OPT_TEXT: return add_text(o, optarg);
-    case OPT_FONT: o->text_def.font = optarg; return true;
-    case OPT_FIT: return cli_double(CMD, "--fit", optarg, 1e-3, 1, &o->text_def.fit);
-    case OPT_HEIGHT: return cli_double(CMD, "--text-height", optarg, 1e-6, 1e3, &o->text_def.height);
-    case OPT_SPACING: return cli_double(CMD, "--line-spacing", optarg, 1, 4, &o->text_def.line_spacing);
-    case OPT_IMAGE: o->image = optarg; return true;
-    case OPT_RASTER: return cli_int(CMD, "--raster", optarg, 16, 8192, &v) && (o->raster = (int)v, true);
-    case OPT_THRESHOLD: return cli_int(CMD, "--threshold", optarg, 0, 10, &v) && (o->def.threshold = (int)v, true);
+    case 'o': o->output = arg; return true;
+    case OPT_TEXT: return add_text(o, arg);
+    case OPT_FONT: o->text_def.font = arg; return true;
+    case OPT_FIT: return cli_double(CMD, "--fit", arg, 1e-3, 1, &o->text_def.fit);
+    case OPT_HEIGHT: return cli_double(CMD, "--text-height", arg, 1e-6, 1e3, &o->text_def.height);
+    case OPT_SPACING: return cli_double(CMD, "--line-spacing", arg, 1, 4, &o->text_def.line_spacing);
+    case OPT_IMAGE: o->image = arg; return true;
+    case OPT_RASTER: return cli_int(CMD, "--raster", arg, 16, 8192, &v) && (o->raster = (int)v, true);
+    case OPT_THRESHOLD: return cli_int(CMD, "--threshold", arg, 0, 10, &v) && (o->def.threshold = (int)v, true);
     case OPT_EMPHASIS:
-        if (spn_emphasis_parse(optarg, &o->def.emphasis) == SPN_OK) return true;
+        if (spn_emphasis_parse(arg, &o->def.emphasis) == SPN_OK) return true;
         cli_usage(CMD, "--emphasis: %s", spn_last_error());
         return false;
-    case OPT_FILL: return cli_double(CMD, "--fill-spacing", optarg, 1e-6, 10, &o->def.fill_spacing);
-    case OPT_GAPS: return cli_int(CMD, "--gaps", optarg, 0, 100000000, &v) && (o->def.gaps = (int)v, true);
-    case OPT_SEED: return cli_u64(CMD, "--seed", optarg, &o->def.seed);
-    case OPT_SOLVER: o->solver = optarg; return true;
-    case OPT_DT: return cli_double(CMD, "--dt", optarg, 1e-9, 1, &o->def.settle_def.dt);
-    case OPT_TOL: return cli_double(CMD, "--tol", optarg, 0, 1e6, &o->def.settle_def.max_residual);
-    case OPT_MAX_TIME: return cli_double(CMD, "--max-time", optarg, 1e-9, 1e7, &o->def.settle_def.max_time);
+    case OPT_FILL: return cli_double(CMD, "--fill-spacing", arg, 1e-6, 10, &o->def.fill_spacing);
+    case OPT_GAPS: return cli_int(CMD, "--gaps", arg, 0, 100000000, &v) && (o->def.gaps = (int)v, true);
+    case OPT_SEED: return cli_u64(CMD, "--seed", arg, &o->def.seed);
+    case OPT_SOLVER: o->solver = arg; return true;
+    case OPT_DT: return cli_double(CMD, "--dt", arg, 1e-9, 1, &o->def.settle_def.dt);
+    case OPT_TOL: return cli_double(CMD, "--tol", arg, 0, 1e6, &o->def.settle_def.max_residual);
+    case OPT_MAX_TIME: return cli_double(CMD, "--max-time", arg, 1e-9, 1e7, &o->def.settle_def.max_time);
     case OPT_NO_SETTLE: o->def.settle = false; return true;
-    case OPT_RENDER: o->render = optarg; return true;
-    case OPT_OVERLAY: o->overlay = optarg; return true;
+    case OPT_RENDER: o->render = arg; return true;
+    case OPT_OVERLAY: o->overlay = arg; return true;
     default: return false;
     }
 }
+
+static int parse_one(int c, const char *arg, void *o) { return take_option(c, arg, o) ? 1 : -1; }
 
 /* Fills `o` from argv; returns -1 to go on, else the exit code. */
 static int parse_options(int argc, char **argv, inscribe_options *o)
@@ -120,13 +122,8 @@ static int parse_options(int argc, char **argv, inscribe_options *o)
         {"max-time", required_argument, NULL, OPT_MAX_TIME}, {"no-settle", no_argument, NULL, OPT_NO_SETTLE},
         {"render", required_argument, NULL, OPT_RENDER}, {"overlay", required_argument, NULL, OPT_OVERLAY},
         {"help", no_argument, NULL, 'h'}, {NULL, 0, NULL, 0}};
-    opterr = 0;
-    for (int c; (c = getopt_long(argc, argv, ":o:h", options, NULL)) != -1;) {
-        if (c == 'h') return usage(stdout), 0;
-        if (c == ':') return cli_usage(CMD, "%s: missing value", argv[optind - 1]);
-        if (c == '?') return cli_usage(CMD, "unknown option '%s'", argv[optind - 1]);
-        if (!parse_one(c, o)) return CLI_EXIT_USAGE;
-    }
+    int r = cli_parse_options(CMD, argc, argv, ":o:h", options, usage, parse_one, o);
+    if (r >= 0) return r;
     if (optind >= argc) return cli_usage(CMD, "missing WEB (the web file to inscribe)");
     if (optind + 1 < argc) return cli_usage(CMD, "unexpected argument '%s'", argv[optind + 1]);
     o->input = argv[optind];

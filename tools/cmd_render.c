@@ -38,6 +38,18 @@ typedef struct cmd_options {
 
 enum { OPT_TURNTABLE = 400, OPT_FPS, OPT_QUIET };
 
+static int parse_one(int c, const char *arg, void *ctx)
+{
+    cmd_options *o = ctx;
+    switch (c) {
+    case 'o': o->out = arg; return 1;
+    case OPT_TURNTABLE: return cli_int(CMD, "--turntable", arg, 1, 100000, &o->turntable) ? 1 : -1;
+    case OPT_FPS: return cli_double(CMD, "--fps", arg, 1, 120, &o->fps) ? 1 : -1;
+    case OPT_QUIET: o->quiet = true; return 1;
+    default: return render_options_parse(CMD, c, arg, &o->ro);
+    }
+}
+
 static int check_output(const cmd_options *o)
 {
     if (!o->out || !*o->out) return cli_usage(CMD, "-o/--output: the output picture is required");
@@ -61,19 +73,8 @@ static int parse(int argc, char **argv, cmd_options *o)
                                             {"help", no_argument, NULL, 'h'},
                                             RENDER_LONG_OPTIONS,
                                             {NULL, 0, NULL, 0}};
-    opterr = 0;
-    for (int c; (c = getopt_long(argc, argv, ":o:h", options, NULL)) != -1;) {
-        bool ok = true;
-        if (c == 'o') o->out = optarg;
-        else if (c == 'h') return usage(stdout), 0;
-        else if (c == ':') return cli_usage(CMD, "%s: missing value", argv[optind - 1]);
-        else if (c == '?') return cli_usage(CMD, "unknown option '%s'", argv[optind - 1]);
-        else if (c == OPT_TURNTABLE) ok = cli_int(CMD, "--turntable", optarg, 1, 100000, &o->turntable);
-        else if (c == OPT_FPS) ok = cli_double(CMD, "--fps", optarg, 1, 120, &o->fps);
-        else if (c == OPT_QUIET) o->quiet = true;
-        else ok = render_options_parse(CMD, c, optarg, &o->ro) > 0;
-        if (!ok) return CLI_EXIT_USAGE;
-    }
+    int r = cli_parse_options(CMD, argc, argv, ":o:h", options, usage, parse_one, o);
+    if (r >= 0) return r;
     if (optind >= argc) return cli_usage(CMD, "missing FILE");
     if (optind + 1 < argc) return cli_usage(CMD, "unexpected argument '%s'", argv[optind + 1]);
     o->in = argv[optind];

@@ -47,11 +47,42 @@ typedef struct settle_options {
     spn_equilibrium_def eq;
 } settle_options;
 
+enum { OPT_SOLVER = 256, OPT_DT, OPT_TOL, OPT_MAX_TIME, OPT_MAX_KINETIC, OPT_METHOD, OPT_REL_TOL, OPT_LOAD, OPT_PRECOND };
+
+/* One option (cli_option_fn). */
+static int parse_one(int c, const char *arg, void *ctx)
+{
+    settle_options *o = ctx;
+    bool ok = true;
+    switch (c) {
+    case 'o': o->output = arg; break;
+    case OPT_SOLVER: o->solver = arg; break;
+    case OPT_DT: ok = cli_double(CMD, "--dt", arg, 1e-9, 1, &o->def.dt); break;
+    case OPT_TOL:
+        ok = cli_double(CMD, "--tol", arg, 0, 1e6, &o->def.max_residual);
+        o->tol_given = true;
+        break;
+    case OPT_MAX_TIME: ok = cli_double(CMD, "--max-time", arg, 1e-9, 1e7, &o->def.max_time); break;
+    case OPT_MAX_KINETIC: ok = cli_double(CMD, "--max-kinetic", arg, 0, 1e6, &o->def.max_kinetic); break;
+    case OPT_METHOD:
+        if (strcmp(arg, "equilibrium") == 0 || strcmp(arg, "static") == 0) o->equilibrium = true;
+        else if (strcmp(arg, "dynamic") == 0) o->equilibrium = false;
+        else return cli_usage(CMD, "--method: '%s' is not dynamic or equilibrium", arg), -1;
+        break;
+    case OPT_REL_TOL: ok = cli_double(CMD, "--rel-tol", arg, 0, 1, &o->eq.tolerance); break;
+    case OPT_LOAD: ok = cli_vec3_bounded(CMD, "--load", arg, CLI_MAX_FORCE, &o->eq.load); break;
+    case OPT_PRECOND:
+        if (spn_precond_parse(arg, &o->eq.preconditioner) != SPN_OK)
+            return cli_usage(CMD, "--preconditioner: %s", spn_last_error()), -1;
+        break;
+    default: return 0;
+    }
+    return ok ? 1 : -1;
+}
+
 /* Fills `o` from argv; returns -1 to go on, else the exit code. */
 static int parse_options(int argc, char **argv, settle_options *o)
 {
-    enum { OPT_SOLVER = 256, OPT_DT, OPT_TOL, OPT_MAX_TIME, OPT_MAX_KINETIC, OPT_METHOD, OPT_REL_TOL, OPT_LOAD,
-           OPT_PRECOND };
     static const struct option options[] = {{"output", required_argument, NULL, 'o'},
                                             {"solver", required_argument, NULL, OPT_SOLVER},
                                             {"dt", required_argument, NULL, OPT_DT},
@@ -64,36 +95,8 @@ static int parse_options(int argc, char **argv, settle_options *o)
                                             {"preconditioner", required_argument, NULL, OPT_PRECOND},
                                             {"help", no_argument, NULL, 'h'},
                                             {NULL, 0, NULL, 0}};
-    opterr = 0;
-    for (int c; (c = getopt_long(argc, argv, ":o:h", options, NULL)) != -1;) {
-        bool ok = true;
-        switch (c) {
-        case 'o': o->output = optarg; break;
-        case OPT_SOLVER: o->solver = optarg; break;
-        case OPT_DT: ok = cli_double(CMD, "--dt", optarg, 1e-9, 1, &o->def.dt); break;
-        case OPT_TOL:
-            ok = cli_double(CMD, "--tol", optarg, 0, 1e6, &o->def.max_residual);
-            o->tol_given = true;
-            break;
-        case OPT_MAX_TIME: ok = cli_double(CMD, "--max-time", optarg, 1e-9, 1e7, &o->def.max_time); break;
-        case OPT_MAX_KINETIC: ok = cli_double(CMD, "--max-kinetic", optarg, 0, 1e6, &o->def.max_kinetic); break;
-        case OPT_METHOD:
-            if (strcmp(optarg, "equilibrium") == 0 || strcmp(optarg, "static") == 0) o->equilibrium = true;
-            else if (strcmp(optarg, "dynamic") == 0) o->equilibrium = false;
-            else return cli_usage(CMD, "--method: '%s' is not dynamic or equilibrium", optarg);
-            break;
-        case OPT_REL_TOL: ok = cli_double(CMD, "--rel-tol", optarg, 0, 1, &o->eq.tolerance); break;
-        case OPT_LOAD: ok = cli_vec3_bounded(CMD, "--load", optarg, CLI_MAX_FORCE, &o->eq.load); break;
-        case OPT_PRECOND:
-            if (spn_precond_parse(optarg, &o->eq.preconditioner) != SPN_OK)
-                return cli_usage(CMD, "--preconditioner: %s", spn_last_error());
-            break;
-        case 'h': usage(stdout); return 0;
-        case ':': return cli_usage(CMD, "%s: missing value", argv[optind - 1]);
-        default: return cli_usage(CMD, "unknown option '%s'", argv[optind - 1]);
-        }
-        if (!ok) return CLI_EXIT_USAGE;
-    }
+    int r = cli_parse_options(CMD, argc, argv, ":o:h", options, usage, parse_one, o);
+    if (r >= 0) return r;
     if (optind >= argc) return cli_usage(CMD, "missing FILE");
     if (optind + 1 < argc) return cli_usage(CMD, "unexpected argument '%s'", argv[optind + 1]);
     o->input = argv[optind];

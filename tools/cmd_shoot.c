@@ -120,11 +120,27 @@ static int parse_other(int c, const char *arg, shoot_options *o)
     case OPT_PHASES:
         if (strcmp(arg, "thwip") == 0) o->def.all_phases = false;
         else if (strcmp(arg, "all") == 0) o->def.all_phases = true;
-        else return cli_usage(CMD, "--phases: expected thwip or all, got '%s'", arg);
+        else return cli_usage(CMD, "--phases: expected thwip or all, got '%s'", arg), -1;
         break;
-    default: return -2;
+    default: return 0;
     }
-    return ok ? -1 : CLI_EXIT_USAGE;
+    return ok ? 1 : -1;
+}
+
+typedef struct shoot_parse {
+    shoot_options *o;
+    const num_opt *t;
+} shoot_parse;
+
+/* One option (cli_option_fn): a number from the table, or one of the others. */
+static int parse_one(int c, const char *arg, void *ctx)
+{
+    shoot_parse *p = ctx;
+    if (c < OPT_NUM || c >= OPT_NUM + NUM_OPTS) return parse_other(c, arg, p->o);
+    const num_opt *n = &p->t[c - OPT_NUM];
+    char name[40];
+    snprintf(name, sizeof name, "--%s", n->name);
+    return cli_double(CMD, name, arg, n->lo, n->hi, n->field) ? 1 : -1;
 }
 
 /* Fills `o` from argv; returns -1 to go on, else the exit code. */
@@ -144,24 +160,9 @@ static int parse_options(int argc, char **argv, shoot_options *o)
     int k = 14;
     for (int i = 0; t[i].name; i++) options[k++] = (struct option){t[i].name, required_argument, NULL, OPT_NUM + i};
     options[k] = (struct option){NULL, 0, NULL, 0};
-    opterr = 0;
-    for (int c; (c = getopt_long(argc, argv, ":o:h", options, NULL)) != -1;) {
-        if (c == 'h') {
-            usage(stdout);
-            return 0;
-        }
-        if (c == ':') return cli_usage(CMD, "%s: missing value", argv[optind - 1]);
-        if (c >= OPT_NUM && c < OPT_NUM + NUM_OPTS) {
-            const num_opt *n = &t[c - OPT_NUM];
-            char name[40];
-            snprintf(name, sizeof name, "--%s", n->name);
-            if (!cli_double(CMD, name, optarg, n->lo, n->hi, n->field)) return CLI_EXIT_USAGE;
-            continue;
-        }
-        int r = parse_other(c, optarg, o);
-        if (r == -2) return cli_usage(CMD, "unknown option '%s'", argv[optind - 1]);
-        if (r != -1) return r;
-    }
+    shoot_parse p = {o, t};
+    int r = cli_parse_options(CMD, argc, argv, ":o:h", options, usage, parse_one, &p);
+    if (r >= 0) return r;
     if (optind < argc) return cli_usage(CMD, "unexpected argument '%s'", argv[optind]);
     if (!o->have_from) return cli_usage(CMD, "--from: the hand position is required");
     if (!o->have_to) return cli_usage(CMD, "--to: the target position is required");

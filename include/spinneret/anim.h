@@ -111,8 +111,10 @@ SPN_API double spn_thread_yield_strain(uint32_t tag);
 /// Denny 1976); 0 for kinds that are not silk.
 SPN_API double spn_thread_hysteresis(uint32_t tag);
 /// Strain rate [1/s] above which the hysteresis is rate-independent (below
-/// it, a dashpot; see spn_world_set_tag_hysteresis).
-#define SPN_HYSTERESIS_RATE 0.1
+/// it, a dashpot; see spn_world_set_tag_hysteresis). A strike strains the
+/// frame and anchors at 0.01-1 /s (docs/wind-and-prey.md): at 0.1 the law
+/// was half a dashpot there and the web gave back 50% instead of 35%.
+#define SPN_HYSTERESIS_RATE 1e-3
 
 /* ---- prey ---------------------------------------------------------------- */
 
@@ -143,6 +145,9 @@ typedef struct spn_impact_def {
                                ///< Hendricks 2009); 0: one droplet per segment
     bool hysteresis;           ///< silk threads dissipate spn_thread_hysteresis of each loading cycle, default
                                ///< true (with the implicit solver; explicit steps go without)
+    double glue_outline;       ///< the prey's sticky outline (legs, wings) as a multiple of its radius: once
+                               ///< it has touched the web, capture thread within this distance of its centre
+                               ///< glues to it; default 2.5 (a 4 mm body spans 2 cm); 1: the sphere only
 } spn_impact_def;
 
 SPN_API spn_impact_def spn_impact_def_default(void);
@@ -159,9 +164,10 @@ typedef struct spn_kind_energy {
 
 typedef enum spn_prey_outcome {
     SPN_PREY_MISSED = 0,   ///< never touched a thread
-    SPN_PREY_STOPPED,      ///< held by the web
+    SPN_PREY_STOPPED,      ///< arrested by the web, no longer touching it
     SPN_PREY_PASSED,       ///< went through the web
-    SPN_PREY_BOUNCED       ///< thrown back
+    SPN_PREY_BOUNCED,      ///< thrown back
+    SPN_PREY_HELD          ///< stopped and still in contact with the web (touching it or glued)
 } spn_prey_outcome;
 
 SPN_API const char *spn_prey_outcome_name(spn_prey_outcome outcome);
@@ -181,6 +187,7 @@ typedef struct spn_impact_report {
     double solver;                ///< dissipated by the implicit solver itself (backward Euler) [J]
     double glue;                  ///< lost when glue droplets let go [J]
     int glue_held;                ///< droplets holding prey at the end
+    double glue_strength_held;    ///< their strengths summed: the most the glue can hold the prey with [N]
     double contact_energy;        ///< penalty energy stored in contacts now [J]
     double web_kinetic;           ///< kinetic energy of the web now (still swinging) [J]
     double balance_error;         ///< |total_now + dissipated + broken - air - wind - total_start| [J]

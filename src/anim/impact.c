@@ -13,6 +13,13 @@
  * Breakage: each thread kind breaks at its strain (web_util.c); the world
  * does the breaking (break_max) and tells us through its break callback.
  *
+ * Glue: once a prey has touched the web, capture thread within its sticky
+ * outline (legs, wings: glue_outline radii) is tethered to it, with a
+ * strength of the adhesion per length of thread in the outline (Opell &
+ * Hendricks 2009); a tether pulled past it lets go and its stretch energy is
+ * the ledger's glue term. Tethers are what hold a caught prey (glue_segment,
+ * spn__impact_glue_update; docs/wind-and-prey.md, "Capture").
+ *
  * The energy ledger (spn_impact_after_step) follows what becomes of the prey's
  * kinetic energy: elastic energy per thread kind, dissipation by the springs'
  * damping per kind (kd (l' . l/|l|)^2 integrated by the trapezoid rule over
@@ -44,13 +51,14 @@ spn_impact_def spn_impact_def_default(void)
     d.glue_strength = 4e-5;
     d.glue_adhesion = 0.05;
     d.hysteresis = true;
+    d.glue_outline = 2.5;
     return d;
 }
 
 const char *spn_prey_outcome_name(spn_prey_outcome outcome)
 {
-    static const char *const names[] = {"missed", "stopped", "passed_through", "bounced"};
-    return (unsigned)outcome < 4 ? names[outcome] : "unknown";
+    static const char *const names[] = {"missed", "stopped", "passed_through", "bounced", "held"};
+    return (unsigned)outcome < 5 ? names[outcome] : "unknown";
 }
 
 double spn_impact_contact_stiffness(const spn_impact *impact) { return impact->kc; }
@@ -194,6 +202,9 @@ spn_status spn_impact_create(spn_world **w, const spn_prey_def *prey, int nprey,
     if (!(im->def.breaking_scale > 0) || !(im->def.contact_stiffness >= 0) || !(im->def.glue_strength >= 0) ||
         !(im->def.glue_adhesion >= 0))
         st = spn_error(SPN_ERR_INVALID, "impact: breaking scale must be > 0, contact stiffness and glue >= 0");
+    else if (!(im->def.glue_outline >= 1 && im->def.glue_outline <= 100))
+        st = spn_error(SPN_ERR_INVALID, "impact: glue outline must be in [1, 100] prey radii, got %g",
+                       im->def.glue_outline);
     if (st == SPN_OK && im->def.breakage) {
         spn_world *copy = NULL;
         st = spn__world_with_breaks(*w, im->def.breaking_scale, &copy);
@@ -345,43 +356,41 @@ static double chord(const spn_impact *im, uint32_t s, const spn_vec3 *x, spn_vec
     return t1 > t0 ? (t1 - t0) * sqrt(A) : 0;
 }
 
-/* A segment inside prey p: glue it there, or, if it is glued already, wet
- * the droplets it now touches too (adhesive recruitment, Opell & Hendricks
- * 2009). The glue grows and moves to the closest point only while the thread
- * is inside the sphere, where the tether (rest >= R) is slack: that changes
- * no energy. */
-static void glue_segment(spn_impact *im, int p, uint32_t s, const spn_vec3 *x, double u)
+/* Capture segment s within prey p's sticky outline (radius Ro = glue_outline
+ * R: legs and wings): glue it, or let an existing glue grow. A tether pulls
+ * the prey's centre towards the thread once it is longer than its rest; the
+ * rest is the closest the thread has come (never under R: the body's contact
+ * holds it there), so the glue holds the prey where the strike left it. Its
+ * strength is the adhesion over the length of thread inside the outline
+ * (adhesive recruitment, Opell & Hendricks 2009), at least one droplet's.
+ * Anchor, rest and strength change only while the tether is slack and leave
+ * it slack: that costs no energy. */
+static void glue_segment(spn_impact *im, int p, uint32_t s, const spn_vec3 *x, double u, double d)
 {
-    double R = im->radius[p];
-    double strength = fmax(im->def.glue_strength, im->def.glue_adhesion * chord(im, s, x, x[im->prey[p]], R));
+    const double R = im->radius[p], Ro = R * im->def.glue_outline;
+    double strength = fmax(im->def.glue_strength, im->def.glue_adhesion * chord(im, s, x, x[im->prey[p]], Ro));
     spn__tether *t = find_tether(im, p, s);
     if (!t) {
         if (im->ntethers == MAX_TETHERS) return;
         t = &im->tethers[im->ntethers++];
-        *t = (spn__tether){p, s, u, R, 0, 0, false};
+        *t = (spn__tether){p, s, u, fmax(R, d), strength, strength / SPN_GLUE_STRETCH, -1};
+        return;
     }
-    if (strength <= t->strength) return;
-    /* the droplets where it held let go of whatever they still held */
-    double before = tether_force(im, t, x, NULL);
-    t->u = u;
-    t->strength = strength;
-    t->k = strength / SPN_GLUE_STRETCH;
-    im->glue_lost += before - tether_force(im, t, x, NULL);
+    if (tether_force(im, t, x, NULL) > 0) return; /* taut: its droplets hold where they are */
+    if (d < t->rest) {
+        t->u = u;
+        t->rest = fmax(R, d);
+    }
+    if (strength > t->strength) {
+        t->strength = strength;
+        t->k = strength / SPN_GLUE_STRETCH;
+    }
 }
 
 void spn__impact_glue_update(spn_impact *im, const spn_world *w)
 {
     if (!(im->def.glue_strength > 0) && !(im->def.glue_adhesion > 0)) return;
     const spn_vec3 *x = spn_world_positions(w);
-    /* A slack droplet was not in the implicit step (it had no force): what it
-     * stretched over the step without pulling is slack taken up, not energy. */
-    for (int i = 0; i < im->ntethers && im->offsets; i++) {
-        spn__tether *t = &im->tethers[i];
-        if (t->listed) continue;
-        uint32_t a = im->sa[t->s], b = im->sb[t->s];
-        spn_vec3 q = spn_v3_add(x[a], spn_v3_scale(spn_v3_sub(x[b], x[a]), t->u));
-        t->rest = fmax(t->rest, spn_v3_len(spn_v3_sub(x[im->prey[t->prey]], q)));
-    }
     /* Droplets that let go: pulled past their strength, or on a broken thread. */
     for (int i = 0; i < im->ntethers;) {
         double e = tether_force(im, &im->tethers[i], x, NULL);
@@ -394,15 +403,18 @@ void spn__impact_glue_update(spn_impact *im, const spn_world *w)
             i++;
         }
     }
-    /* Glue where a prey touches capture thread. */
-    for (int p = 0; p < im->nprey; p++)
+    /* Glue where a prey that has touched the web reaches capture thread. */
+    for (int p = 0; p < im->nprey; p++) {
+        if (!im->touched[p]) continue;
+        const double Ro = im->radius[p] * im->def.glue_outline;
         for (uint32_t s = 0; s < im->ns; s++) {
             if (im->broken[s] || !sticky(im->tag[s])) continue;
             double u;
             spn_vec3 r;
-            if (spn__impact_closest(im, s, x, x[im->prey[p]], &u, &r) >= im->radius[p] * im->radius[p]) continue;
-            glue_segment(im, p, s, x, u);
+            double d2 = spn__impact_closest(im, s, x, x[im->prey[p]], &u, &r);
+            if (d2 < Ro * Ro) glue_segment(im, p, s, x, u, sqrt(d2));
         }
+    }
 }
 
 /* A flying insect's lift balances its weight until it is caught. */

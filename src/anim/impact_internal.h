@@ -9,14 +9,14 @@
 
 /* The glue holding prey p to segment s, attached at point u: tension-only,
  * rest length `rest` from the prey's centre. It stands for all the droplets
- * of the segment's length that touched the prey. */
+ * of the segment's length within the prey's sticky outline (impact.c). */
 typedef struct spn__tether {
     int prey;
     uint32_t s;
     double u, rest;
     double strength; /* it lets go past this pull [N]: glue over its contact length */
     double k;        /* strength / SPN_GLUE_STRETCH [N/m] */
-    bool listed; /* handed to the implicit solver for the step just taken */
+    int slot;    /* its index in the implicit solver's contact list of the step just taken; -1: not in it */
 } spn__tether;
 
 #define MAX_PREY 8

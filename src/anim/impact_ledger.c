@@ -167,16 +167,19 @@ static void check_strike(spn_impact *im, spn_world *w)
     spn_impact_report_get(im, w, &im->strike);
 }
 
+/* Held: a thread inside the prey's sphere or a glue droplet on it. */
 static spn_prey_outcome outcome(const spn_impact *im, const spn_world *w, int p)
 {
     if (!im->touched[p]) return SPN_PREY_MISSED;
     spn_vec3 c = spn_world_position(w, im->prey[p]), n = im->dir0[p];
     double R = im->radius[p], lo = INFINITY, hi = -INFINITY;
+    for (int i = 0; i < im->ntethers; i++)
+        if (im->tethers[i].prey == p) return SPN_PREY_HELD;
     for (uint32_t s = 0; s < im->ns; s++) {
         if (im->broken[s]) continue;
         double u;
         spn_vec3 r;
-        if (spn__impact_closest(im, s, spn_world_positions(w), c, &u, &r) < R * R) return SPN_PREY_STOPPED;
+        if (spn__impact_closest(im, s, spn_world_positions(w), c, &u, &r) < R * R) return SPN_PREY_HELD;
     }
     for (uint32_t i = 0; i < im->np; i++) {
         if (spn_world_particle_tag(w, i) == SPN_PARTICLE_PREY) continue;
@@ -213,6 +216,7 @@ void spn_impact_report_get(spn_impact *im, const spn_world *w, spn_impact_report
     r->nkinds = im->nkinds;
     r->glue = im->glue_lost;
     r->glue_held = im->ntethers;
+    for (int i = 0; i < im->ntethers; i++) r->glue_strength_held += im->tethers[i].strength;
     r->solver = im->solver;
     double lost = im->viscous + im->glue_lost + im->solver;
     for (int i = 0; i < im->nkinds; i++) {

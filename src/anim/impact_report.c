@@ -63,11 +63,11 @@ spn_status spn_impact_report_write(const spn_impact_report *r, spn_sink *s)
         st = spn_sink_printf(s,
                              "  \"energy\": {\"prey_kinetic_start\": %.9g, \"prey_kinetic_end\": %.9g, "
                              "\"prey_kinetic_lost\": %.9g,\n    \"air_drag\": %.9g, \"air_drag_fraction\": %.6f, "
-                             "\"web_kinetic\": %.9g, \"viscous\": %.9g, \"solver\": %.9g, \"glue\": %.9g, \"glue_droplets_holding\": %d, \"wind_work\": %.9g, \"contact\": %.9g,\n"
+                             "\"web_kinetic\": %.9g, \"viscous\": %.9g, \"solver\": %.9g, \"glue\": %.9g, \"glue_droplets_holding\": %d, \"glue_strength_holding\": %.6g, \"wind_work\": %.9g, \"contact\": %.9g,\n"
                              "    \"total_start\": %.9g, \"total_end\": %.9g, \"balance_error\": %.9g, "
                              "\"balance_error_relative\": %.6g},\n",
                              r->prey_kinetic_start, r->prey_kinetic_end, lost, air, lost > 0 ? air / lost : 0,
-                             r->web_kinetic, r->viscous, r->solver, r->glue, r->glue_held, r->wind_work, r->contact_energy, r->total_start, r->total_now,
+                             r->web_kinetic, r->viscous, r->solver, r->glue, r->glue_held, r->glue_strength_held, r->wind_work, r->contact_energy, r->total_start, r->total_now,
                              r->balance_error, r->prey_kinetic_start > 0 ? r->balance_error / r->prey_kinetic_start : 0);
     if (st == SPN_OK) st = write_kinds(r, s, lost);
     if (st == SPN_OK) st = write_strike(r, s);

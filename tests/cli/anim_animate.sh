@@ -3,12 +3,8 @@
 # the impact report reads as JSON with the outcome, bad options are refused
 # with the option named and nothing written, and an interrupt keeps finished
 # frames and leaves no partial video.
-set -u
-SPN=$1
+. "$(dirname "$0")/lib/common.sh" "$@"
 WEB=$SPN_TEST_DATA/anim/orb.json
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
 
 common=(--wind thesis --thesis-gain 300 --duration 1 --fps 10 --size 160x160 --quiet --camera persp --eye 0.3,0.15,0.35)
 "$SPN" animate "$WEB" -o "$T/whole" "${common[@]}" || fail "whole run"
@@ -34,7 +30,7 @@ cmp -s "$T/whole/frame_00000.png" "$T/whole/frame_00008.png" && fail "the wind d
 python3 - "$T/r.json" <<'PY' || fail "report"
 import json, sys
 r = json.load(open(sys.argv[1]))
-assert r["prey"][0]["outcome"] in ("stopped", "passed_through", "bounced"), r["prey"]
+assert r["prey"][0]["outcome"] in ("held", "stopped", "passed_through", "bounced"), r["prey"]
 assert r["energy"]["balance_error_relative"] < 0.02, r["energy"]
 assert "radius" in r["threads"], r["threads"]
 PY
@@ -50,6 +46,7 @@ expect 2 "--fps" "$WEB" -o "$T/bad1" --fps 0
 expect 2 "--wind" "$WEB" -o "$T/bad2" --wind storm
 expect 2 "--impact" "$WEB" -o "$T/bad3" --impact "1,2;3"
 expect 2 "--impact" "$WEB" -o "$T/bad3" --impact "0,0,0.01;0,0,-1;-1;0.01"
+expect 2 "--glue-outline" "$WEB" -o "$T/bad3" --glue-outline 0.5
 expect 2 "--frame-range" "$WEB" -o "$T/bad4" --frame-range 5-2
 expect 2 "--report" "$WEB" -o "$T/bad5" --report "$T/r2.json"
 expect 2 "missing -o" "$WEB"

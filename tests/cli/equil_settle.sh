@@ -3,12 +3,7 @@
 # is statically balanced (checked here from the written positions) and agrees
 # with the dynamic settle; a load moves it; bad options exit 2 naming the
 # option and write nothing.
-set -u
-SPN=$1
-DATA=${SPN_TEST_DATA:?}
-fail() { echo "FAIL: $*"; exit 1; }
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
+. "$(dirname "$0")/lib/common.sh" "$@"
 WEB=$DATA/io/chain4.json
 
 "$SPN" settle "$WEB" -o "$T/static.json" --method equilibrium --rel-tol 1e-10 2>"$T/err" \

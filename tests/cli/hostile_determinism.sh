@@ -3,11 +3,7 @@
 # (32768 particles, so 2 threads really split the loops) with 1 and 2 OpenMP
 # threads; the written web files are byte-identical. (Across builds and
 # solvers: scripts/determinism.sh, `make determinism`.)
-set -u
-SPN=$1
-fail() { echo "FAIL: $*"; exit 1; }
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
+. "$(dirname "$0")/lib/common.sh" "$@"
 "$SPN" export scene:orb:190x180 -o "$T/web.json" || fail "export failed"
 for solver in symplectic rk4; do
   for threads in 1 2; do

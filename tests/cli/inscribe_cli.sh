@@ -3,13 +3,8 @@
 # inscribed (web file, render and overlay written, fewer capture threads,
 # inscription threads added), and every bad input refused with a one-line
 # message, a non-zero exit and no output file.
-set -u
-SPN=$1
-DATA=$SPN_TEST_DATA
+. "$(dirname "$0")/lib/common.sh" "$@"
 WEB=$DATA/inscribe/orb.json
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
 SETTLE=(--solver implicit --dt 1e-3 --max-time 5)
 
 count_kind() { # file kind-number: springs carrying that tag

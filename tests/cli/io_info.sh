@@ -1,12 +1,7 @@
 #!/usr/bin/env bash
 # spinneret info: the numbers of a hand-made chain (tests/data/io/chain4.json)
 # against values worked out by hand, the --json output, and bad invocations.
-set -u
-SPN=$1
-DATA=${SPN_TEST_DATA:?}
-fail() { echo "FAIL: $*"; exit 1; }
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
+. "$(dirname "$0")/lib/common.sh" "$@"
 WEB=$DATA/io/chain4.json
 
 "$SPN" info "$WEB" >"$T/out" 2>"$T/err" || fail "info exited $?: $(cat "$T/err")"

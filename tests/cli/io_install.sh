@@ -2,13 +2,9 @@
 # `make install` works for users: install the build tree into a temporary
 # prefix, then build and run a small program against the installed library
 # twice, once through pkg-config and once through CMake's find_package.
-set -u
-SPN=$1
-fail() { echo "FAIL: $*"; exit 1; }
+. "$(dirname "$0")/lib/common.sh" "$@"
 BUILD=$(cd "$(dirname "$SPN")" && pwd)
 [ -f "$BUILD/cmake_install.cmake" ] || fail "$BUILD is not a CMake build folder"
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
 PREFIX=$T/prefix
 
 cmake --install "$BUILD" --prefix "$PREFIX" >"$T/install.log" 2>&1 || fail "cmake --install: $(tail -5 "$T/install.log")"

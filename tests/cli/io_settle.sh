@@ -2,12 +2,7 @@
 # spinneret settle: the hand-made chain settles to a statically balanced,
 # symmetric sag; bad options exit 2 naming the option and write nothing; a
 # blow-up exits 1 and clobbers nothing.
-set -u
-SPN=$1
-DATA=${SPN_TEST_DATA:?}
-fail() { echo "FAIL: $*"; exit 1; }
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
+. "$(dirname "$0")/lib/common.sh" "$@"
 WEB=$DATA/io/chain4.json
 
 "$SPN" settle "$WEB" -o "$T/settled.json" 2>"$T/err" || fail "settle exited $?: $(cat "$T/err")"

@@ -3,12 +3,7 @@
 # sign (tests/data/render/cross.json) where the strokes are and nowhere else,
 # alpha 0.7 over white, a background image showing through, the same pixels
 # twice, every exporter's file, and bad options refused with exit 2 and no file.
-set -u
-SPN=$1
-DATA=${SPN_TEST_DATA:?}
-fail() { echo "FAIL: $*"; exit 1; }
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
+. "$(dirname "$0")/lib/common.sh" "$@"
 CROSS=$DATA/render/cross.json
 
 # A PNG reader and writer small enough to trust (zlib + the five row filters).

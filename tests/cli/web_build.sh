@@ -2,11 +2,7 @@
 # spinneret build: species and methods write web files that info reads back
 # with web measures; the same seed gives the same file; bad anchors and
 # out-of-range options fail with a message naming them and leave no file.
-set -u
-SPN=$1
-fail() { echo "FAIL: $*"; exit 1; }
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
+. "$(dirname "$0")/lib/common.sh" "$@"
 
 "$SPN" build --species zygiella --seed 4 -o "$T/a.json" || fail "species build"
 "$SPN" build --species zygiella --seed 4 -o "$T/b.json" || fail "species build again"
