@@ -5,9 +5,10 @@
 # air (3 m/s, gust 0.6, turbulence 0.3) on the implicit solver at steps of
 # 0.1 s (1 frame a second, 10 substeps, CG tolerance 1e-3), with two prey
 # of 0.05 g that strike at once and bounce off: 0.5 m/s downwind into the
-# billowing web from 16 and 26 mm upwind, 6 cm from the hub, where the glue
-# did not hold such a prey (a prey that stays on the web costs ~100x the
-# wind, docs/wind-and-prey.md, so these leave it);
+# billowing web from 16 and 26 mm upwind, 6 cm from the hub, with the glue
+# at its weakest (`--glue 0 --glue-outline 1`: no droplet minimum, only the
+# thread inside the body sticks), so both leave it; a prey held on the web
+# costs ~100x the wind (docs/wind-and-prey.md);
 # every frame's state saved, checked (no NaN; kinetic + elastic energy from
 # `info --json`: prey fly without gravity, so their height is no energy) and
 # deleted; the RSS of the process sampled every 10 s.
@@ -62,7 +63,7 @@ if "$S" animate --help >/dev/null 2>&1; then
   mode=animate
   mkdir -p "$T/states"
   "$S" animate "$T/web.json" -o "$T/frames" --duration "$duration" --fps 1 --size 320x320 --quiet --solver implicit --substeps 10 --solver-tol 1e-3 \
-    --wind air --wind-speed 3 --gust 0.6 --turbulence 0.3 --save-states "$T/states" \
+    --wind air --wind-speed 3 --gust 0.6 --turbulence 0.3 --save-states "$T/states" --glue 0 --glue-outline 1 \
     --impact '-0.03,0.05,0.02;0,0,-0.5;0.00005;0.004' --impact '0.03,0.05,0.03;0,0,-0.5;0.00005;0.004' \
     2>"$T/err" &
   pid=$!
