@@ -225,9 +225,10 @@ SPN_API void spn_impact_track_wind(spn_impact *impact, spn_force_fn fn, void *us
 /// Before every step of `dt`: with the implicit solver, hand the world the
 /// prey's contacts (spn_world_set_contacts) so it integrates them implicitly.
 SPN_API spn_status spn_impact_before_step(spn_impact *impact, spn_world *w, double dt);
-/// The step the prey need now [s]: at most a tenth of a radius of travel
-/// near the web, or 0.8 of the free flight to the web's bounding box; `dt`
-/// when that is shorter.
+/// The step the prey need now [s], `dt` at most: 3% of a radius of travel
+/// at the prey's speed while it touches a thread or is glued; for each thread
+/// closing in, max(3% of a radius, 0.8 of the gap) at the closing speed;
+/// no limit from threads it moves away from.
 SPN_API double spn_impact_step_limit(const spn_impact *impact, const spn_world *w, double dt);
 /// Update the energy ledger after a step of `dt` (call after every step).
 SPN_API void spn_impact_after_step(spn_impact *impact, spn_world *w, double dt);

@@ -7,9 +7,9 @@
  * Euler step carries the stiffness, so the prey and the 1e-10 kg thread
  * particles move together at the solver's step instead of the 1e-7 s an
  * explicit contact needs. A contact is found a step late, already some way
- * in (the prey moves at most a tenth of its radius per step, runner.c): the
- * depth it first has becomes the contact's offset, so the penalty does not
- * create k depth^2 / 2 from nothing (the sphere is that much smaller for that
+ * in (at most 3% of a radius: spn_impact_step_limit, below): the depth it
+ * first has becomes the contact's offset, so the penalty does not create
+ * k depth^2 / 2 from nothing (the sphere is that much smaller for that
  * thread; the offset shrinks as the thread comes back out).
  *
  * Backward Euler removes energy by itself: for a quadratic energy one step
@@ -229,31 +229,60 @@ double spn__impact_solver_loss(spn_impact *im, const spn_world *w)
     return loss + sl + cl;
 }
 
-/* Distance from c to the box [lo, hi] (0 inside). */
-static double box_distance(spn_vec3 c, spn_vec3 lo, spn_vec3 hi)
+/* The step schedule near prey (docs/wind-and-prey.md, "Contact step
+ * schedule"): how far a step may carry a prey among the threads it touches
+ * or nears.
+ *
+ * A contact's normal is frozen over a step while the thread slides over the
+ * curved sphere: at a tenth of a radius of travel per step that missed
+ * curvature made 13-18% of a slow strike's energy on the small Araneus web;
+ * at 3% it is 1%. So:
+ * - touching a thread (closer than R) or glued: 3% of R at the prey's own
+ *   speed. Not its speed relative to the threads: those it drags move with
+ *   it, the steps grew to the frame's substep while the strike still loaded
+ *   the web, and the slow strike's ledger missed 2-9% (at the turn-around,
+ *   where silk's hysteresis changes sign within a long step); nor a speed
+ *   that fades below a few cm/s (a prey carried by the swaying web): 1.5-2.7%.
+ *   The prey's own speed gives 0.02%;
+ * - each thread closing in: max(3% of R, 0.8 of its gap) at the closing
+ *   speed, so a contact is found at most 3% of a radius deep;
+ * - threads it moves away from: no limit. A prey that bounced off or went
+ *   through flies on at the frame's steps, even inside the web's box (the
+ *   box rule before kept its steps fine as long as it was near the web). */
+#define CONTACT_TRAVEL 0.03 /* of a radius, per step */
+#define GAP_FRACTION 0.8    /* of an approaching thread's gap, per step */
+
+static double prey_step(const spn_impact *im, const spn_vec3 *x, const spn_vec3 *v, int p, double dt)
 {
-    double dx = fmax(fmax(lo.x - c.x, c.x - hi.x), 0), dy = fmax(fmax(lo.y - c.y, c.y - hi.y), 0);
-    double dz = fmax(fmax(lo.z - c.z, c.z - hi.z), 0);
-    return sqrt(dx * dx + dy * dy + dz * dz);
+    const uint32_t ip = im->prey[p];
+    const spn_vec3 c = x[ip], vp = v[ip];
+    const double R = im->radius[p], fine = CONTACT_TRAVEL * R;
+    double limit = dt;
+    bool touching = false;
+    for (int i = 0; i < im->ntethers && !touching; i++) touching = im->tethers[i].prey == p;
+    for (uint32_t s = 0; s < im->ns; s++) {
+        if (im->broken[s]) continue;
+        double u;
+        spn_vec3 r;
+        double d2 = spn__impact_closest(im, s, x, c, &u, &r);
+        if (d2 <= 1e-30) continue; /* no normal: not a contact (list_segments) */
+        double d = sqrt(d2);
+        if (d < R) {
+            touching = true;
+            continue;
+        }
+        spn_vec3 vq = spn_v3_add(spn_v3_scale(v[im->sa[s]], 1 - u), spn_v3_scale(v[im->sb[s]], u));
+        double closing = -spn_v3_dot(spn_v3_sub(vp, vq), r) / d, reach = fmax(fine, GAP_FRACTION * (d - R));
+        if (closing * limit > reach) limit = reach / closing;
+    }
+    double speed = touching ? spn_v3_len(vp) : 0;
+    return speed * limit > fine ? fine / speed : limit;
 }
 
 double spn_impact_step_limit(const spn_impact *im, const spn_world *w, double dt)
 {
-    spn_vec3 lo, hi;
-    spn__web_bounds(w, &lo, &hi);
+    const spn_vec3 *x = spn_world_positions(w), *v = spn_world_velocities(w);
     double limit = dt;
-    for (int p = 0; p < im->nprey; p++) {
-        spn_vec3 c = spn_world_position(w, im->prey[p]);
-        double speed = spn_v3_len(spn_world_velocity(w, im->prey[p])), R = im->radius[p];
-        if (!(speed > 0)) continue;
-        /* 3% of a radius per step, or a free flight up to most of the way to
-         * the web's box, whichever is longer. The contact's normal is frozen
-         * over a step while thread particles slide over the curved sphere:
-         * at a tenth of a radius per step that missed curvature made up to
-         * 13-18% of a slow strike's energy on the small Araneus web; at 3%
-         * it is 1% (docs/wind-and-prey.md). */
-        double step = fmax(0.03 * R, 0.8 * (box_distance(c, lo, hi) - R)) / speed;
-        if (step < limit) limit = step;
-    }
+    for (int p = 0; p < im->nprey; p++) limit = fmin(limit, prey_step(im, x, v, p, limit));
     return limit;
 }
