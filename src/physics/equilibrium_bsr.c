@@ -7,6 +7,7 @@
 #include "equilibrium_bsr.h"
 #include "equilibrium_internal.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #ifdef _OPENMP
@@ -197,5 +198,35 @@ void spn__bsr_gauss_seidel(const spn__bsr *a, const double *dinv, const double *
             s[2] -= m[6] * v[0] + m[7] * v[1] + m[8] * v[2];
         }
         spn__sym_mul(dinv + 6 * (size_t)i, s, x + 3 * (size_t)i);
+    }
+}
+
+bool spn__dense_cholesky(double *f, size_t n)
+{
+    for (size_t k = 0; k < n; k++) {
+        double d = f[k * n + k];
+        for (size_t q = 0; q < k; q++) d -= f[k * n + q] * f[k * n + q];
+        if (!(d > 0)) return false;
+        d = sqrt(d);
+        f[k * n + k] = d;
+        for (size_t i = k + 1; i < n; i++) {
+            double s = f[i * n + k];
+            for (size_t q = 0; q < k; q++) s -= f[i * n + q] * f[k * n + q];
+            f[i * n + k] = s / d;
+        }
+    }
+    return true;
+}
+
+void spn__dense_cholesky_solve(const double *f, size_t n, const double *b, double *x)
+{
+    for (size_t i = 0; i < n; i++) { /* L y = b */
+        double s = b[i];
+        for (size_t q = 0; q < i; q++) s -= f[i * n + q] * x[q];
+        x[i] = s / f[i * n + i];
+    }
+    for (size_t i = n; i-- > 0;) { /* L^T x = y by rows of L (contiguous), not its columns */
+        x[i] /= f[i * n + i];
+        for (size_t q = 0; q < i; q++) x[q] -= f[i * n + q] * x[i];
     }
 }

@@ -9,6 +9,7 @@
 #define SPN_EQUILIBRIUM_BSR_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 typedef struct spn__bsr {
@@ -35,6 +36,13 @@ void spn__bsr_residual(const spn__bsr *a, const double *b, const double *x, doub
 /* One block Gauss-Seidel sweep in place, rows in order (forward) or reverse;
  * dinv: 6 per row, the inverted (symmetric) diagonal blocks. */
 void spn__bsr_gauss_seidel(const spn__bsr *a, const double *dinv, const double *b, double *x, bool forward);
+
+/* Dense Cholesky A = L L^T in place: f is n x n row-major, its lower
+ * triangle read and overwritten with L. False when A is not positive
+ * definite. (The multigrid's coarsest level and the thread slides.) */
+bool spn__dense_cholesky(double *f, size_t n);
+/* Solves L L^T x = b with a factor from spn__dense_cholesky; x may be b. */
+void spn__dense_cholesky_solve(const double *f, size_t n, const double *b, double *x);
 
 static inline void spn__blk_mul_vec(const double *m, const double *v, double *o)
 {

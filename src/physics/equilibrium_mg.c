@@ -319,35 +319,12 @@ static bool dense_factor(spn__mg *mg)
         for (uint32_t p = a->start[I]; p < a->start[I + 1]; p++)
             for (int r = 0; r < 3; r++)
                 for (int c = 0; c < 3; c++) f[(3 * I + r) * N + 3 * a->col[p] + c] += a->val[9 * (size_t)p + 3 * r + c];
-    for (size_t k = 0; k < N; k++) {
-        double d = f[k * N + k];
-        for (size_t q = 0; q < k; q++) d -= f[k * N + q] * f[k * N + q];
-        if (!(d > 0)) return false;
-        d = sqrt(d);
-        f[k * N + k] = d;
-        for (size_t i = k + 1; i < N; i++) {
-            double s = f[i * N + k];
-            for (size_t q = 0; q < k; q++) s -= f[i * N + q] * f[k * N + q];
-            f[i * N + k] = s / d;
-        }
-    }
-    return true;
+    return spn__dense_cholesky(f, N);
 }
 
 static void dense_solve(const spn__mg *mg, const double *b, double *x)
 {
-    size_t N = 3 * (size_t)mg->lv[mg->nlevels - 1].A.rows;
-    const double *f = mg->dense;
-    for (size_t i = 0; i < N; i++) {
-        double s = b[i];
-        for (size_t q = 0; q < i; q++) s -= f[i * N + q] * x[q];
-        x[i] = s / f[i * N + i];
-    }
-    for (size_t i = N; i-- > 0;) {
-        double s = x[i];
-        for (size_t q = i + 1; q < N; q++) s -= f[q * N + i] * x[q];
-        x[i] = s / f[i * N + i];
-    }
+    spn__dense_cholesky_solve(mg->dense, 3 * (size_t)mg->lv[mg->nlevels - 1].A.rows, b, x);
 }
 
 /* ---- setup ---------------------------------------------------------------- */

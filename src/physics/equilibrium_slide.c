@@ -21,6 +21,7 @@
  * x += Z C^-1 Z^T (b - A x) is applied before and after the aggregation
  * multigrid's coarse correction, so the V-cycle stays symmetric.
  * Sequential and in a fixed order: the same bits for any thread count. */
+#include "equilibrium_bsr.h"
 #include "equilibrium_internal.h"
 
 #include <math.h>
@@ -146,19 +147,7 @@ bool spn__slide_factor(spn__slide *S, const spn__eq *e)
     double big = 0;
     for (size_t k = 0; k < N; k++) big = fmax(big, f[k * N + k]);
     for (size_t k = 0; k < N; k++) f[k * N + k] += 1e-12 * big;
-    for (size_t k = 0; k < N; k++) {
-        double d = f[k * N + k];
-        for (size_t q = 0; q < k; q++) d -= f[k * N + q] * f[k * N + q];
-        if (!(d > 0)) return false;
-        d = sqrt(d);
-        f[k * N + k] = d;
-        for (size_t i = k + 1; i < N; i++) {
-            double s = f[i * N + k];
-            for (size_t q = 0; q < k; q++) s -= f[i * N + q] * f[k * N + q];
-            f[i * N + k] = s / d;
-        }
-    }
-    return true;
+    return spn__dense_cholesky(f, N);
 }
 
 void spn__slide_correct(const spn__slide *S, const spn__eq *e, const double *r, double *x)
@@ -172,15 +161,7 @@ void spn__slide_correct(const spn__slide *S, const spn__eq *e, const double *r, 
             const double *t = S->ptan + 3 * (size_t)q, *rp = r + 3 * (size_t)p;
             w[S->pcol[q]] += t[0] * rp[0] + t[1] * rp[1] + t[2] * rp[2];
         }
-    for (size_t i = 0; i < N; i++) { /* L y = w, then L^T y' = y, in place */
-        double s = w[i];
-        for (size_t q = 0; q < i; q++) s -= f[i * N + q] * w[q];
-        w[i] = s / f[i * N + i];
-    }
-    for (size_t i = N; i-- > 0;) { /* by rows of L (contiguous), not its columns */
-        w[i] /= f[i * N + i];
-        for (size_t q = 0; q < i; q++) w[q] -= f[i * N + q] * w[i];
-    }
+    spn__dense_cholesky_solve(f, N, w, w);
     for (uint32_t p = 0; p < e->n; p++)
         for (uint32_t q = S->pstart[p]; q < S->pstart[p + 1]; q++) {
             const double *t = S->ptan + 3 * (size_t)q, y = w[S->pcol[q]];
