@@ -43,19 +43,27 @@ static inline spn_vec3 util_breeze(void *user, double t, spn_vec3 p)
     return spn_v3(0.1 * sin(3 * p.x), 0, 0.8 + 0.3 * sin(5 * t + 7 * p.y));
 }
 
-/* The 50 x 50 standard web (2,501 particles) in util_breeze, with silk
- * diameters, split across `threads` even at this size (parallel_min 256). */
-static inline spn_world *util_breezy_orb(spn_integrator integ, int threads)
+/* The standard web of rings x radials, split across `threads` even at
+ * test sizes (parallel_min 256); NULL if it cannot be made. */
+static inline spn_world *util_orb(spn_integrator integ, int threads, int rings, int radials)
 {
     spn_world_def def = spn_world_def_default();
     def.integrator = integ;
     def.threads = threads;
     def.parallel_min = 256;
     spn_orb_scene_def od = spn_orb_scene_def_default();
-    od.rings = 50;
-    od.radials = 50;
+    od.rings = rings;
+    od.radials = radials;
     spn_world *w = NULL;
-    if (spn_scene_orb(&def, &od, &w) != SPN_OK) return NULL;
+    return spn_scene_orb(&def, &od, &w) == SPN_OK ? w : NULL;
+}
+
+/* The 50 x 50 standard web (2,501 particles) in util_breeze, with silk
+ * diameters. */
+static inline spn_world *util_breezy_orb(spn_integrator integ, int threads)
+{
+    spn_world *w = util_orb(integ, threads, 50, 50);
+    if (!w) return NULL;
     spn_world_set_air(w, util_breeze, NULL, 1.2, 1.8e-5);
     spn_world_set_tag_diameter(w, SPN_THREAD_CAPTURE, 3e-6);
     spn_world_set_tag_diameter(w, SPN_THREAD_RADIUS, 4e-6);

@@ -20,15 +20,8 @@
 
 static spn_world *web(spn_integrator integ, int threads)
 {
-    spn_world_def def = spn_world_def_default();
-    def.integrator = integ;
-    def.threads = threads;
-    def.parallel_min = 256;
-    spn_orb_scene_def od = spn_orb_scene_def_default();
-    od.rings = 20;
-    od.radials = 30;
-    spn_world *w;
-    assert_int_equal(spn_scene_orb(&def, &od, &w), SPN_OK);
+    spn_world *w = util_orb(integ, threads, 20, 30);
+    assert_non_null(w);
     /* start from a disturbed state so every step moves something */
     for (uint32_t i = 0; i < spn_world_particle_count(w); i += 7)
         if (!spn_world_is_fixed(w, i)) spn_world_set_velocity(w, i, spn_v3(0, 0, 1e-3 * (double)(i % 5)));
