@@ -6,25 +6,15 @@
  * same inputs give the same bits for any thread count. */
 #include "equilibrium_bsr.h"
 #include "equilibrium_internal.h"
+#include "world_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 #define PAR_MIN 16384u /* rows below which a loop stays on one thread */
 
 static inline int team(uint32_t rows, int threads) { return rows < PAR_MIN ? 1 : threads; }
-static inline int thread_id(void)
-{
-#ifdef _OPENMP
-    return omp_get_thread_num();
-#else
-    return 0;
-#endif
-}
 
 void spn__bsr_free(spn__bsr *a)
 {
@@ -70,7 +60,7 @@ bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_f
     for (size_t t = 0; t < (size_t)nt * b->cols; t++) marks[t] = UINT32_MAX;
 #pragma omp parallel for schedule(static) num_threads(nt)
     for (uint32_t i = 0; i < a->rows; i++)
-        c->start[i + 1] = row_pattern(a, b, i, diag_first, marks + (size_t)thread_id() * b->cols, NULL);
+        c->start[i + 1] = row_pattern(a, b, i, diag_first, marks + (size_t)spn__thread_num() * b->cols, NULL);
     for (uint32_t i = 0; i < a->rows; i++) c->start[i + 1] += c->start[i];
     size_t nnz = c->start[a->rows];
     c->col = malloc((nnz ? nnz : 1) * sizeof *c->col);
@@ -79,7 +69,7 @@ bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_f
     for (size_t t = 0; t < (size_t)nt * b->cols; t++) marks[t] = UINT32_MAX;
 #pragma omp parallel for schedule(static) num_threads(nt)
     for (uint32_t i = 0; i < a->rows; i++)
-        row_pattern(a, b, i, diag_first, marks + (size_t)thread_id() * b->cols, c->col + c->start[i]);
+        row_pattern(a, b, i, diag_first, marks + (size_t)spn__thread_num() * b->cols, c->col + c->start[i]);
     free(marks);
     marks = NULL;
     if (spn__bsr_mul_values(a, b, c, threads)) return true;
@@ -96,7 +86,7 @@ bool spn__bsr_mul_values(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, int 
     if (!pos) return false;
 #pragma omp parallel for schedule(static) num_threads(nt)
     for (uint32_t i = 0; i < a->rows; i++) {
-        uint32_t *where = pos + (size_t)thread_id() * b->cols;
+        uint32_t *where = pos + (size_t)spn__thread_num() * b->cols;
         for (uint32_t q = c->start[i]; q < c->start[i + 1]; q++) where[c->col[q]] = q;
         memset(c->val + 9 * (size_t)c->start[i], 0, 9 * (size_t)(c->start[i + 1] - c->start[i]) * sizeof *c->val);
         for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) {

@@ -265,19 +265,7 @@ SPN__KERNEL static void band_pass(const lat_args *a, double *ws, uint32_t b)
     const size_t q0 = 1 + (size_t)(hi - 1) * n;
     finish_row(a, q0, n, X[last], V[last], rad_prev, RING[last],
                hi < L->rings ? (const double *const *)next_cut : NULL, F, t, B, acc);
-    double *out = L->partial + (size_t)b * L_NSUMS;
-    if (b == 0) out[L_ELASTIC] = out[L_DAMP] = 0;
-    out[L_ELASTIC] += lane_total(acc_e), out[L_DAMP] += lane_total(acc_p);
-    out[L_MV2] = lane_total(acc[L_MV2]), out[L_GAIN] = lane_total(acc[L_GAIN]), out[L_MVN2] = lane_total(acc[L_MVN2]);
-}
-
-static int thread_id(void)
-{
-#ifdef _OPENMP
-    return omp_get_thread_num();
-#else
-    return 0;
-#endif
+    store_band_sums(L->partial + (size_t)b * L_NSUMS, b == 0, acc_e, acc_p, acc);
 }
 
 /* One force evaluation and update over the whole lattice; sums into sum[]. */
@@ -287,7 +275,7 @@ static void sweep(spn_world *w, const lat_args *a, int threads, double *sum)
     const uint32_t nb = L->nbands;
 #pragma omp parallel num_threads(threads)
     {
-        double *ws = L->ws[thread_id()];
+        double *ws = L->ws[spn__thread_num()];
 #pragma omp for schedule(static)
         for (uint32_t b = 1; b < nb; b++) cut_pass(a, ws, b);
 #pragma omp for schedule(static)

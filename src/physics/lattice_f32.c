@@ -249,19 +249,7 @@ SPN__KERNEL static void band32(const a32 *a, float *ws, uint32_t b)
         rad_prev = rad_cur;
     }
     finish32(a, 1 + (size_t)(hi - 1) * n, n, rad_prev, RING[cur ^ 1], hi < L->rings ? next_cut : NULL, t, Fw, acc);
-    double *out = L->partial + (size_t)b * L_NSUMS;
-    if (b == 0) out[L_ELASTIC] = out[L_DAMP] = 0;
-    out[L_ELASTIC] += lane_total(acc_e), out[L_DAMP] += lane_total(acc_p);
-    out[L_MV2] = lane_total(acc[L_MV2]), out[L_GAIN] = lane_total(acc[L_GAIN]), out[L_MVN2] = lane_total(acc[L_MVN2]);
-}
-
-static int thread_id(void)
-{
-#ifdef _OPENMP
-    return omp_get_thread_num();
-#else
-    return 0;
-#endif
+    store_band_sums(L->partial + (size_t)b * L_NSUMS, b == 0, acc_e, acc_p, acc);
 }
 
 static void sweep32(const a32 *a, int threads, double *sum)
@@ -270,7 +258,7 @@ static void sweep32(const a32 *a, int threads, double *sum)
     const uint32_t nb = L->nbands;
 #pragma omp parallel num_threads(threads)
     {
-        float *ws = a->F->ws[thread_id()];
+        float *ws = a->F->ws[spn__thread_num()];
 #pragma omp for schedule(static)
         for (uint32_t b = 1; b < nb; b++) cut32(a, ws, b);
 #pragma omp for schedule(static)

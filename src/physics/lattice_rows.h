@@ -89,6 +89,17 @@ LAT_INLINE double lane_total(const double *acc)
     return ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
 }
 
+/* A band's sums into out (its L_NSUMS partials): the spring energy terms
+ * add up over the band's sweeps from the first band's reset, the particle
+ * terms are the last sweep's. */
+LAT_INLINE void store_band_sums(double *out, bool first, const double *acc_e, const double *acc_p,
+                                double acc[L_NSUMS][LANES])
+{
+    if (first) out[L_ELASTIC] = out[L_DAMP] = 0;
+    out[L_ELASTIC] += lane_total(acc_e), out[L_DAMP] += lane_total(acc_p);
+    out[L_MV2] = lane_total(acc[L_MV2]), out[L_GAIN] = lane_total(acc[L_GAIN]), out[L_MVN2] = lane_total(acc[L_MVN2]);
+}
+
 /* Springs j = 0..n-1 from (a[j]) to (b[j]), SoA: force on end a into f, the
  * elastic energy and damping power into e, p. The arithmetic of chunk_forces
  * (same bits): a spring is off (no force) at zero length or when slack and

@@ -17,6 +17,16 @@
 #include <omp.h>
 #endif
 
+/* The calling thread's number in its OpenMP team (0 without OpenMP). */
+static inline int spn__thread_num(void)
+{
+#ifdef _OPENMP
+    return omp_get_thread_num();
+#else
+    return 0;
+#endif
+}
+
 #define SPN_SPRING_TENSION_ONLY 1u
 #define SPN_SPRING_BROKEN 2u
 
