@@ -1,9 +1,12 @@
 /* Block sparse rows with 3x3 blocks (equilibrium_bsr.h): products for the
  * Galerkin coarse operators P^T (A P), the transpose, products with vectors
  * and a Gauss-Seidel sweep. Products go row by row with a marker array per
- * thread (Gustavson's algorithm), in two passes: the pattern, then the
- * values; each row's entries appear in the order its terms are met, so the
- * same inputs give the same bits for any thread count. */
+ * thread (Gustavson's algorithm), in two passes: the count of each row,
+ * then its columns and values together; each row's entries appear in the
+ * order its terms are met, so the same inputs give the same bits for any
+ * thread count. The Galerkin product computes only the blocks on and above
+ * the diagonal and mirrors the rest (C = P^T A P is symmetric): half the
+ * block arithmetic of the setup's largest product. */
 #include "equilibrium_bsr.h"
 #include "equilibrium_internal.h"
 #include "world_internal.h"
@@ -24,15 +27,13 @@ void spn__bsr_free(spn__bsr *a)
     memset(a, 0, sizeof *a);
 }
 
-/* Columns of row i of A B into cols (marker: per column, the last row that
- * saw it); returns the count. */
-static uint32_t row_pattern(const spn__bsr *a, const spn__bsr *b, uint32_t i, bool diag_first, uint32_t *mark,
-                            uint32_t *cols)
+/* The number of distinct columns of row i of A B (mark: per column, the
+ * last row that saw it). */
+static uint32_t row_count(const spn__bsr *a, const spn__bsr *b, uint32_t i, bool diag_first, uint32_t *mark)
 {
     uint32_t cnt = 0;
     if (diag_first) {
         mark[i] = i;
-        if (cols) cols[cnt] = i;
         cnt++;
     }
     for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) {
@@ -41,63 +42,101 @@ static uint32_t row_pattern(const spn__bsr *a, const spn__bsr *b, uint32_t i, bo
             uint32_t j = b->col[q];
             if (mark[j] == i) continue;
             mark[j] = i;
-            if (cols) cols[cnt] = j;
             cnt++;
         }
     }
     return cnt;
 }
 
-bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, int threads)
+/* Row i of C = A B, columns and values in one pass (pos[j]: where column j
+ * went in this row; mark as in row_count). upper: only the blocks with
+ * column >= i get values (C is known to be symmetric; the rest are mirrored
+ * afterwards), which halves the Galerkin product's block arithmetic. */
+static void row_values(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_t i, bool diag_first, bool upper,
+                       uint32_t *mark, uint32_t *pos)
+{
+    uint32_t q0 = c->start[i], cnt = q0;
+    memset(c->val + 9 * (size_t)q0, 0, 9 * (size_t)(c->start[i + 1] - q0) * sizeof *c->val);
+    if (diag_first) {
+        mark[i] = i;
+        pos[i] = cnt;
+        c->col[cnt++] = i;
+    }
+    for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) {
+        const double *ab = a->val + 9 * (size_t)p;
+        uint32_t k = a->col[p];
+        for (uint32_t q = b->start[k]; q < b->start[k + 1]; q++) {
+            uint32_t j = b->col[q];
+            if (mark[j] != i) {
+                mark[j] = i;
+                pos[j] = cnt;
+                c->col[cnt++] = j;
+            }
+            if (!upper || j >= i) spn__blk_mul_add(ab, b->val + 9 * (size_t)q, c->val + 9 * (size_t)pos[j]);
+        }
+    }
+}
+
+/* The blocks below the diagonal of a structurally symmetric C from those
+ * above it: C_ij = C_ji^T (row j found by a scan: rows are short). */
+static void mirror_lower(spn__bsr *c, int threads)
+{
+#pragma omp parallel for schedule(static) num_threads(team(c->rows, threads))
+    for (uint32_t i = 0; i < c->rows; i++)
+        for (uint32_t q = c->start[i]; q < c->start[i + 1]; q++) {
+            uint32_t j = c->col[q], t = c->start[j];
+            if (j >= i) continue;
+            while (c->col[t] != i) t++;
+            const double *s = c->val + 9 * (size_t)t;
+            double *d = c->val + 9 * (size_t)q;
+            d[0] = s[0], d[1] = s[3], d[2] = s[6];
+            d[3] = s[1], d[4] = s[4], d[5] = s[7];
+            d[6] = s[2], d[7] = s[5], d[8] = s[8];
+        }
+}
+
+static bool mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, bool upper, int threads)
 {
     memset(c, 0, sizeof *c);
     c->rows = a->rows;
     c->cols = b->cols;
     int nt = team(a->rows, threads);
+    size_t per = b->cols ? b->cols : 1;
     c->start = calloc((size_t)a->rows + 1, sizeof *c->start);
-    uint32_t *marks = malloc((size_t)nt * (b->cols ? b->cols : 1) * sizeof *marks);
+    uint32_t *marks = malloc(2 * (size_t)nt * per * sizeof *marks);
     if (!c->start || !marks) goto fail;
-    for (size_t t = 0; t < (size_t)nt * b->cols; t++) marks[t] = UINT32_MAX;
+    for (size_t t = 0; t < (size_t)nt * per; t++) marks[t] = UINT32_MAX;
 #pragma omp parallel for schedule(static) num_threads(nt)
     for (uint32_t i = 0; i < a->rows; i++)
-        c->start[i + 1] = row_pattern(a, b, i, diag_first, marks + (size_t)spn__thread_num() * b->cols, NULL);
+        c->start[i + 1] = row_count(a, b, i, diag_first, marks + (size_t)spn__thread_num() * per);
     for (uint32_t i = 0; i < a->rows; i++) c->start[i + 1] += c->start[i];
     size_t nnz = c->start[a->rows];
     c->col = malloc((nnz ? nnz : 1) * sizeof *c->col);
     c->val = malloc(9 * (nnz ? nnz : 1) * sizeof *c->val);
     if (!c->col || !c->val) goto fail;
-    for (size_t t = 0; t < (size_t)nt * b->cols; t++) marks[t] = UINT32_MAX;
+    for (size_t t = 0; t < (size_t)nt * per; t++) marks[t] = UINT32_MAX;
 #pragma omp parallel for schedule(static) num_threads(nt)
-    for (uint32_t i = 0; i < a->rows; i++)
-        row_pattern(a, b, i, diag_first, marks + (size_t)spn__thread_num() * b->cols, c->col + c->start[i]);
+    for (uint32_t i = 0; i < a->rows; i++) {
+        uint32_t *mark = marks + (size_t)spn__thread_num() * per;
+        row_values(a, b, c, i, diag_first, upper, mark, mark + (size_t)nt * per);
+    }
     free(marks);
-    marks = NULL;
-    if (spn__bsr_mul_values(a, b, c, threads)) return true;
+    if (upper) mirror_lower(c, threads);
+    return true;
 fail:
     free(marks);
     spn__bsr_free(c);
     return false;
 }
 
-bool spn__bsr_mul_values(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, int threads)
+bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, int threads)
 {
-    int nt = team(a->rows, threads);
-    uint32_t *pos = malloc((size_t)nt * (b->cols ? b->cols : 1) * sizeof *pos);
-    if (!pos) return false;
-#pragma omp parallel for schedule(static) num_threads(nt)
-    for (uint32_t i = 0; i < a->rows; i++) {
-        uint32_t *where = pos + (size_t)spn__thread_num() * b->cols;
-        for (uint32_t q = c->start[i]; q < c->start[i + 1]; q++) where[c->col[q]] = q;
-        memset(c->val + 9 * (size_t)c->start[i], 0, 9 * (size_t)(c->start[i + 1] - c->start[i]) * sizeof *c->val);
-        for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) {
-            const double *ab = a->val + 9 * (size_t)p;
-            uint32_t k = a->col[p];
-            for (uint32_t q = b->start[k]; q < b->start[k + 1]; q++)
-                spn__blk_mul_add(ab, b->val + 9 * (size_t)q, c->val + 9 * (size_t)where[b->col[q]]);
-        }
-    }
-    free(pos);
-    return true;
+    return mul(a, b, c, diag_first, false, threads);
+}
+
+bool spn__bsr_galerkin(const spn__bsr *r, const spn__bsr *ap, spn__bsr *c, int threads)
+{
+    return mul(r, ap, c, true, true, threads);
 }
 
 bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm_out)

@@ -23,9 +23,10 @@ void spn__bsr_free(spn__bsr *a);
 /* Pattern and values of C = A B (C's square-matrix diagonal first when
  * diag_first). false on out of memory. */
 bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, int threads);
-/* Values only, into a C whose pattern came from spn__bsr_mul of the same
- * patterns; false on out of memory. */
-bool spn__bsr_mul_values(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, int threads);
+/* The Galerkin product C = R (A P), R = P^T, A symmetric: diagonal first,
+ * the blocks above the diagonal computed and those below mirrored from them
+ * (C exactly symmetric). false on out of memory. */
+bool spn__bsr_galerkin(const spn__bsr *r, const spn__bsr *ap, spn__bsr *c, int threads);
 /* T = A^T, blocks transposed; perm[k]: the entry of A that T's entry k came from. */
 bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm);
 void spn__bsr_transpose_values(const spn__bsr *a, spn__bsr *t, const uint32_t *perm, int threads);

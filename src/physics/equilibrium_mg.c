@@ -69,7 +69,7 @@ typedef struct mg_level {
     /* to the next coarser level */
     uint32_t *agg;      /* coarse row of each row */
     double omega;       /* prolongator smoothing damping */
-    spn__bsr S, P, R;   /* S = I - omega D^-1 A (while building), P = S P0, R = P^T */
+    spn__bsr P, R;      /* P = (I - omega D^-1 A) P0 (or P0), R = P^T */
     spn__lines *lines;  /* NULL: point Gauss-Seidel */
 } mg_level;
 
@@ -233,72 +233,95 @@ static double spectral_radius(const mg_level *L, int threads)
     return 1.1 * rho; /* power iteration approaches from below */
 }
 
-/* S = I - omega D^-1 A, on A's pattern. (Keeping only the strong blocks,
- * the weak ones lumped on the diagonal, made the coarse levels sparser but
- * the method weaker: 80 CG iterations instead of 53 at 100k; measured.) */
-static bool smoother_matrix(mg_level *L)
+/* P = (I - omega D^-1 A) P0, straight from A and the aggregates: row i of
+ * P has a block for each aggregate among row i's columns, the sum of
+ * -omega D_i^-1 A_ic over its columns c (plus I for c = i). Forming the
+ * smoother matrix and multiplying it by P0 (whose blocks are identities)
+ * did the same with three times the arithmetic and a matrix more memory.
+ * (Keeping only the strong blocks, the weak ones lumped on the diagonal,
+ * made the coarse levels sparser but the method weaker: 80 CG iterations
+ * instead of 53 at 100k; measured.) */
+static bool smoothed_prolongator(mg_level *L, uint32_t nc)
 {
-    uint32_t n = L->A.rows, nnz = L->A.start[n];
-    spn__bsr *S = &L->S;
-    S->rows = S->cols = n;
-    S->start = malloc(((size_t)n + 1) * sizeof *S->start);
-    S->col = malloc((nnz ? nnz : 1) * sizeof *S->col);
-    S->val = malloc(9 * (size_t)(nnz ? nnz : 1) * sizeof *S->val);
-    if (!S->start || !S->col || !S->val) return false;
-    memcpy(S->start, L->A.start, ((size_t)n + 1) * sizeof *S->start);
-    memcpy(S->col, L->A.col, (size_t)nnz * sizeof *S->col);
+    const spn__bsr *A = &L->A;
+    uint32_t n = A->rows, *mark = malloc(2 * (size_t)(nc ? nc : 1) * sizeof *mark), *pos = mark + (nc ? nc : 1);
+    spn__bsr *P = &L->P;
+    P->rows = n, P->cols = nc;
+    P->start = malloc(((size_t)n + 1) * sizeof *P->start);
+    if (!mark || !P->start) {
+        free(mark);
+        return false;
+    }
+    for (uint32_t c = 0; c < nc; c++) mark[c] = UINT32_MAX;
+    P->start[0] = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t cnt = 0;
+        for (uint32_t p = A->start[i]; p < A->start[i + 1]; p++) {
+            uint32_t g = L->agg[A->col[p]];
+            if (mark[g] != i) mark[g] = i, cnt++;
+        }
+        P->start[i + 1] = P->start[i] + cnt;
+    }
+    size_t nnz = P->start[n];
+    P->col = malloc((nnz ? nnz : 1) * sizeof *P->col);
+    P->val = calloc(9 * (nnz ? nnz : 1), sizeof *P->val);
+    if (!P->col || !P->val) {
+        free(mark);
+        return false;
+    }
+    for (uint32_t c = 0; c < nc; c++) mark[c] = UINT32_MAX;
     for (uint32_t i = 0; i < n; i++) {
         const double *d = L->dinv + 6 * (size_t)i;
-        double di[9] = {d[0], d[3], d[4], d[3], d[1], d[5], d[4], d[5], d[2]};
-        for (uint32_t p = L->A.start[i]; p < L->A.start[i + 1]; p++) {
-            double *sv = S->val + 9 * (size_t)p, t[9] = {0};
-            spn__blk_mul_add(di, L->A.val + 9 * (size_t)p, t);
-            for (int k = 0; k < 9; k++) sv[k] = -L->omega * t[k];
-            if (L->A.col[p] == i) sv[0] += 1, sv[4] += 1, sv[8] += 1;
+        double di[9] = {-L->omega * d[0], -L->omega * d[3], -L->omega * d[4], -L->omega * d[3], -L->omega * d[1],
+                        -L->omega * d[5], -L->omega * d[4], -L->omega * d[5], -L->omega * d[2]};
+        uint32_t cnt = P->start[i];
+        for (uint32_t p = A->start[i]; p < A->start[i + 1]; p++) {
+            uint32_t c = A->col[p], g = L->agg[c];
+            if (mark[g] != i) mark[g] = i, pos[g] = cnt, P->col[cnt++] = g;
+            double *pv = P->val + 9 * (size_t)pos[g];
+            spn__blk_mul_add(di, A->val + 9 * (size_t)p, pv);
+            if (c == i) pv[0] += 1, pv[4] += 1, pv[8] += 1;
         }
     }
+    free(mark);
     return true;
 }
 
-/* Aggregate level l; build P = S P0, R = P^T and level l + 1 = R (A P). */
+/* Aggregate level l; build P (smoothed, or P0 on a dense level), R = P^T
+ * and level l + 1 = R (A P). */
 static bool add_level(spn__mg *mg, int l)
 {
     mg_level *L = &mg->lv[l], *C = &mg->lv[l + 1];
     uint32_t n = L->A.rows;
-    spn__bsr p0 = {0}, ap = {0};
+    spn__bsr ap = {0};
     uint32_t *rperm = NULL;
     L->agg = malloc((n ? n : 1) * sizeof *L->agg);
     if (!L->agg) return false;
     uint32_t nc = aggregate(&L->A, L->agg, THETA);
-    p0.rows = n, p0.cols = nc;
-    p0.start = malloc(((size_t)n + 1) * sizeof *p0.start);
-    p0.col = malloc((n ? n : 1) * sizeof *p0.col);
-    p0.val = calloc(9 * (size_t)(n ? n : 1), sizeof *p0.val);
-    bool ok = nc > 0 && p0.start && p0.col && p0.val;
-    if (ok) {
-        for (uint32_t i = 0; i <= n; i++) p0.start[i] = i;
-        for (uint32_t i = 0; i < n; i++) {
-            p0.col[i] = L->agg[i];
-            p0.val[9 * (size_t)i] = p0.val[9 * (size_t)i + 4] = p0.val[9 * (size_t)i + 8] = 1;
+    bool ok = nc > 0;
+    /* smoothing widens the stencil a level at a time (5, 12, 47, 96 ... blocks a
+     * row on the 100k web, 145-338 on levels 3-5 of the 1M web, where the
+     * products then cost more than the solve): dense levels keep P0 */
+    if (ok && (double)L->A.start[n] <= MAX_SMOOTHED_ROW * n) {
+        L->omega = 4.0 / (3.0 * (l == 0 ? 2.0 : spectral_radius(L, mg->threads)));
+        ok = smoothed_prolongator(L, nc);
+    } else if (ok) { /* P0: an aggregate's three translations copied to its members */
+        spn__bsr *P = &L->P;
+        P->rows = n, P->cols = nc;
+        P->start = malloc(((size_t)n + 1) * sizeof *P->start);
+        P->col = malloc((n ? n : 1) * sizeof *P->col);
+        P->val = calloc(9 * (size_t)(n ? n : 1), sizeof *P->val);
+        ok = P->start && P->col && P->val;
+        for (uint32_t i = 0; ok && i <= n; i++) P->start[i] = i;
+        for (uint32_t i = 0; ok && i < n; i++) {
+            P->col[i] = L->agg[i];
+            P->val[9 * (size_t)i] = P->val[9 * (size_t)i + 4] = P->val[9 * (size_t)i + 8] = 1;
         }
-        /* smoothing widens the stencil a level at a time (5, 12, 47, 96 ... blocks a
-         * row on the 100k web, 145-338 on levels 3-5 of the 1M web, where the
-         * products then cost more than the solve): dense levels keep P0 */
-        bool smooth = (double)L->A.start[n] <= MAX_SMOOTHED_ROW * n;
-        if (smooth) {
-            L->omega = 4.0 / (3.0 * (l == 0 ? 2.0 : spectral_radius(L, mg->threads)));
-            ok = smoother_matrix(L) && spn__bsr_mul(&L->S, &p0, &L->P, false, mg->threads);
-        } else {
-            L->P = p0;
-            memset(&p0, 0, sizeof p0);
-        }
-        ok = ok && spn__bsr_mul(&L->A, &L->P, &ap, false, mg->threads) && spn__bsr_transpose(&L->P, &L->R, &rperm) &&
-             spn__bsr_mul(&L->R, &ap, &C->A, true, mg->threads);
     }
-    spn__bsr_free(&p0);
+    ok = ok && spn__bsr_mul(&L->A, &L->P, &ap, false, mg->threads) && spn__bsr_transpose(&L->P, &L->R, &rperm) &&
+         spn__bsr_galerkin(&L->R, &ap, &C->A, mg->threads);
     spn__bsr_free(&ap);
     free(rperm);
-    spn__bsr_free(&L->S);
     if (!ok) return false;
     size_t n3 = 3 * (size_t)(nc ? nc : 1);
     C->dinv = malloc(2 * n3 * sizeof *C->dinv);
@@ -334,7 +357,7 @@ void spn__mg_free(spn__mg *mg)
     if (!mg) return;
     for (int l = 0; l < MAX_LEVELS; l++) {
         mg_level *L = &mg->lv[l];
-        spn__bsr_free(&L->A), spn__bsr_free(&L->S), spn__bsr_free(&L->P), spn__bsr_free(&L->R);
+        spn__bsr_free(&L->A), spn__bsr_free(&L->P), spn__bsr_free(&L->R);
         free(L->agg), free(L->x), free(L->b), free(L->r);
         spn__lines_free(L->lines);
         if (l > 0) free(L->dinv);
