@@ -347,25 +347,24 @@ fail:
 }
 
 
-/* out = sym(D - U^T M U), M symmetric (6), U a full block, D full (9). */
-static void schur(const double *d, const double *m, const double *u, double *out)
+/* The pivot after step k - 1: out = D - U^T M U with M = Dinv_{k-1} (6),
+ * U = U_{k-1} and D = D_k (9 each); w = M U, the factor the back
+ * substitution needs. Level-0 blocks are symmetric (sums of H_s or -H_s), so
+ * U^T M U = U w is too and only its six distinct entries are formed. */
+static void schur(const double *d, const double *m, const double *u, double *w, double *out)
 {
-    double mm[9] = {m[0], m[3], m[4], m[3], m[1], m[5], m[4], m[5], m[2]}, w[9] = {0}, t[9] = {0}, ut[9];
-    for (int r = 0; r < 3; r++)
-        for (int c = 0; c < 3; c++) ut[3 * r + c] = u[3 * c + r];
+    double mm[9] = {m[0], m[3], m[4], m[3], m[1], m[5], m[4], m[5], m[2]};
+    memset(w, 0, 9 * sizeof *w);
     spn__blk_mul_add(mm, u, w);
-    spn__blk_mul_add(ut, w, t);
-    out[0] = d[0] - t[0];
-    out[1] = d[4] - t[4];
-    out[2] = d[8] - t[8];
-    out[3] = 0.5 * (d[1] + d[3]) - 0.5 * (t[1] + t[3]);
-    out[4] = 0.5 * (d[2] + d[6]) - 0.5 * (t[2] + t[6]);
-    out[5] = 0.5 * (d[5] + d[7]) - 0.5 * (t[5] + t[7]);
+    static const int R[6] = {0, 1, 2, 0, 0, 1}, C[6] = {0, 1, 2, 1, 2, 2};
+    for (int q = 0; q < 6; q++) {
+        const double *ur = u + 3 * R[q];
+        out[q] = d[3 * R[q] + C[q]] - (ur[0] * w[C[q]] + ur[1] * w[3 + C[q]] + ur[2] * w[6 + C[q]]);
+    }
 }
 
 bool spn__lines_factor(spn__lines *L, const spn__bsr *a0)
 {
-    static const double zero6[6] = {0, 0, 0, 0, 0, 0};
     const uint32_t nnz = a0->start[a0->rows];
     for (uint32_t p = 0; p < nnz; p++) { /* level-0 blocks are symmetric (sums of -H_s or of H_s) */
         const double *v = a0->val + 9 * (size_t)p;
@@ -377,16 +376,14 @@ bool spn__lines_factor(spn__lines *L, const spn__bsr *a0)
         double prev[6] = {0, 0, 0, 0, 0, 0}; /* the last pivot's inverse, in float64 */
         for (uint32_t k = L->start[l]; k < L->start[l + 1]; k++) {
             const double *d = a0->val + 9 * (size_t)a0->start[L->node[k]];
-            double piv[6], inv[6];
-            if (k == L->start[l]) schur(d, zero6, d, piv); /* U^T 0 U = 0: the plain diagonal */
-            else schur(d, prev, a0->val + 9 * (size_t)L->upos[k - 1], piv);
-            if (!spn__sym_inverse(piv, inv)) return false;
-            if (k > L->start[l]) { /* Dinv_{k-1} U_{k-1} */
-                double mm[9] = {prev[0], prev[3], prev[4], prev[3], prev[1], prev[5], prev[4], prev[5], prev[2]};
-                double c[9] = {0};
-                spn__blk_mul_add(mm, a0->val + 9 * (size_t)L->upos[k - 1], c);
-                for (int q = 0; q < 9; q++) L->cu[9 * (size_t)(k - 1) + q] = (float)c[q];
+            double piv[6], inv[6], w[9];
+            if (k == L->start[l]) { /* the plain diagonal */
+                piv[0] = d[0], piv[1] = d[4], piv[2] = d[8], piv[3] = d[1], piv[4] = d[2], piv[5] = d[5];
+            } else {
+                schur(d, prev, a0->val + 9 * (size_t)L->upos[k - 1], w, piv);
+                for (int q = 0; q < 9; q++) L->cu[9 * (size_t)(k - 1) + q] = (float)w[q]; /* Dinv_{k-1} U_{k-1} */
             }
+            if (!spn__sym_inverse(piv, inv)) return false;
             for (int q = 0; q < 6; q++) L->dinv[6 * (size_t)k + q] = (float)inv[q];
             memcpy(prev, inv, sizeof prev);
         }
