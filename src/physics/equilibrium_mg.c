@@ -39,7 +39,7 @@
  *
  * Newton steps: the hierarchy is built from the first Newton system and
  * kept; each later step refreshes only the finest level and the line
- * factors. The Hessian of a taut web changes little between steps, and a
+ * factors (and, on webs above SLIDE_REFRESH_N, the slide matrix). The Hessian of a taut web changes little between steps, and a
  * stale coarse operator is still symmetric positive definite (measured: 22
  * CG instead of 23 at 5k, 65 instead of 60 at 100k, for a setup a quarter
  * the cost). If the first system cannot be factored (a singular web), the
@@ -60,7 +60,9 @@
 #define MAX_LEVELS 24
 #define MAX_SMOOTHED_ROW 64.0 /* blocks a row above which a level's prolongator is not smoothed */
 #define POWER_STEPS 10  /* power iterations for rho(D^-1 A) on coarse levels */
-#define SLIDE_MAX_N 200000u /* free particles above which the thread slides are left out (see build) */
+/* Free particles above which the slide matrix is factored again at every
+ * Newton step instead of kept from the first (see spn__mg_setup). */
+#define SLIDE_REFRESH_N 50000u
 
 typedef struct mg_level {
     spn__bsr A;         /* the level's matrix, diagonal block first in each row */
@@ -78,7 +80,7 @@ struct spn__mg {
     mg_level lv[MAX_LEVELS];
     uint32_t *map0;     /* per adjacency entry of the spring system: its level-0 block, or UINT32_MAX */
     spn__slide *slide;  /* thread-slide correction on level 0 (spring systems only), or NULL */
-    bool slide_ok;      /* its matrix factored (from the first system that allowed it; then kept) */
+    bool slide_ok;      /* its matrix factored (from the first system that allowed it; kept on small webs) */
     double *dense;      /* coarsest level's Cholesky factor */
     int threads;
 };
@@ -378,11 +380,8 @@ static spn_status build(spn__mg *mg, const spn__eq *e, const double *inv0)
     if (!L0->r || !L0->x || !level0_pattern(mg, e)) return SPN_ERR_NOMEM;
     level0_values(mg, e);
     if (!(L0->lines = spn__lines_build(e, &L0->A))) return SPN_ERR_NOMEM;
-    /* NULL: too many lines, or no memory; the cycle goes without. Above
-     * SLIDE_MAX_N it is left out: on the 1M web Newton then stalled (the
-     * residual stuck near 150x the target after 10 steps, against 4 steps
-     * without the slides), not understood yet; validated up to 100k. */
-    if (e->hs && e->n <= SLIDE_MAX_N) mg->slide = spn__slide_build(e, L0->lines);
+    /* NULL: too many lines, or no memory; the cycle goes without */
+    if (e->hs) mg->slide = spn__slide_build(e, L0->lines);
     mg->nlevels = 1;
     while (mg->nlevels < MAX_LEVELS && mg->lv[mg->nlevels - 1].A.rows > COARSEST) {
         int l = mg->nlevels - 1;
@@ -414,9 +413,17 @@ spn_status spn__mg_setup(spn__mg **out, const spn__eq *e, const double *inv0)
         mg->lv[0].dinv = (double *)inv0;
         level0_values(mg, e);
     }
-    /* like the hierarchy, the slide matrix of the first system is kept: the
-     * later ones needed the same CG iterations (5k: 12, 100k: 24) */
-    if (mg->slide && !mg->slide_ok) mg->slide_ok = spn__slide_factor(mg->slide, e);
+    /* Like the hierarchy, the slide matrix of the first system is kept on a
+     * small web: the later ones needed the same CG iterations (5k: 12, 100k:
+     * 24) and refactoring costs 0.7 ms a step at 5k. On a large web it is
+     * factored again every step: with the first system's matrix the 1M web's
+     * Newton stalled (the residual stuck near 1e-4 T0 after 19 steps, each
+     * CG stopping at its forcing term 0.1 in 4 iterations while the energy
+     * fell exactly as predicted: a preconditioner that no longer fits the
+     * soft modes, not a poor Newton model); refactored, it converged in 4
+     * steps and 62 CG. Why the first matrix fits at 100k and not at 1M was
+     * not found out. */
+    if (mg->slide && (!mg->slide_ok || e->n > SLIDE_REFRESH_N)) mg->slide_ok = spn__slide_factor(mg->slide, e);
     return spn__lines_factor(mg->lv[0].lines, &mg->lv[0].A) ? SPN_OK : SPN_ERR_UNSTABLE;
 }
 
