@@ -77,44 +77,48 @@ static void row_sums(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_t
 }
 
 #if SPN__BSR_AVX
-/* c += a b on 256-bit vectors: row r of c (three lanes and one spare) plus
- * a_r0 b_0 + a_r1 b_1 + a_r2 b_2, rows of b as vectors. Products and sums in
- * the same order as spn__blk_mul_add, no fused multiply-add: the same bits.
- * Each row is read with the next row's first number in its spare lane and
- * written back in row order, so the next row's store repairs it; the last
- * row (and b's) is moved in two and one numbers, never past the block. */
-__attribute__((target("avx"))) static inline void blk_mul_add_avx(const double *restrict a, const double *restrict b,
+/* c += a b on 256-bit vectors, a given as its nine numbers broadcast: row r
+ * of c (three lanes and one spare) plus a_r0 b_0 + a_r1 b_1 + a_r2 b_2, rows
+ * of b as vectors. Products and sums in the same order as spn__blk_mul_add,
+ * no fused multiply-add: the same bits. Each row is read with the next
+ * row's first number in its spare lane and written back in row order, so
+ * the next row's store repairs it; the last row (and b's) is moved in two
+ * and one numbers, never past the block. */
+__attribute__((target("avx"))) static inline void blk_mul_add_avx(const __m256d *a, const double *restrict b,
                                                                    double *restrict c)
 {
     __m256d b0 = _mm256_loadu_pd(b), b1 = _mm256_loadu_pd(b + 3);
     __m256d b2 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(b + 6)), _mm_load_sd(b + 8), 1);
     __m256d c0 = _mm256_loadu_pd(c), c1 = _mm256_loadu_pd(c + 3);
     __m256d c2 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(c + 6)), _mm_load_sd(c + 8), 1);
-    c0 = _mm256_add_pd(c0, _mm256_mul_pd(_mm256_broadcast_sd(a), b0));
-    c1 = _mm256_add_pd(c1, _mm256_mul_pd(_mm256_broadcast_sd(a + 3), b0));
-    c2 = _mm256_add_pd(c2, _mm256_mul_pd(_mm256_broadcast_sd(a + 6), b0));
-    c0 = _mm256_add_pd(c0, _mm256_mul_pd(_mm256_broadcast_sd(a + 1), b1));
-    c1 = _mm256_add_pd(c1, _mm256_mul_pd(_mm256_broadcast_sd(a + 4), b1));
-    c2 = _mm256_add_pd(c2, _mm256_mul_pd(_mm256_broadcast_sd(a + 7), b1));
-    c0 = _mm256_add_pd(c0, _mm256_mul_pd(_mm256_broadcast_sd(a + 2), b2));
-    c1 = _mm256_add_pd(c1, _mm256_mul_pd(_mm256_broadcast_sd(a + 5), b2));
-    c2 = _mm256_add_pd(c2, _mm256_mul_pd(_mm256_broadcast_sd(a + 8), b2));
+    c0 = _mm256_add_pd(c0, _mm256_mul_pd(a[0], b0));
+    c1 = _mm256_add_pd(c1, _mm256_mul_pd(a[3], b0));
+    c2 = _mm256_add_pd(c2, _mm256_mul_pd(a[6], b0));
+    c0 = _mm256_add_pd(c0, _mm256_mul_pd(a[1], b1));
+    c1 = _mm256_add_pd(c1, _mm256_mul_pd(a[4], b1));
+    c2 = _mm256_add_pd(c2, _mm256_mul_pd(a[7], b1));
+    c0 = _mm256_add_pd(c0, _mm256_mul_pd(a[2], b2));
+    c1 = _mm256_add_pd(c1, _mm256_mul_pd(a[5], b2));
+    c2 = _mm256_add_pd(c2, _mm256_mul_pd(a[8], b2));
     _mm256_storeu_pd(c, c0);
     _mm256_storeu_pd(c + 3, c1);
     _mm_storeu_pd(c + 6, _mm256_castpd256_pd128(c2));
     _mm_store_sd(c + 8, _mm256_extractf128_pd(c2, 1));
 }
 
-/* row_sums with blk_mul_add_avx: a third of the instructions. */
+/* row_sums with blk_mul_add_avx (a block of A broadcast once for the row
+ * of B it multiplies): a third of the instructions. */
 __attribute__((target("avx"))) static void row_sums_avx(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_t i,
                                                         bool upper, const uint32_t *pos)
 {
     for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) {
         const double *ab = a->val + 9 * (size_t)p;
+        __m256d av[9];
+        for (int k = 0; k < 9; k++) av[k] = _mm256_broadcast_sd(ab + k);
         uint32_t k = a->col[p];
         for (uint32_t q = b->start[k]; q < b->start[k + 1]; q++) {
             uint32_t j = b->col[q];
-            if (!upper || j >= i) blk_mul_add_avx(ab, b->val + 9 * (size_t)q, c->val + 9 * (size_t)pos[j]);
+            if (!upper || j >= i) blk_mul_add_avx(av, b->val + 9 * (size_t)q, c->val + 9 * (size_t)pos[j]);
         }
     }
 }
