@@ -114,8 +114,7 @@ typedef struct spn__lines spn__lines;
 struct spn__bsr;
 spn__lines *spn__lines_build(const spn__eq *e, const struct spn__bsr *a0);
 bool spn__lines_factor(spn__lines *L, const struct spn__bsr *a0);
-void spn__lines_sweep(const spn__lines *L, const struct spn__bsr *a0, const double *b, double *x, bool forward,
-                      int threads);
+void spn__lines_sweep(const spn__lines *L, const double *b, double *x, bool forward, int threads);
 void spn__lines_free(spn__lines *L);
 /* The lines' particles: line l is node[start[l] .. start[l + 1]). */
 void spn__lines_nodes(const spn__lines *L, uint32_t *count, const uint32_t **start, const uint32_t **node);

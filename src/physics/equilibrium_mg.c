@@ -432,7 +432,7 @@ spn_status spn__mg_setup(spn__mg **out, const spn__eq *e, const double *inv0)
 static void smooth(const spn__mg *mg, int l, const double *b, double *x, bool forward)
 {
     const mg_level *L = &mg->lv[l];
-    if (L->lines) spn__lines_sweep(L->lines, &L->A, b, x, forward, mg->threads);
+    if (L->lines) spn__lines_sweep(L->lines, b, x, forward, mg->threads);
     else spn__bsr_gauss_seidel(&L->A, L->dinv, b, x, forward);
 }
 
