@@ -17,17 +17,6 @@
 
 #define PAR_MIN 16384u /* rows below which a loop stays on one thread */
 
-/* The block products of the setup on 256-bit vectors where the processor
- * has them (GCC or Clang on x86-64; chosen at run time, so the build needs
- * no -march): the same bits either way. */
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(SPN_NO_AVX)
-#define SPN__BSR_AVX 1
-#include <immintrin.h>
-static bool have_avx(void) { return __builtin_cpu_supports("avx"); }
-#else
-#define SPN__BSR_AVX 0
-static bool have_avx(void) { return false; }
-#endif
 
 static inline int team(uint32_t rows, int threads) { return rows < PAR_MIN ? 1 : threads; }
 
@@ -76,7 +65,7 @@ static void row_sums(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_t
     }
 }
 
-#if SPN__BSR_AVX
+#if SPN__AVX
 /* c += a b on 256-bit vectors, a given as its nine numbers broadcast: row r
  * of c (three lanes and one spare) plus a_r0 b_0 + a_r1 b_1 + a_r2 b_2, rows
  * of b as vectors. Products and sums in the same order as spn__blk_mul_add,
@@ -144,7 +133,7 @@ static void row_values(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32
             pos[j] = cnt;
             c->col[cnt++] = j;
         }
-#if SPN__BSR_AVX
+#if SPN__AVX
     if (avx) {
         row_sums_avx(a, b, c, i, upper, pos);
         return;
@@ -180,7 +169,7 @@ static bool mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_fir
     c->cols = b->cols;
     int nt = team(a->rows, threads);
     size_t per = b->cols ? b->cols : 1;
-    bool avx = have_avx();
+    bool avx = spn__have_avx();
     c->start = calloc((size_t)a->rows + 1, sizeof *c->start);
     uint32_t *marks = malloc(2 * (size_t)nt * per * sizeof *marks);
     if (!c->start || !marks) goto fail;
@@ -283,7 +272,7 @@ static inline void row_sum(const spn__bsr *a, uint32_t i, uint32_t p0, const dou
     for (int r = 0; r < 3; r++) s[r] = (l[3 * r] + l[3 * r + 1]) + l[3 * r + 2];
 }
 
-#if SPN__BSR_AVX
+#if SPN__AVX
 /* row_sum on 256-bit vectors: lanes (m_r0 v0, m_r1 v1, m_r2 v2, 0). A row
  * of a block is read with the next number in the spare lane, times a zero;
  * the last row in two and one numbers, never past the block. */
@@ -334,8 +323,8 @@ __attribute__((target("avx"))) static void gauss_seidel_avx(const spn__bsr *a, c
 
 static void rows(const spn__bsr *a, const double *b, const double *x, double *y, bool add, int threads)
 {
-#if SPN__BSR_AVX
-    if (have_avx()) {
+#if SPN__AVX
+    if (spn__have_avx()) {
         rows_avx(a, b, x, y, add, threads);
         return;
     }
@@ -362,8 +351,8 @@ void spn__bsr_residual(const spn__bsr *a, const double *b, const double *x, doub
 
 void spn__bsr_gauss_seidel(const spn__bsr *a, const double *dinv, const double *b, double *x, bool forward)
 {
-#if SPN__BSR_AVX
-    if (have_avx()) {
+#if SPN__AVX
+    if (spn__have_avx()) {
         gauss_seidel_avx(a, dinv, b, x, forward);
         return;
     }

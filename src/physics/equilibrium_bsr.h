@@ -12,6 +12,20 @@
 #include <stddef.h>
 #include <stdint.h>
 
+/* 256-bit vector paths (the Galerkin products, the coarse levels' row sums,
+ * the line sweep) for GCC and Clang on x86-64, chosen at run time so the
+ * build needs no -march; each does the scalar code's operations in the same
+ * order, without fused multiply-adds, so both give the same bits. Build with
+ * -DSPN_NO_AVX to leave them out. */
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(SPN_NO_AVX)
+#define SPN__AVX 1
+#include <immintrin.h>
+static inline bool spn__have_avx(void) { return __builtin_cpu_supports("avx"); }
+#else
+#define SPN__AVX 0
+static inline bool spn__have_avx(void) { return false; }
+#endif
+
 typedef struct spn__bsr {
     uint32_t rows, cols;
     uint32_t *start; /* rows + 1 */

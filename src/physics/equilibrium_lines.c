@@ -76,7 +76,7 @@ struct spn__lines {
     float *offval;       /* 6 per off entry: its symmetric block, in line order */
     float *uval;         /* 6 per line node k (not the last): the block U_k = A(node[k], node[k+1]) */
     float *dinv;         /* 6 per line node: inverted pivots of the factorisation */
-    float *cu;           /* 9 per line node (not the last): Dinv_k U_k, for the back substitution */
+    float *cu;           /* 9 per line node (not the last): Dinv_k U_k by columns, for the back substitution */
     double *work;        /* 3 per line node */
     uint32_t colours, *colour_start; /* lines [colour_start[c], colour_start[c + 1]) have colour c */
 };
@@ -399,7 +399,8 @@ bool spn__lines_factor(spn__lines *L, const spn__bsr *a0)
                 piv[0] = d[0], piv[1] = d[4], piv[2] = d[8], piv[3] = d[1], piv[4] = d[2], piv[5] = d[5];
             } else {
                 schur(d, prev, a0->val + 9 * (size_t)L->upos[k - 1], w, piv);
-                for (int q = 0; q < 9; q++) L->cu[9 * (size_t)(k - 1) + q] = (float)w[q]; /* Dinv_{k-1} U_{k-1} */
+                for (int q = 0; q < 9; q++) /* Dinv_{k-1} U_{k-1}, by columns */
+                    L->cu[9 * (size_t)(k - 1) + 3 * (q % 3) + q / 3] = (float)w[q];
             }
             if (!spn__sym_inverse(piv, inv)) return false;
             for (int q = 0; q < 6; q++) L->dinv[6 * (size_t)k + q] = (float)inv[q];
@@ -446,15 +447,92 @@ static inline void backward_step(const spn__lines *L, uint32_t l, uint32_t t, do
     uint32_t k = L->start[l] + t;
     double *g = L->work + 3 * (size_t)k;
     if (k + 1 < L->start[l + 1]) {
-        const float *m = L->cu + 9 * (size_t)k;
+        const float *m = L->cu + 9 * (size_t)k; /* by columns */
         const double *n = g + 3;
-        g[0] -= (double)m[0] * n[0] + (double)m[1] * n[1] + (double)m[2] * n[2];
-        g[1] -= (double)m[3] * n[0] + (double)m[4] * n[1] + (double)m[5] * n[2];
-        g[2] -= (double)m[6] * n[0] + (double)m[7] * n[1] + (double)m[8] * n[2];
+        g[0] -= (double)m[0] * n[0] + (double)m[3] * n[1] + (double)m[6] * n[2];
+        g[1] -= (double)m[1] * n[0] + (double)m[4] * n[1] + (double)m[7] * n[2];
+        g[2] -= (double)m[2] * n[0] + (double)m[5] * n[1] + (double)m[8] * n[2];
     }
     double *xi = x + 3 * (size_t)L->node[k];
     xi[0] = g[0], xi[1] = g[1], xi[2] = g[2];
 }
+
+#if SPN__AVX
+/* fsym_mul on 256-bit vectors: o = (c0 v0 + c1 v1) + c2 v2 by lanes, c_j
+ * the block's columns (three lanes and a spare), which is fsym_mul's order
+ * in each lane: the same bits. The six floats are read as h[0..3] and
+ * h[2..5] and the columns shuffled out of them. */
+__attribute__((target("avx"))) static inline __m256d fsym_avx(const float *h, __m256d v0, __m256d v1, __m256d v2)
+{
+    __m128 a = _mm_loadu_ps(h), b = _mm_loadu_ps(h + 2);
+    __m256d c0 = _mm256_cvtps_pd(_mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 2, 3, 0))); /* h0 h3 h4 */
+    __m256d c1 = _mm256_cvtps_pd(_mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 3, 1, 3))); /* h3 h1 h5 */
+    __m256d c2 = _mm256_cvtps_pd(_mm_shuffle_ps(b, a, _MM_SHUFFLE(0, 2, 3, 2))); /* h4 h5 h2 */
+    return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(c0, v0), _mm256_mul_pd(c1, v1)), _mm256_mul_pd(c2, v2));
+}
+
+/* forward_step with fsym_avx for the couplings and U; the pivot's inverse
+ * stays scalar (the right-hand side's lanes would need moving across). */
+__attribute__((target("avx"))) static inline void forward_step_avx(const spn__lines *L, uint32_t l, uint32_t t,
+                                                                    const double *b, const double *x)
+{
+    uint32_t k = L->start[l] + t, i = L->node[k];
+    __m256d r = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(b + 3 * (size_t)i)),
+                                     _mm_load_sd(b + 3 * (size_t)i + 2), 1);
+    for (uint32_t q = L->off_start[k]; q < L->off_start[k + 1]; q++) {
+        const double *v = x + 3 * (size_t)L->offcol[q];
+        r = _mm256_sub_pd(r, fsym_avx(L->offval + 6 * (size_t)q, _mm256_broadcast_sd(v), _mm256_broadcast_sd(v + 1),
+                                      _mm256_broadcast_sd(v + 2)));
+    }
+    if (t > 0) { /* r -= U_{t-1}^T g_{t-1}; U is symmetric */
+        const double *gp = L->work + 3 * (size_t)(k - 1);
+        r = _mm256_sub_pd(r, fsym_avx(L->uval + 6 * (size_t)(k - 1), _mm256_broadcast_sd(gp),
+                                      _mm256_broadcast_sd(gp + 1), _mm256_broadcast_sd(gp + 2)));
+    }
+    double rr[4];
+    _mm256_storeu_pd(rr, r);
+    fsym_mul(L->dinv + 6 * (size_t)k, rr[0], rr[1], rr[2], L->work + 3 * (size_t)k);
+}
+
+/* backward_step on 256-bit vectors: g -= (c0 n0 + c1 n1) + c2 n2 by lanes,
+ * c_j the columns of Dinv U (stored by columns): backward_step's order. */
+__attribute__((target("avx"))) static inline void backward_step_avx(const spn__lines *L, uint32_t l, uint32_t t,
+                                                                     double *x)
+{
+    uint32_t k = L->start[l] + t;
+    double *g = L->work + 3 * (size_t)k, *xi = x + 3 * (size_t)L->node[k];
+    if (k + 1 < L->start[l + 1]) {
+        const float *m = L->cu + 9 * (size_t)k;
+        const double *n = g + 3;
+        __m128 c = _mm_loadu_ps(m + 5);
+        __m256d c0 = _mm256_cvtps_pd(_mm_loadu_ps(m)), c1 = _mm256_cvtps_pd(_mm_loadu_ps(m + 3));
+        __m256d c2 = _mm256_cvtps_pd(_mm_shuffle_ps(c, c, _MM_SHUFFLE(3, 3, 2, 1)));
+        __m256d o = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(c0, _mm256_broadcast_sd(n)),
+                                                _mm256_mul_pd(c1, _mm256_broadcast_sd(n + 1))),
+                                  _mm256_mul_pd(c2, _mm256_broadcast_sd(n + 2)));
+        __m256d gv = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(g)), _mm_load_sd(g + 2), 1);
+        gv = _mm256_sub_pd(gv, o);
+        _mm_storeu_pd(g, _mm256_castpd256_pd128(gv));
+        _mm_store_sd(g + 2, _mm256_extractf128_pd(gv, 1));
+    }
+    xi[0] = g[0], xi[1] = g[1], xi[2] = g[2];
+}
+
+/* solve_group with forward_step_avx and backward_step_avx. */
+__attribute__((target("avx"))) static void solve_group_avx(const spn__lines *L, uint32_t l0, uint32_t l1,
+                                                           const double *b, double *x)
+{
+    uint32_t longest = 0;
+    for (uint32_t l = l0; l < l1; l++)
+        if (L->start[l + 1] - L->start[l] > longest) longest = L->start[l + 1] - L->start[l];
+    for (uint32_t t = 0; t < longest; t++)
+        for (uint32_t l = l0; l < l1; l++)
+            if (t < L->start[l + 1] - L->start[l]) forward_step_avx(L, l, t, b, x);
+    for (uint32_t t = longest; t-- > 0;)
+        for (uint32_t l = l0; l < l1; l++)
+            if (t < L->start[l + 1] - L->start[l]) backward_step_avx(L, l, t, x);
+}
+#endif
 
 /* Lines [l0, l1) of one colour, stepped together. */
 static void solve_group(const spn__lines *L, uint32_t l0, uint32_t l1, const double *b, double *x)
@@ -472,13 +550,23 @@ static void solve_group(const spn__lines *L, uint32_t l0, uint32_t l1, const dou
 
 void spn__lines_sweep(const spn__lines *L, const double *b, double *x, bool forward, int threads)
 {
+    const bool avx = spn__have_avx();
+    (void)avx;
     for (uint32_t k = 0; k < L->colours; k++) {
         uint32_t c = forward ? k : L->colours - 1 - k;
         uint32_t l0 = L->colour_start[c], l1 = L->colour_start[c + 1], groups = (l1 - l0 + GROUP - 1) / GROUP;
         int team = L->start[l1] - L->start[l0] < PAR_MIN ? 1 : threads;
         (void)team;
 #pragma omp parallel for schedule(static) num_threads(team)
-        for (uint32_t g = 0; g < groups; g++)
-            solve_group(L, l0 + g * GROUP, l0 + (g + 1) * GROUP < l1 ? l0 + (g + 1) * GROUP : l1, b, x);
+        for (uint32_t g = 0; g < groups; g++) {
+            uint32_t g0 = l0 + g * GROUP, g1 = l0 + (g + 1) * GROUP < l1 ? l0 + (g + 1) * GROUP : l1;
+#if SPN__AVX
+            if (avx) {
+                solve_group_avx(L, g0, g1, b, x);
+                continue;
+            }
+#endif
+            solve_group(L, g0, g1, b, x);
+        }
     }
 }
