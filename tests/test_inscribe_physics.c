@@ -182,6 +182,38 @@ static void test_compaction_keeps_the_world_settings(void **state)
     spn_world_destroy(w);
 }
 
+/* A broken half of a divided capture thread: its middle particle is left
+ * with one live thread, which dangles and goes, and the particle goes with
+ * its broken spring (the rebuild used to look up the dropped particle's id). */
+static void test_broken_half_goes_with_its_particle(void **state)
+{
+    (void)state;
+    spn_world *w = inscribe_orb();
+    uint32_t np0 = spn_world_particle_count(w);
+    subdivide_capture(&w);
+    uint32_t half = SPN_REMOVED;
+    for (uint32_t s = 0; s < spn_world_spring_count(w) && half == SPN_REMOVED; s++) {
+        spn_spring_info si = spn_world_spring(w, s);
+        bool right = spn_world_position(w, si.a).x > 0.05 && spn_world_position(w, si.b).x > 0.05;
+        if (si.tag == SPN_THREAD_CAPTURE && right) half = s;
+    }
+    assert_true(half != SPN_REMOVED);
+    assert_true(spn_world_spring(w, half).a >= np0 || spn_world_spring(w, half).b >= np0); /* ends on a middle */
+    spn_world_break_spring(w, half);
+    spn_target *t = NULL;
+    assert_int_equal(spn_target_create(w, 1200, &t), SPN_OK);
+    spn_target_paint(t, left_third, NULL);
+    spn_inscribe_def d = spn_inscribe_def_default();
+    d.settle = false;
+    spn_inscribe_report rep;
+    assert_int_equal(spn_inscribe(&w, t, &d, &rep), SPN_OK);
+    assert_int_equal(rep.particles_removed, rep.removed + 1);
+    for (uint32_t s = 0; s < spn_world_spring_count(w); s++) assert_false(spn_world_spring(w, s).broken);
+    check_hangs_whole(w);
+    spn_target_destroy(t);
+    spn_world_destroy(w);
+}
+
 static void test_failure_leaves_the_web_alone(void **state)
 {
     (void)state;
@@ -210,6 +242,7 @@ int main(void)
         cmocka_unit_test(test_inscribed_web_is_settled_and_whole),
         cmocka_unit_test(test_subdivided_segments_go_whole),
         cmocka_unit_test(test_compaction_keeps_the_world_settings),
+        cmocka_unit_test(test_broken_half_goes_with_its_particle),
         cmocka_unit_test(test_failure_leaves_the_web_alone),
     };
     int failed = cmocka_run_group_tests(tests, NULL, NULL);
