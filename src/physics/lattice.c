@@ -49,7 +49,9 @@ static void lattice_free(spn__lattice *L)
 {
     if (!L) return;
     free(L->rk), free(L->rkd), free(L->rrest), free(L->gk), free(L->gkd), free(L->grest);
-    free(L->cut), free(L->partial), free(L->rk4), free(L->state);
+    free(L->cut), free(L->partial), free(L->rk4), free(L->state), free(L->partial_k);
+    for (int t = 0; t < L->nbws; t++) free(L->bws[t]);
+    free(L->bws);
     spn__lat32_free(L->f32);
     for (int t = 0; t < L->nws; t++) free(L->ws[t]);
     free(L->ws);
@@ -219,39 +221,25 @@ LAT_INLINE void finish(const lat_args *a, size_t p0, uint32_t n, double *const *
     }
     double *X[3], *V[3];
     for (int c = 0; c < 3; c++) X[c] = L->x[c] + p0, V[c] = L->v[c] + p0;
-    /* (sym a constant in each call: GCC 12 does not vectorise a select on a
-     * run-time bool) */
-#define ROW64(sym)                                                                                              \
-    row64(n, sym, a->dt, a->g, a->drag, a->mass + p0, a->inv_mass + p0, X[0], X[1], X[2], V[0], V[1], V[2], ri[0], \
-          ri[1], ri[2], rg[0], rg[1], rg[2], ro ? ro[0] : NULL, ro ? ro[1] : NULL, ro ? ro[2] : NULL, t[0], t[1], t[2])
-    if (a->mode == MODE_SYMPLECTIC) ROW64(true);
-    else ROW64(false);
-#undef ROW64
-    lane_add64(acc[L_MV2], t[0], n);
-    lane_add64(acc[L_GAIN], t[1], n);
-    lane_add64(acc[L_MVN2], t[2], n);
+    lat_row_move(a, p0, n, X, V, ri, rg, ro, t, acc);
 }
 
 /* The hub: its radial forces in radial order, then its update. */
 static void hub(const lat_args *a, double *const *rad, double *const *t, double (*acc)[LANES])
 {
-    const spn__lattice *L = a->L;
-    const uint32_t n = L->radials;
+    if (a->mode != MODE_RK4_STAGE && a->mode != MODE_RK4_LAST) {
+        lat_hub_move(a, rad, acc);
+        return;
+    }
+    const uint32_t n = a->L->radials;
     const double m = a->mass[0], dm = a->drag * m;
     double f[3];
     for (int c = 0; c < 3; c++) {
         f[c] = m * a->g[c] - dm * a->ev[c][0];
         for (uint32_t i = 0; i < n; i++) f[c] += rad[c][i];
     }
-    if (a->mode == MODE_RK4_STAGE || a->mode == MODE_RK4_LAST) {
-        double *Fp[3] = {f, f + 1, f + 2};
-        rk4_update(a, 0, 1, Fp, t, acc);
-        return;
-    }
-    const moved64 o = one64(f[0], f[1], f[2], a->inv_mass[0], m, L->x[0][0], L->x[1][0], L->x[2][0], L->v[0][0],
-                            L->v[1][0], L->v[2][0], a->mode == MODE_SYMPLECTIC, a->dt, a->g);
-    for (int c = 0; c < 3; c++) L->x[c][0] = o.x[c], L->v[c][0] = o.v[c];
-    acc[L_MV2][0] += o.mv2, acc[L_GAIN][0] += o.gain, acc[L_MVN2][0] += o.mvn2;
+    double *Fp[3] = {f, f + 1, f + 2};
+    rk4_update(a, 0, 1, Fp, t, acc);
 }
 
 /* Radial springs into band b's first row, from the state before the step. */
@@ -535,4 +523,33 @@ bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r)
     r->dissipated = dt / 6 * damp;
     end(w, threads);
     return true;
+}
+
+/* Up to k explicit steps as one blocked pass (lattice_block.c), inside a
+ * replayable spn_world_advance on a web too big for the caches (from
+ * def.parallel_min particles, the size from which a step is spread over
+ * threads); each step's results into r[]. The count done, 0 when a blocked
+ * pass does not apply (the caller then takes single steps). */
+int spn__lattice_explicit_block(spn_world *w, double dt, bool symplectic, int k, spn__step_result *r)
+{
+    if (k > LAT_LEVELS) k = LAT_LEVELS;
+    if (k < 2 || !w->no_backup || w->np < w->def.parallel_min || w->precision == SPN_PRECISION_FLOAT32) return 0;
+    const int threads = ready(w);
+    if (!threads || !spn__lattice_block_ready(w->lat, threads, (uint32_t)k)) return 0;
+    spn__lat32_sync(w);
+    lat_args a;
+    if (!begin(w, threads, dt, false, &a)) return 0;
+    a.mode = symplectic ? MODE_SYMPLECTIC : MODE_EULER;
+    double sums[LAT_LEVELS][L_NSUMS];
+    if (!spn__lattice_block(w->lat, &a, threads, (uint32_t)k, sums)) return 0;
+    for (int q = 0; q < k; q++) {
+        const double *sum = sums[q];
+        r[q].elastic = sum[L_ELASTIC];
+        r[q].e_before = 0.5 * sum[L_MV2] + sum[L_ELASTIC];
+        r[q].gain_kp = sum[L_GAIN];
+        r[q].work = 0;
+        r[q].dissipated = dt * (sum[L_DAMP] + w->def.drag * sum[L_MV2]);
+        r[q].kinetic = 0.5 * sum[L_MVN2];
+    }
+    return k;
 }

@@ -18,6 +18,8 @@
  * evaluated state, energy gain of the update, sum m v^2 after it. */
 enum { L_ELASTIC, L_DAMP, L_MV2, L_GAIN, L_MVN2, L_NSUMS };
 #define LANES 8
+/* Steps a pass of the blocked sweep takes (lattice_block.c). */
+#define LAT_LEVELS SPN__LAT_BLOCK_MAX
 #define LAT_INLINE static inline __attribute__((always_inline))
 
 /* Arrays of one thread's workspace, `stride` doubles each. */
@@ -64,6 +66,11 @@ struct spn__lattice {
     bool live;       /* inside spn_world_advance: x, v above are ahead of w->x, w->v */
     double *rk4;     /* RK4 (on first use): two trial states, 6 x np each, ax, av */
     double *trial[2][6], *ax[3], *av[3];
+    double **bws;      /* temporal blocking (lattice_block.c): per-thread workspaces */
+    int nbws;
+    size_t block_size; /* doubles in each */
+    double *partial_k; /* per level and band: L_NSUMS */
+    uint32_t npartial_k;
     spn__lat32 *f32; /* the float32 step (on first use) */
 };
 
@@ -147,5 +154,52 @@ LAT_INLINE void springs_rows(uint32_t n, const double *const *ax, const double *
     lane_add64(acc_e, e, n);
     lane_add64(acc_p, p, n);
 }
+
+
+/* The explicit hub: its radial forces (in radial order) added to gravity and
+ * drag, then moved in place; its sum terms into acc. */
+LAT_INLINE void lat_hub_move(const lat_args *a, double *const *rad, double (*acc)[LANES])
+{
+    const spn__lattice *L = a->L;
+    const uint32_t n = L->radials;
+    const double m = a->mass[0], dm = a->drag * m;
+    double f[3];
+    for (int c = 0; c < 3; c++) {
+        f[c] = m * a->g[c] - dm * a->ev[c][0];
+        for (uint32_t i = 0; i < n; i++) f[c] += rad[c][i];
+    }
+    const moved64 o = one64(f[0], f[1], f[2], a->inv_mass[0], m, L->x[0][0], L->x[1][0], L->x[2][0], L->v[0][0],
+                            L->v[1][0], L->v[2][0], a->mode == MODE_SYMPLECTIC, a->dt, a->g);
+    for (int c = 0; c < 3; c++) L->x[c][0] = o.x[c], L->v[c][0] = o.v[c];
+    acc[L_MV2][0] += o.mv2, acc[L_GAIN][0] += o.gain, acc[L_MVN2][0] += o.mvn2;
+}
+
+/* An explicit row (particles p0 .., state arrays X, V) with its forces
+ * complete (radial in, ring, radial out or NULL), moved in place; its sum
+ * terms through t into acc. */
+LAT_INLINE void lat_row_move(const lat_args *a, size_t p0, uint32_t n, double *const *X, double *const *V,
+                             double *const *ri, double *const *rg, double *const *ro, double *const *t,
+                             double (*acc)[LANES])
+{
+    /* (sym a constant in each call: GCC 12 does not vectorise a select on a
+     * run-time bool) */
+#define ROW64(sym)                                                                                              \
+    row64(n, sym, a->dt, a->g, a->drag, a->mass + p0, a->inv_mass + p0, X[0], X[1], X[2], V[0], V[1], V[2], ri[0], \
+          ri[1], ri[2], rg[0], rg[1], rg[2], ro ? ro[0] : NULL, ro ? ro[1] : NULL, ro ? ro[2] : NULL, t[0], t[1], t[2])
+    if (a->mode == MODE_SYMPLECTIC) ROW64(true);
+    else ROW64(false);
+#undef ROW64
+    lane_add64(acc[L_MV2], t[0], n);
+    lane_add64(acc[L_GAIN], t[1], n);
+    lane_add64(acc[L_MVN2], t[2], n);
+}
+
+/* Whether K explicit steps can go as one blocked pass on `threads` threads
+ * (each thread's run of bands deep enough for its ghost rows). */
+bool spn__lattice_block_ready(const spn__lattice *L, int threads, uint32_t K);
+/* K (2 .. LAT_LEVELS) explicit steps of a (mode, dt; state in L->x, L->v) in
+ * one blocked pass; each step's sums into sums[step]. False when out of
+ * memory (nothing done). */
+bool spn__lattice_block(spn__lattice *L, const lat_args *a, int threads, uint32_t K, double sums[][L_NSUMS]);
 
 #endif
