@@ -116,22 +116,24 @@ static void test_bands_and_threads(void **state)
 }
 
 /* Steps several to a pass over memory (spn_world_advance on a web of at
- * least def.parallel_min particles, lattice_block.c): the same bits as single
- * steps, in the state and in the energy books, on 1 and 2 threads, and a
+ * least def.parallel_min particles, lattice_block.c: four explicit steps or
+ * the four stages of an RK4 step to a pass): the same bits as single steps, in the state and in the energy books, on 1 and 2 threads, and a
  * blow-up inside a pass found at the same step as without passes. */
 static void test_blocked_passes(void **state)
 {
     (void)state;
-    const spn_integrator integs[] = {SPN_INTEGRATOR_EULER, SPN_INTEGRATOR_SYMPLECTIC};
-    for (int k = 0; k < 2; k++) {
+    const spn_integrator integs[] = {SPN_INTEGRATOR_EULER, SPN_INTEGRATOR_SYMPLECTIC, SPN_INTEGRATOR_RK4};
+    for (int k = 0; k < 3; k++) {
         const double dt = integs[k] == SPN_INTEGRATOR_EULER ? 2e-7 : 2e-6;
+        /* explicit: 7 passes of 4 steps, 1 single step; RK4: a pass a step */
+        const int blocked = integs[k] == SPN_INTEGRATOR_RK4 ? 29 : 28;
         spn_world *one = disturbed_orb(integs[k], 40, 50, 1, 256, true);
         spn_world *two = disturbed_orb(integs[k], 40, 50, 2, 256, true);
         spn_world *ref = disturbed_orb(integs[k], 40, 50, 1, 256, true);
         assert_int_equal(spn_world_advance(one, dt, 29), SPN_OK);
-        assert_int_equal(spn_world_last_step(one).blocked, 28); /* 7 passes of 4, 1 single step */
+        assert_int_equal(spn_world_last_step(one).blocked, blocked);
         assert_int_equal(spn_world_advance(two, dt, 29), SPN_OK);
-        assert_int_equal(spn_world_last_step(two).blocked, 28);
+        assert_int_equal(spn_world_last_step(two).blocked, blocked);
         for (int i = 0; i < 29; i++) assert_int_equal(spn_world_step(ref, dt), SPN_OK);
         assert_same_state(one, ref);
         assert_same_state(two, ref);

@@ -183,29 +183,13 @@ LAT_INLINE void rk4_update(const lat_args *a, size_t p0, uint32_t n, double *con
                            double (*acc)[LANES])
 {
     const spn__lattice *L = a->L;
-    const double *m = a->mass + p0, *im = a->inv_mass + p0;
-    const double *V[3] = {a->ev[0] + p0, a->ev[1] + p0, a->ev[2] + p0};
-    if (a->mode == MODE_RK4_STAGE) {
-        rk4_kin64(n, m, im, V[0], V[1], V[2], t[0], t[1], t[2]);
-        /* (three calls, not a loop: GCC 12 does not vectorise an inlined
-         * function with restrict parameters inside a loop) */
-        rk4_stage64(n, a->first, a->h, a->weight, im, V[0], F[0], L->x[0] + p0, L->v[0] + p0, a->tx[0] + p0,
-                    a->tv[0] + p0, L->ax[0] + p0, L->av[0] + p0);
-        rk4_stage64(n, a->first, a->h, a->weight, im, V[1], F[1], L->x[1] + p0, L->v[1] + p0, a->tx[1] + p0,
-                    a->tv[1] + p0, L->ax[1] + p0, L->av[1] + p0);
-        rk4_stage64(n, a->first, a->h, a->weight, im, V[2], F[2], L->x[2] + p0, L->v[2] + p0, a->tx[2] + p0,
-                    a->tv[2] + p0, L->ax[2] + p0, L->av[2] + p0);
-    } else {
-        rk4_sums64(n, a->h, a->g, m, im, V[0], V[1], V[2], F[0], F[1], F[2], L->ax[0] + p0, L->ax[1] + p0,
-                   L->ax[2] + p0, L->av[0] + p0, L->av[1] + p0, L->av[2] + p0, L->v[0] + p0, L->v[1] + p0,
-                   L->v[2] + p0, t[0], t[1], t[2]);
-        rk4_last64(n, a->h, im, V[0], F[0], L->ax[0] + p0, L->av[0] + p0, L->x[0] + p0, L->v[0] + p0);
-        rk4_last64(n, a->h, im, V[1], F[1], L->ax[1] + p0, L->av[1] + p0, L->x[1] + p0, L->v[1] + p0);
-        rk4_last64(n, a->h, im, V[2], F[2], L->ax[2] + p0, L->av[2] + p0, L->x[2] + p0, L->v[2] + p0);
+    rk4_rows R;
+    for (int c = 0; c < 3; c++) {
+        R.V[c] = a->ev[c] + p0, R.xb[c] = L->x[c] + p0, R.vb[c] = L->v[c] + p0;
+        R.xt[c] = a->tx[c] ? a->tx[c] + p0 : NULL, R.vt[c] = a->tv[c] ? a->tv[c] + p0 : NULL;
+        R.ax[c] = L->ax[c] + p0, R.av[c] = L->av[c] + p0;
     }
-    lane_add64(acc[L_MV2], t[0], n);
-    lane_add64(acc[L_GAIN], t[1], n);
-    lane_add64(acc[L_MVN2], t[2], n);
+    lat_rk4_update(a, p0, n, &R, F, t, acc);
 }
 
 /* Row p0 complete (radial in, ring, radial out or NULL): its update. */
@@ -231,13 +215,9 @@ static void hub(const lat_args *a, double *const *rad, double *const *t, double 
         lat_hub_move(a, rad, acc);
         return;
     }
-    const uint32_t n = a->L->radials;
-    const double m = a->mass[0], dm = a->drag * m;
+    const double v[3] = {a->ev[0][0], a->ev[1][0], a->ev[2][0]};
     double f[3];
-    for (int c = 0; c < 3; c++) {
-        f[c] = m * a->g[c] - dm * a->ev[c][0];
-        for (uint32_t i = 0; i < n; i++) f[c] += rad[c][i];
-    }
+    lat_hub_force(a, v, rad, f);
     double *Fp[3] = {f, f + 1, f + 2};
     rk4_update(a, 0, 1, Fp, t, acc);
 }
@@ -525,23 +505,48 @@ bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r)
     return true;
 }
 
-/* Up to k explicit steps as one blocked pass (lattice_block.c), inside a
- * replayable spn_world_advance on a web too big for the caches (from
- * def.parallel_min particles, the size from which a step is spread over
- * threads); each step's results into r[]. The count done, 0 when a blocked
+/* Steps as blocked passes (lattice_block.c), inside a replayable
+ * spn_world_advance on a web too big for the caches (from def.parallel_min
+ * particles, the size from which a step is spread over threads): up to k
+ * Euler or symplectic steps in one pass, or one RK4 step (its four stages)
+ * per pass. Each step's results into r[]; the count done, 0 when a blocked
  * pass does not apply (the caller then takes single steps). */
-int spn__lattice_explicit_block(spn_world *w, double dt, bool symplectic, int k, spn__step_result *r)
+int spn__lattice_block_steps(spn_world *w, double dt, int k, spn__step_result *r)
 {
+    const spn_integrator in = w->def.integrator;
+    const bool rk4 = in == SPN_INTEGRATOR_RK4;
+    if (!rk4 && in != SPN_INTEGRATOR_EULER && in != SPN_INTEGRATOR_SYMPLECTIC) return 0;
     if (k > LAT_LEVELS) k = LAT_LEVELS;
-    if (k < 2 || !w->no_backup || w->np < w->def.parallel_min || w->precision == SPN_PRECISION_FLOAT32) return 0;
+    const uint32_t levels = rk4 ? 4 : (uint32_t)k;
+    if (levels < 2 || !w->no_backup || w->np < w->def.parallel_min || w->precision == SPN_PRECISION_FLOAT32)
+        return 0;
     const int threads = ready(w);
-    if (!threads || !spn__lattice_block_ready(w->lat, threads, (uint32_t)k)) return 0;
+    if (!threads || !spn__lattice_block_ready(w->lat, threads, levels)) return 0;
     spn__lat32_sync(w);
-    lat_args a;
-    if (!begin(w, threads, dt, false, &a)) return 0;
-    a.mode = symplectic ? MODE_SYMPLECTIC : MODE_EULER;
+    lat_args la[LAT_LEVELS];
+    if (!begin(w, threads, dt, false, &la[0])) return 0;
+    static const double weight[4] = {1, 2, 2, 1}, frac[4] = {0, 0.5, 0.5, 1};
+    for (uint32_t s = 0; s < levels; s++) {
+        la[s] = la[0];
+        la[s].mode = rk4 ? (s < 3 ? MODE_RK4_STAGE : MODE_RK4_LAST)
+                         : (in == SPN_INTEGRATOR_SYMPLECTIC ? MODE_SYMPLECTIC : MODE_EULER);
+        la[s].first = s == 0;
+        la[s].weight = weight[s % 4];
+        la[s].h = s < 3 ? frac[s + 1] * dt : dt / 6;
+    }
     double sums[LAT_LEVELS][L_NSUMS];
-    if (!spn__lattice_block(w->lat, &a, threads, (uint32_t)k, sums)) return 0;
+    if (!spn__lattice_block(w->lat, la, rk4, threads, levels, sums)) return 0;
+    if (rk4) {
+        double damp = 0;
+        for (int s = 0; s < 4; s++) damp += weight[s] * (sums[s][L_DAMP] + w->def.drag * sums[s][L_MV2]);
+        r[0].e_before = 0.5 * sums[0][L_MV2] + sums[0][L_ELASTIC];
+        r[0].elastic = sums[0][L_ELASTIC];
+        r[0].gain_kp = sums[3][L_GAIN];
+        r[0].kinetic = 0.5 * sums[3][L_MVN2];
+        r[0].work = 0;
+        r[0].dissipated = dt / 6 * damp;
+        return 1;
+    }
     for (int q = 0; q < k; q++) {
         const double *sum = sums[q];
         r[q].elastic = sum[L_ELASTIC];

@@ -44,10 +44,17 @@ typedef struct level {
 } level;
 
 typedef struct block {
-    const lat_args *a;
+    const lat_args *la;       /* per level: the step's arguments (RK4: the stage's) */
+    const spn__lattice *L;
+    bool rk4;
     uint32_t R0, R1, K;       /* own rows [R0, R1), levels */
     double *ghost[2 * LAT_LEVELS][6];
-    double *hub[6], *e, *p, *t[3];
+    double *hub[6], *e, *p, *t[3], *F[3];
+    /* RK4: the trial state of levels 1-3 by row mod 4 and the weighted sums
+     * ax, av by row mod 8 (a row's live for at most 2 and 5 fronts), and
+     * the hub's */
+    double *trial[LAT_LEVELS - 1][4][6], *sums[8][6];
+    double hub_trial[LAT_LEVELS - 1][6], hub_sums[6];
     double dummy[L_NSUMS + 4][LANES];
     level lv[LAT_LEVELS];
 } block;
@@ -55,7 +62,7 @@ typedef struct block {
 /* Row j's x and v arrays: the state for own rows, a ghost buffer else. */
 static void row_ptrs(const block *B, uint32_t j, double **X, double **V)
 {
-    const spn__lattice *L = B->a->L;
+    const spn__lattice *L = B->L;
     if (j >= B->R0 && j < B->R1) {
         const size_t p0 = 1 + (size_t)j * L->radials;
         for (int c = 0; c < 3; c++) X[c] = L->x[c] + p0, V[c] = L->v[c] + p0;
@@ -69,12 +76,24 @@ static uint32_t band_of(const spn__lattice *L, uint32_t j) { return j / L->band_
 
 static bool own(const block *B, uint32_t j) { return j >= B->R0 && j < B->R1; }
 
+/* Row j at level s - 1, the state the forces of level s are taken at: the
+ * state itself, or an RK4 trial state. */
+static void eval_ptrs(const block *B, uint32_t s, uint32_t j, double **X, double **V)
+{
+    if (!B->rk4 || s == 1) {
+        row_ptrs(B, j, X, V);
+        return;
+    }
+    double *const *T = B->trial[s - 2][j % 4];
+    for (int c = 0; c < 3; c++) X[c] = T[c], V[c] = T[3 + c];
+}
+
 /* Lowest and one past the highest row this block steps at level s. */
 static uint32_t low(const block *B, uint32_t s) { return B->R0 ? B->R0 - B->K + s : 0; }
 
 static uint32_t high(const block *B, uint32_t s)
 {
-    const uint32_t rings = B->a->L->rings;
+    const uint32_t rings = B->L->rings;
     return B->R1 == rings ? rings : B->R1 + B->K - s;
 }
 
@@ -84,7 +103,7 @@ static void store_level(const block *B, double *partial, uint32_t s, uint32_t b)
 {
     level *lv = (level *)&B->lv[s - 1];
     const int q = (int)(b & 1);
-    const spn__lattice *L = B->a->L;
+    const spn__lattice *L = B->L;
     double *out = partial + ((size_t)(s - 1) * L->nbands + b) * L_NSUMS;
     if (b) out[L_ELASTIC] = lane_total(lv->cut_e[q]), out[L_DAMP] = lane_total(lv->cut_p[q]);
     store_band_sums(out, b == 0, lv->acc_e[q], lv->acc_p[q], lv->acc[q]);
@@ -97,14 +116,14 @@ static void store_level(const block *B, double *partial, uint32_t s, uint32_t b)
  * target_clones version of it vectorises its own copy.) */
 LAT_INLINE void op(block *B, double *partial, uint32_t s, uint32_t j)
 {
-    const lat_args *a = B->a;
-    const spn__lattice *L = a->L;
+    const lat_args *a = &B->la[s - 1];
+    const spn__lattice *L = B->L;
     level *lv = &B->lv[s - 1];
     const uint32_t n = L->radials, rings = L->rings, hi = high(B, s);
     const int cur = lv->cur;
     double *X[3], *V[3], *Xp[3], *Vp[3];
-    if (j < rings) row_ptrs(B, j, X, V);
     if (j < rings) {
+        eval_ptrs(B, s, j, X, V);
         const size_t s0 = (size_t)j * n;
         const bool mine = own(B, j) && j < hi;
         const int q = (int)(band_of(L, j) & 1);
@@ -112,16 +131,32 @@ LAT_INLINE void op(block *B, double *partial, uint32_t s, uint32_t j)
         double *ae = mine ? (cut ? lv->cut_e[q] : lv->acc_e[q]) : B->dummy[0];
         double *ap = mine ? (cut ? lv->cut_p[q] : lv->acc_p[q]) : B->dummy[1];
         if (j == 0) {
+            double hx[3], hv[3];
+            const bool base = !B->rk4 || s == 1;
             for (int c = 0; c < 3; c++) {
-                const double hx = L->x[c][0], hv = L->v[c][0];
-                for (uint32_t i = 0; i < n; i++) B->hub[c][i] = hx, B->hub[3 + c][i] = hv;
+                hx[c] = base ? L->x[c][0] : B->hub_trial[s - 2][c];
+                hv[c] = base ? L->v[c][0] : B->hub_trial[s - 2][3 + c];
+                for (uint32_t i = 0; i < n; i++) B->hub[c][i] = hx[c], B->hub[3 + c][i] = hv[c];
             }
             springs_rows(n, (const double *const *)B->hub, (const double *const *)B->hub + 3,
                          (const double *const *)X, (const double *const *)V, 0, 0, L->rk, L->rkd, L->rrest,
                          lv->rad[cur], 0, B->e, B->p, ae, ap);
-            lat_hub_move(a, lv->rad[cur], lv->acc[q]);
+            if (B->rk4) {
+                double f[3], *Fp[3] = {f, f + 1, f + 2};
+                lat_hub_force(a, hv, lv->rad[cur], f);
+                rk4_rows R;
+                for (int c = 0; c < 3; c++) {
+                    R.V[c] = &hv[c], R.xb[c] = &L->x[c][0], R.vb[c] = &L->v[c][0];
+                    R.xt[c] = s < 4 ? &B->hub_trial[s - 1][c] : NULL;
+                    R.vt[c] = s < 4 ? &B->hub_trial[s - 1][3 + c] : NULL;
+                    R.ax[c] = &B->hub_sums[c], R.av[c] = &B->hub_sums[3 + c];
+                }
+                lat_rk4_update(a, 0, 1, &R, Fp, B->t, lv->acc[q]);
+            } else {
+                lat_hub_move(a, lv->rad[cur], lv->acc[q]);
+            }
         } else {
-            row_ptrs(B, j - 1, Xp, Vp);
+            eval_ptrs(B, s, j - 1, Xp, Vp);
             springs_rows(n, (const double *const *)Xp, (const double *const *)Vp, (const double *const *)X,
                          (const double *const *)V, 0, 0, L->rk + s0, L->rkd + s0, L->rrest + s0, lv->rad[cur], 0,
                          B->e, B->p, ae, ap);
@@ -139,11 +174,27 @@ LAT_INLINE void op(block *B, double *partial, uint32_t s, uint32_t j)
     if (j > low(B, s)) {
         const uint32_t r = j - 1;
         const size_t p0 = 1 + (size_t)r * n;
-        row_ptrs(B, r, Xp, Vp);
         const bool mine = own(B, r);
         const uint32_t b = band_of(L, r);
         double(*acc)[LANES] = mine ? lv->acc[b & 1] : B->dummy + 2;
-        lat_row_move(a, p0, n, Xp, Vp, lv->rad_prev, lv->ring[cur ^ 1], j < rings ? lv->rad[cur] : NULL, B->t, acc);
+        double *const *ro = j < rings ? lv->rad[cur] : NULL;
+        row_ptrs(B, r, Xp, Vp);
+        if (B->rk4) {
+            double *EX[3], *EV[3];
+            eval_ptrs(B, s, r, EX, EV);
+            rk4_rows R;
+            for (int c = 0; c < 3; c++) {
+                assemble64(n, a->g[c], a->drag, a->mass + p0, EV[c], lv->rad_prev[c], lv->ring[cur ^ 1][c],
+                           ro ? ro[c] : NULL, B->F[c]);
+                R.V[c] = EV[c], R.xb[c] = Xp[c], R.vb[c] = Vp[c];
+                R.xt[c] = s < 4 ? B->trial[s - 1][r % 4][c] : NULL;
+                R.vt[c] = s < 4 ? B->trial[s - 1][r % 4][3 + c] : NULL;
+                R.ax[c] = B->sums[r % 8][c], R.av[c] = B->sums[r % 8][3 + c];
+            }
+            lat_rk4_update(a, p0, n, &R, B->F, B->t, acc);
+        } else {
+            lat_row_move(a, p0, n, Xp, Vp, lv->rad_prev, lv->ring[cur ^ 1], ro, B->t, acc);
+        }
         const uint32_t band_end = (b + 1) * L->band_rows < rings ? (b + 1) * L->band_rows : rings;
         if (mine && r + 1 == band_end) store_level(B, partial, s, b);
     }
@@ -151,29 +202,38 @@ LAT_INLINE void op(block *B, double *partial, uint32_t s, uint32_t j)
     lv->cur ^= 1;
 }
 
-/* The workspace of one thread for K levels, stride doubles per array. */
-static size_t block_doubles(size_t stride) { return (size_t)(12 * LAT_LEVELS + 12 * LAT_LEVELS + 11) * stride; }
-
-static void block_init(block *B, const lat_args *a, double *ws, uint32_t R0, uint32_t R1, uint32_t K)
+/* The workspace of one thread, stride doubles per array. */
+static size_t block_doubles(size_t stride)
 {
-    const size_t st = a->L->stride;
+    const size_t levels = 12 * LAT_LEVELS, ghosts = 12 * LAT_LEVELS, rk4 = 6 * 4 * (LAT_LEVELS - 1) + 6 * 8;
+    return (levels + ghosts + rk4 + 14) * stride;
+}
+
+static void block_init(block *B, const lat_args *la, bool rk4, double *ws, uint32_t R0, uint32_t R1, uint32_t K)
+{
+    const size_t st = la->L->stride;
     memset(B, 0, sizeof *B);
-    B->a = a, B->R0 = R0, B->R1 = R1, B->K = K;
+    B->la = la, B->L = la->L, B->rk4 = rk4, B->R0 = R0, B->R1 = R1, B->K = K;
     double *q = ws;
     for (uint32_t s = 0; s < LAT_LEVELS; s++)
         for (int r = 0; r < 2; r++)
             for (int c = 0; c < 3; c++) B->lv[s].rad[r][c] = q, q += st, B->lv[s].ring[r][c] = q, q += st;
     for (uint32_t g = 0; g < 2 * LAT_LEVELS; g++)
         for (int c = 0; c < 6; c++) B->ghost[g][c] = q, q += st;
+    for (uint32_t s = 0; s + 1 < LAT_LEVELS; s++)
+        for (int r = 0; r < 4; r++)
+            for (int c = 0; c < 6; c++) B->trial[s][r][c] = q, q += st;
+    for (int r = 0; r < 8; r++)
+        for (int c = 0; c < 6; c++) B->sums[r][c] = q, q += st;
     for (int c = 0; c < 6; c++) B->hub[c] = q, q += st;
     B->e = q, q += st, B->p = q, q += st;
-    for (int c = 0; c < 3; c++) B->t[c] = q, q += st;
+    for (int c = 0; c < 3; c++) B->t[c] = q, q += st, B->F[c] = q, q += st;
 }
 
 /* Level 0 of the ghost rows, from the state before anyone moves it. */
 static void copy_ghosts(block *B)
 {
-    const spn__lattice *L = B->a->L;
+    const spn__lattice *L = B->L;
     const uint32_t n = L->radials;
     for (uint32_t g = 0; g < 2 * B->K; g++) {
         const uint32_t j = g < B->K ? B->R0 - B->K + g : B->R1 + (g - B->K);
@@ -205,7 +265,8 @@ bool spn__lattice_block_ready(const spn__lattice *L, int threads, uint32_t K)
     return K >= 2 && K <= LAT_LEVELS && per >= 1 && per * L->band_rows >= 4 * K;
 }
 
-bool spn__lattice_block(spn__lattice *L, const lat_args *a, int threads, uint32_t K, double sums[][L_NSUMS])
+bool spn__lattice_block(spn__lattice *L, const lat_args *la, bool rk4, int threads, uint32_t K,
+                        double sums[][L_NSUMS])
 {
     const size_t need = block_doubles(L->stride);
     if (L->block_size < need || L->nbws < threads) {
@@ -232,7 +293,7 @@ bool spn__lattice_block(spn__lattice *L, const lat_args *a, int threads, uint32_
         const uint32_t b1 = (uint32_t)((uint64_t)nb * (uint32_t)(t + 1) / (uint32_t)threads);
         const uint32_t R0 = b0 * L->band_rows, R1 = b1 * L->band_rows < L->rings ? b1 * L->band_rows : L->rings;
         block B;
-        block_init(&B, a, L->bws[t], R0, R1, K);
+        block_init(&B, la, rk4, L->bws[t], R0, R1, K);
         copy_ghosts(&B);
 #pragma omp barrier
         run_block(&B, L->partial_k);

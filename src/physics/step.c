@@ -123,11 +123,9 @@ static spn_status step_once(spn_world *w, double dt)
 static spn_status block_steps(spn_world *w, double dt, int left, int *done)
 {
     *done = 0;
-    const spn_integrator in = w->def.integrator;
-    if (in != SPN_INTEGRATOR_EULER && in != SPN_INTEGRATOR_SYMPLECTIC) return SPN_OK;
     spn__step_result r[SPN__LAT_BLOCK_MAX];
     memset(r, 0, sizeof r);
-    const int k = spn__lattice_explicit_block(w, dt, in == SPN_INTEGRATOR_SYMPLECTIC, left, r);
+    const int k = spn__lattice_block_steps(w, dt, left, r);
     for (int q = 0; q < k; q++) {
         reset_last(w, dt);
         spn_status st = accept(w, dt, &r[q]);
