@@ -206,9 +206,11 @@ typedef struct spn_impact_report {
 
 typedef struct spn_impact spn_impact;
 
-/// Add prey particles to `*w` and make its springs breakable. Breaking lengths
-/// are fixed at creation, so the world is rebuilt with them: `*w` may be
-/// replaced (the old one is destroyed).
+/// Add prey particles to `*w` and make its springs breakable. With breakage
+/// on, `*w` is replaced by a copy with break lengths (the old one is
+/// destroyed) that keeps everything set on it: its definition, state,
+/// callbacks, air, tag diameters and hysteresis, colliders, contacts, lattice
+/// switch, precision and implicit preconditioner.
 SPN_API spn_status spn_impact_create(spn_world **w, const spn_prey_def *prey, int nprey, const spn_impact_def *def,
                                      spn_impact **out);
 SPN_API void spn_impact_destroy(spn_impact *impact);

@@ -39,6 +39,8 @@ SPN_API const char *spn_precond_name(spn_precond p);
 /// solver tolerance; a clone of a world mid-run continues within it, not bit for bit
 /// (the clone builds its hierarchy afresh).
 SPN_API spn_status spn_world_set_implicit_preconditioner(spn_world *w, spn_precond p);
+/// The implicit step's preconditioner as set (SPN_PRECOND_AUTO until then).
+SPN_API spn_precond spn_world_implicit_preconditioner(const spn_world *w);
 /// Parse a name as above; SPN_ERR_INVALID naming the choices otherwise.
 SPN_API spn_status spn_precond_parse(const char *name, spn_precond *out);
 

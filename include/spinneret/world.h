@@ -119,6 +119,8 @@ SPN_API const char *spn_world_step_path(const spn_world *w);
 /// Allow (the default) or forbid the lattice stencil, e.g. to measure or test
 /// the general path on a regular web.
 SPN_API void spn_world_set_lattice(spn_world *w, bool allow);
+/// Whether the lattice stencil is allowed (spn_world_set_lattice).
+SPN_API bool spn_world_lattice_allowed(const spn_world *w);
 /// Arithmetic of the lattice path's Euler, symplectic and RK4 steps.
 typedef enum spn_precision {
     SPN_PRECISION_FLOAT64 = 0, ///< the default: every step in double precision
@@ -165,6 +167,9 @@ SPN_API spn_spring_info spn_world_spring(const spn_world *w, uint32_t s);
 SPN_API void spn_world_set_spring_rest(spn_world *w, uint32_t s, double rest);
 SPN_API void spn_world_set_spring_stiffness(spn_world *w, uint32_t s, double k, double kd);
 SPN_API void spn_world_set_spring_tag(spn_world *w, uint32_t s, uint32_t tag);
+/// Break lengths of spring s as spn_spring_def has them (0, INFINITY: never);
+/// SPN_ERR_INVALID naming the spring when either is NaN.
+SPN_API spn_status spn_world_set_spring_breaks(spn_world *w, uint32_t s, double break_min, double break_max);
 /// Break a spring by hand: flagged broken, it exerts no force from now on (its
 /// stiffness is kept in spn_spring_info for the record); no callback.
 SPN_API void spn_world_break_spring(spn_world *w, uint32_t s);
@@ -188,6 +193,8 @@ SPN_API const char *spn_world_metadata(const spn_world *w);
 typedef void (*spn_force_fn)(void *user, const spn_world *w, double t,
                              const spn_vec3 *x, const spn_vec3 *v, spn_vec3 *f);
 SPN_API void spn_world_set_force_callback(spn_world *w, spn_force_fn fn, void *user);
+/// The force callback (NULL: none); its user pointer into `user` when not NULL.
+SPN_API spn_force_fn spn_world_force_callback(const spn_world *w, void **user);
 
 /// Air velocity at a point and time [m/s], for aerodynamic drag on threads.
 /// Called from one thread, once per tagged segment (at its midpoint) per
@@ -197,8 +204,13 @@ typedef spn_vec3 (*spn_air_fn)(void *user, double t, spn_vec3 position);
 /// from the air velocity relative to them, normal component only, with a drag
 /// coefficient from the cylinder Reynolds number. rho [kg/m^3], mu [Pa s].
 SPN_API void spn_world_set_air(spn_world *w, spn_air_fn fn, void *user, double rho, double mu);
+/// The air function (NULL: still air); its user pointer, rho and mu into the
+/// arguments that are not NULL (rho 1.204, mu 1.81e-5 until set).
+SPN_API spn_air_fn spn_world_air(const spn_world *w, void **user, double *rho, double *mu);
 /// Thread diameter [m] for springs with `tag` (0: no aerodynamic drag).
 SPN_API void spn_world_set_tag_diameter(spn_world *w, uint32_t tag, double diameter);
+/// The diameter set for `tag` (0 when none).
+SPN_API double spn_world_tag_diameter(const spn_world *w, uint32_t tag);
 /// Drag coefficient of a cylinder in cross-flow at Reynolds number `re`:
 /// Lamb's Oseen result 8 pi / (Re (2.002 - ln Re)) below Re 0.5, White's
 /// 1 + 10 Re^(-2/3) above Re 2, blended in ln Re between (docs/physics.md).
@@ -207,6 +219,8 @@ SPN_API double spn_cylinder_drag_coefficient(double re);
 /// Called after the step in which spring `s` broke, with the time and length.
 typedef void (*spn_break_fn)(void *user, uint32_t s, double t, double length);
 SPN_API void spn_world_set_break_callback(spn_world *w, spn_break_fn fn, void *user);
+/// The break callback (NULL: none); its user pointer into `user` when not NULL.
+SPN_API spn_break_fn spn_world_break_callback(const spn_world *w, void **user);
 
 /// Per-particle collision callback (Juhasz & Bercovici): the particle `i`
 /// moves from `from` to `to` this step. Return the fraction of the move
@@ -215,6 +229,8 @@ SPN_API void spn_world_set_break_callback(spn_world *w, spn_break_fn fn, void *u
 typedef double (*spn_collide_fn)(void *user, uint32_t i, spn_vec3 from, spn_vec3 to,
                                  spn_vec3 *normal, double *keep);
 SPN_API void spn_world_set_collide_callback(spn_world *w, spn_collide_fn fn, void *user);
+/// The collision callback (NULL: none); its user pointer into `user` when not NULL.
+SPN_API spn_collide_fn spn_world_collide_callback(const spn_world *w, void **user);
 
 /// Built-in colliders. Restitution in [0, 1] keeps that fraction of the normal
 /// speed; friction in [0, 1] removes that fraction of the tangential speed on contact.
@@ -222,6 +238,8 @@ SPN_API spn_status spn_world_add_plane(spn_world *w, spn_vec3 normal, double off
                                        double restitution, double friction);
 SPN_API spn_status spn_world_add_sphere(spn_world *w, spn_vec3 centre, double radius,
                                         double restitution, double friction);
+/// Planes and spheres added so far.
+SPN_API uint32_t spn_world_collider_count(const spn_world *w);
 
 /* ---- silk hysteresis and stiff contacts (hysteresis.c, contact.c) ------- */
 
@@ -235,6 +253,9 @@ SPN_API spn_status spn_world_add_sphere(spn_world *w, spn_vec3 centre, double ra
 /// carries it at any step and its loss is counted in spn_energy.dissipated;
 /// explicit integrators get it capped at the stable m / (2 dt).
 SPN_API spn_status spn_world_set_tag_hysteresis(spn_world *w, uint32_t tag, double loss, double rate0);
+/// The loss set for `tag` (0 when none, to round-off of the stored eta
+/// otherwise); its rate0 into `rate0` when not NULL (0 when none).
+SPN_API double spn_world_tag_hysteresis(const spn_world *w, uint32_t tag, double *rate0);
 /// Axial damping coefficient spring s used in the last step [N s/m]: kd plus
 /// the hysteresis secant.
 SPN_API double spn_world_spring_damping(const spn_world *w, uint32_t s);

@@ -1,5 +1,5 @@
 /* Shared between the files of src/anim: web geometry helpers and the world
- * rebuild that fixes breaking lengths. */
+ * copy that fixes breaking lengths. */
 #ifndef SPN_ANIM_INTERNAL_H
 #define SPN_ANIM_INTERNAL_H
 
@@ -13,8 +13,9 @@ uint32_t spn__hub_particle(const spn_world *w);
 double spn__web_radius(const spn_world *w, uint32_t centre);
 /* Bounding box of the web particles (prey excluded). */
 void spn__web_bounds(const spn_world *w, spn_vec3 *lo, spn_vec3 *hi);
-/* A copy of `w` (particles, springs, state, settings, metadata; no callbacks)
- * whose intact springs of a breakable kind get break_max = rest * (1 + strain * scale). */
+/* A copy of `w` that steps as w would (spn_world_clone plus the contacts:
+ * every setting and callback), but that its intact springs of a breakable
+ * kind get break_max = min(break_max, rest * (1 + strain * scale)). */
 spn_status spn__world_with_breaks(const spn_world *w, double scale, spn_world **out);
 
 /* True when this build's world applies aerodynamic drag (probed once on a

@@ -9,8 +9,9 @@
  * silk at 2.7; minor ampullate (auxiliary spiral) about 0.33 (Blackledge &
  * Hayashi 2006); the thesis quotes 40% for radii (Mehla 2005, section 3).
  *
- * spn__world_with_breaks rebuilds a world because break lengths are fixed when
- * a spring is added (world.h has no setter); the copy keeps ids and state. */
+ * spn__world_with_breaks hands the prey a copy of the world with break
+ * lengths, so the caller's world is left as it was until the copy replaces it;
+ * the copy keeps ids, state and every setting. */
 #include "anim_internal.h"
 
 #include <math.h>
@@ -122,54 +123,28 @@ void spn__web_bounds(const spn_world *w, spn_vec3 *lo, spn_vec3 *hi)
     if (lo->x > hi->x) *lo = *hi = spn_v3(0, 0, 0);
 }
 
-static spn_status copy_particles(const spn_world *w, spn_world *c)
-{
-    for (uint32_t i = 0; i < spn_world_particle_count(w); i++) {
-        spn_particle_def p = spn_world_particle_def(w, i);
-        spn_status st = spn_world_add_particle(c, &p, NULL);
-        if (st != SPN_OK) return st;
-    }
-    return SPN_OK;
-}
-
-static spn_status copy_springs(const spn_world *w, spn_world *c, double scale)
-{
-    for (uint32_t s = 0; s < spn_world_spring_count(w); s++) {
-        spn_spring_info in = spn_world_spring(w, s);
-        spn_spring_def d = spn_spring_def_default();
-        d.a = in.a;
-        d.b = in.b;
-        d.k = in.k;
-        d.kd = in.kd;
-        d.rest = in.rest;
-        d.break_min = in.break_min;
-        d.break_max = in.break_max;
-        d.tension_only = in.tension_only;
-        d.tag = in.tag;
-        d.stage = in.stage;
-        d.order = in.order;
-        double strain = spn_thread_breaking_strain(in.tag) * scale;
-        if (!in.broken && isfinite(strain) && in.rest > 0) d.break_max = fmin(d.break_max, in.rest * (1 + strain));
-        spn_status st = spn_world_add_spring(c, &d, NULL);
-        if (st != SPN_OK) return st;
-        if (in.broken) spn_world_break_spring(c, s);
-    }
-    return SPN_OK;
-}
-
+/* The copy is a clone, so it carries everything set on w (lattice switch,
+ * precision, implicit preconditioner, callbacks, air, diameters, hysteresis,
+ * colliders, the adaptive stepper's state), then the contacts, which a clone
+ * leaves out, and the break lengths that are the point of the copy. */
 spn_status spn__world_with_breaks(const spn_world *w, double scale, spn_world **out)
 {
     *out = NULL;
-    spn_world *c = spn_world_create(spn_world_get_def(w));
+    spn_world *c = spn_world_clone(w);
     if (!c) return spn_error(SPN_ERR_NOMEM, "out of memory");
-    spn_status st = copy_particles(w, c);
-    if (st == SPN_OK) st = copy_springs(w, c, scale);
-    if (st == SPN_OK && spn_world_metadata(w)) st = spn_world_set_metadata(c, spn_world_metadata(w));
+    uint32_t ncontacts;
+    const spn_contact *contacts = spn_world_contacts(w, &ncontacts);
+    spn_status st = spn_world_set_contacts(c, contacts, ncontacts);
+    for (uint32_t s = 0; s < spn_world_spring_count(w) && st == SPN_OK; s++) {
+        spn_spring_info in = spn_world_spring(w, s);
+        double strain = spn_thread_breaking_strain(in.tag) * scale;
+        if (!in.broken && isfinite(strain) && in.rest > 0)
+            st = spn_world_set_spring_breaks(c, s, in.break_min, fmin(in.break_max, in.rest * (1 + strain)));
+    }
     if (st != SPN_OK) {
         spn_world_destroy(c);
         return st;
     }
-    spn_world_set_time(c, spn_world_time(w));
     *out = c;
     return SPN_OK;
 }

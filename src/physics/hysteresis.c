@@ -53,6 +53,17 @@ spn_status spn_world_set_tag_hysteresis(spn_world *w, uint32_t tag, double loss,
     return SPN_OK;
 }
 
+double spn_world_tag_hysteresis(const spn_world *w, uint32_t tag, double *rate0)
+{
+    for (uint32_t i = 0; i < w->nhyst; i++)
+        if (w->hyst[i].tag == tag) {
+            if (rate0) *rate0 = w->hyst[i].rate0;
+            return 2 * w->hyst[i].eta / (1 + w->hyst[i].eta); /* eta = loss / (2 - loss) */
+        }
+    if (rate0) *rate0 = 0;
+    return 0;
+}
+
 double spn_world_spring_damping(const spn_world *w, uint32_t s)
 {
     if (s >= w->ns) return 0;

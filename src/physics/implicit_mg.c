@@ -52,6 +52,12 @@ spn_status spn_world_set_implicit_preconditioner(spn_world *w, spn_precond p)
     }
 }
 
+spn_precond spn_world_implicit_preconditioner(const spn_world *w)
+{
+    static const spn_precond kinds[] = {SPN_PRECOND_AUTO, SPN_PRECOND_BLOCK_JACOBI, SPN_PRECOND_MULTIGRID};
+    return kinds[w->implicit_pc];
+}
+
 void spn__imp_mg_free(spn__imp_mg *m)
 {
     if (!m) return;

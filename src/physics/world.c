@@ -303,6 +303,16 @@ void spn_world_set_spring_tag(spn_world *w, uint32_t s, uint32_t tag)
     w->stag[s] = tag;
     w->compiled = false; /* the air buffers depend on the tags' diameters */
 }
+spn_status spn_world_set_spring_breaks(spn_world *w, uint32_t s, double break_min, double break_max)
+{
+    if (isnan(break_min) || isnan(break_max))
+        return spn_error(SPN_ERR_INVALID, "spring %u: break lengths must be numbers", s);
+    w->bmin[s] = break_min;
+    w->bmax[s] = break_max;
+    w->compiled = false; /* whether any spring can break decides the step's path */
+    return SPN_OK;
+}
+
 void spn_world_break_spring(spn_world *w, uint32_t s)
 {
     w->sflags[s] |= SPN_SPRING_BROKEN;
@@ -312,6 +322,8 @@ void spn_world_break_spring(spn_world *w, uint32_t s)
         spn__lattice_drop(w);
     }
 }
+
+bool spn_world_lattice_allowed(const spn_world *w) { return !w->lattice_off; }
 
 void spn_world_set_integrator(spn_world *w, spn_integrator integrator) { w->def.integrator = integrator; }
 
@@ -354,10 +366,22 @@ void spn_world_set_force_callback(spn_world *w, spn_force_fn fn, void *user)
     w->force_user = user;
 }
 
+spn_force_fn spn_world_force_callback(const spn_world *w, void **user)
+{
+    if (user) *user = w->force_user;
+    return w->force_fn;
+}
+
 void spn_world_set_break_callback(spn_world *w, spn_break_fn fn, void *user)
 {
     w->break_fn = fn;
     w->break_user = user;
+}
+
+spn_break_fn spn_world_break_callback(const spn_world *w, void **user)
+{
+    if (user) *user = w->break_user;
+    return w->break_fn;
 }
 
 void spn_world_set_collide_callback(spn_world *w, spn_collide_fn fn, void *user)
@@ -366,12 +390,26 @@ void spn_world_set_collide_callback(spn_world *w, spn_collide_fn fn, void *user)
     w->collide_user = user;
 }
 
+spn_collide_fn spn_world_collide_callback(const spn_world *w, void **user)
+{
+    if (user) *user = w->collide_user;
+    return w->collide_fn;
+}
+
 void spn_world_set_air(spn_world *w, spn_air_fn fn, void *user, double rho, double mu)
 {
     w->air_fn = fn;
     w->air_user = user;
     w->air_rho = rho;
     w->air_mu = mu;
+}
+
+spn_air_fn spn_world_air(const spn_world *w, void **user, double *rho, double *mu)
+{
+    if (user) *user = w->air_user;
+    if (rho) *rho = w->air_rho;
+    if (mu) *mu = w->air_mu;
+    return w->air_fn;
 }
 
 void spn_world_set_tag_diameter(spn_world *w, uint32_t tag, double diameter)
@@ -389,6 +427,13 @@ void spn_world_set_tag_diameter(spn_world *w, uint32_t tag, double diameter)
     w->diam[w->ndiam].diameter = diameter;
     w->ndiam++;
     w->compiled = false;
+}
+
+double spn_world_tag_diameter(const spn_world *w, uint32_t tag)
+{
+    for (uint32_t i = 0; i < w->ndiam; i++)
+        if (w->diam[i].tag == tag) return w->diam[i].diameter;
+    return 0;
 }
 
 static spn_status add_collider(spn_world *w, spn_collider c)
@@ -416,6 +461,8 @@ spn_status spn_world_add_sphere(spn_world *w, spn_vec3 centre, double radius, do
     spn_collider c = {1, centre, radius, restitution, friction};
     return add_collider(w, c);
 }
+
+uint32_t spn_world_collider_count(const spn_world *w) { return w->ncolliders; }
 
 static bool dup_array(void **dst, const void *src, size_t n, size_t size)
 {
