@@ -17,11 +17,17 @@
  * never has). Anything that breaks the pattern (a broken spring, an added
  * one, a force callback, air drag) sends the step back to the general path.
  *
- * The sweep. Rows are swept outwards. Row j's state is copied into structure-
- * of-arrays buffers; its radial springs (to row j - 1, whose pre-step state is
- * still in the other buffer) and its ring springs are computed; then row j - 1
- * has every force it will get and is moved. So every spring sees the state
- * from before the step, and each particle is read once and written once.
+ * State. For the length of an spn_world_advance call (or around a lone
+ * spn_world_step) the step keeps its own copy of the state, structure of
+ * arrays (x, v by component, rows one after another), loaded from w->x,
+ * w->v at its first step and written back by spn__lattice_sync.
+ *
+ * The sweep. Rows are swept outwards, read straight from those arrays: row
+ * j's radial springs (to row j - 1, not moved yet) and its ring springs are
+ * computed; then row j - 1 has every force it will get and is moved in
+ * place. So every spring sees the state from before the step, and each
+ * particle is read once and written once. Big webs take several steps to a
+ * sweep (lattice_block.c).
  *
  * Same bits as the general two-pass step. A particle's force is summed in the
  * order the gather uses for a web numbered like spn_scene_orb (radials added
