@@ -110,7 +110,11 @@ LAT_INLINE void rk4_update(const a32 *a, size_t p0, uint32_t n, float *const *F,
     const float *m = S->mass + p0, *im = S->inv_mass + p0;
     const float *V[3] = {a->eu[0] + p0, a->eu[1] + p0, a->eu[2] + p0};
     if (a->mode == M_RK4_STAGE) {
-        rk4_kin32(n, m, im, V[0], V[1], V[2], t[0], t[1], t[2]);
+        /* (m v^2 only where it counts, as in lattice_rows.h's lat_rk4_update) */
+        if (a->first || a->drag != 0) {
+            rk4_kin32(n, m, im, V[0], V[1], V[2], t[0]);
+            lane_add32(acc[L_MV2], t[0], n);
+        }
         /* (three calls, not a loop, as in lattice_rows.h's update) */
         rk4_stage32(n, a->first, a->h, a->weight, im, V[0], F[0], S->d[0] + p0, S->u[0] + p0, a->td[0] + p0,
                     a->tu[0] + p0, S->ax[0] + p0, S->av[0] + p0);
@@ -125,10 +129,10 @@ LAT_INLINE void rk4_update(const a32 *a, size_t p0, uint32_t n, float *const *F,
         rk4_last32(n, a->h, im, V[0], F[0], S->ax[0] + p0, S->av[0] + p0, S->d[0] + p0, S->u[0] + p0);
         rk4_last32(n, a->h, im, V[1], F[1], S->ax[1] + p0, S->av[1] + p0, S->d[1] + p0, S->u[1] + p0);
         rk4_last32(n, a->h, im, V[2], F[2], S->ax[2] + p0, S->av[2] + p0, S->d[2] + p0, S->u[2] + p0);
+        lane_add32(acc[L_MV2], t[0], n);
+        lane_add32(acc[L_GAIN], t[1], n);
+        lane_add32(acc[L_MVN2], t[2], n);
     }
-    lane_add32(acc[L_MV2], t[0], n);
-    lane_add32(acc[L_GAIN], t[1], n);
-    lane_add32(acc[L_MVN2], t[2], n);
 }
 
 LAT_INLINE void finish32(const a32 *a, size_t p0, uint32_t n, float *const *ri, float *const *rg,

@@ -126,15 +126,14 @@ LAT_INLINE void LK(assemble)(uint32_t n, LK_T gc, LK_T drag, const LK_T *restric
     f[l] = ((fl - in[l]) - wrap) - ring[l - 1];
 }
 
-/* Sum terms of a stage but the last: m v^2 of the free particles. */
+/* The sum term of a stage but the last: m v^2 of the free particles (its
+ * gain and new-energy terms are zero, so they are not summed at all). */
 LAT_INLINE void LK(rk4_kin)(uint32_t n, const LK_T *restrict mass, const LK_T *restrict inv_mass,
                             const LK_T *restrict Vx, const LK_T *restrict Vy, const LK_T *restrict Vz,
-                            LK_T *restrict t_mv2, LK_T *restrict t_gain, LK_T *restrict t_mvn2)
+                            LK_T *restrict t_mv2)
 {
-    for (uint32_t i = 0; i < n; i++) {
+    for (uint32_t i = 0; i < n; i++)
         t_mv2[i] = (inv_mass[i] != 0 ? mass[i] : (LK_T)0) * (Vx[i] * Vx[i] + Vy[i] * Vy[i] + Vz[i] * Vz[i]);
-        t_gain[i] = t_mvn2[i] = 0;
-    }
 }
 
 /* One component of a stage but the last: the weighted sums ax, av and the
