@@ -141,6 +141,17 @@ static void test_blocked_passes(void **state)
         assert_memory_equal(&e1.dissipated, &er.dissipated, sizeof(double));
         assert_memory_equal(&e2.dissipated, &er.dissipated, sizeof(double));
         assert_true(fastest(one) > 0.01);
+        /* a spring changed between calls reaches the blocked passes */
+        const uint32_t sp = 1234;
+        spn_spring_info info = spn_world_spring(one, sp);
+        spn_world_set_spring_rest(one, sp, 0.9 * info.rest);
+        spn_world_set_spring_rest(ref, sp, 0.9 * info.rest);
+        spn_world_set_spring_stiffness(one, sp + 1, 2 * info.k, info.kd);
+        spn_world_set_spring_stiffness(ref, sp + 1, 2 * info.k, info.kd);
+        assert_int_equal(spn_world_advance(one, dt, 8), SPN_OK);
+        assert_int_equal(spn_world_last_step(one).blocked, 8);
+        for (int i = 0; i < 8; i++) assert_int_equal(spn_world_step(ref, dt), SPN_OK);
+        assert_same_state(one, ref);
         spn_world_destroy(one);
         spn_world_destroy(two);
         spn_world_destroy(ref);
