@@ -118,6 +118,102 @@ static void test_subdivided_segments_go_whole(void **state)
     spn_world_destroy(w);
 }
 
+/* Settings made on the world before inscribing, none at its default. */
+static int force_user, collide_user, break_user, air_user;
+static void no_force(void *user, const spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v, spn_vec3 *f)
+{
+    (void)user, (void)w, (void)t, (void)x, (void)v, (void)f;
+}
+static double no_collision(void *user, uint32_t i, spn_vec3 from, spn_vec3 to, spn_vec3 *normal, double *keep)
+{
+    (void)user, (void)i, (void)from, (void)to, (void)normal, (void)keep;
+    return 1;
+}
+static void no_break(void *user, uint32_t s, double t, double length) { (void)user, (void)s, (void)t, (void)length; }
+static spn_vec3 still_air(void *user, double t, spn_vec3 p) { return (void)user, (void)t, (void)p, spn_v3(0, 0, 0); }
+
+/* An inscription that has to take particles out (the middles of divided
+ * capture threads) keeps what was set on the world outside its definition:
+ * the particles go in place (spn_world_remove_particles), not by a rebuild. */
+static void test_compaction_keeps_the_world_settings(void **state)
+{
+    (void)state;
+    spn_world *w = inscribe_orb();
+    subdivide_capture(&w);
+    spn_world_set_force_callback(w, no_force, &force_user);
+    spn_world_set_collide_callback(w, no_collision, &collide_user);
+    spn_world_set_break_callback(w, no_break, &break_user);
+    spn_world_set_air(w, still_air, &air_user, 1.1, 1.9e-5);
+    spn_world_set_tag_diameter(w, SPN_THREAD_RADIUS, 3e-6);
+    assert_int_equal(spn_world_set_tag_hysteresis(w, SPN_THREAD_RADIUS, 0.6, 2e-3), SPN_OK);
+    assert_int_equal(spn_world_add_plane(w, spn_v3(0, 1, 0), -0.5, 0.3, 0.4), SPN_OK);
+    spn_world_set_lattice(w, false);
+    spn_world_set_precision(w, SPN_PRECISION_FLOAT32);
+    assert_int_equal(spn_world_set_implicit_preconditioner(w, SPN_PRECOND_MULTIGRID), SPN_OK);
+    spn_world_set_time(w, 0.75);
+    spn_target *t = NULL;
+    assert_int_equal(spn_target_create(w, 1200, &t), SPN_OK);
+    spn_target_paint(t, left_third, NULL);
+    spn_inscribe_def d = spn_inscribe_def_default();
+    d.settle = false;
+    spn_inscribe_report rep;
+    assert_int_equal(spn_inscribe(&w, t, &d, &rep), SPN_OK);
+    assert_true(rep.particles_removed > 20); /* the compaction did run */
+    void *user = NULL;
+    assert_ptr_equal(spn_world_force_callback(w, &user), no_force);
+    assert_ptr_equal(user, &force_user);
+    assert_ptr_equal(spn_world_collide_callback(w, &user), no_collision);
+    assert_ptr_equal(user, &collide_user);
+    assert_ptr_equal(spn_world_break_callback(w, &user), no_break);
+    assert_ptr_equal(user, &break_user);
+    double rho = 0, mu = 0, rate0 = 0;
+    assert_ptr_equal(spn_world_air(w, &user, &rho, &mu), still_air);
+    assert_ptr_equal(user, &air_user);
+    assert_true(rho == 1.1 && mu == 1.9e-5);
+    assert_true(spn_world_tag_diameter(w, SPN_THREAD_RADIUS) == 3e-6);
+    assert_true(fabs(spn_world_tag_hysteresis(w, SPN_THREAD_RADIUS, &rate0) - 0.6) < 1e-15 && rate0 == 2e-3);
+    assert_int_equal(spn_world_collider_count(w), 1);
+    assert_false(spn_world_lattice_allowed(w));
+    assert_int_equal(spn_world_precision(w), SPN_PRECISION_FLOAT32);
+    assert_int_equal(spn_world_implicit_preconditioner(w), SPN_PRECOND_MULTIGRID);
+    assert_true(spn_world_time(w) == 0.75);
+    check_hangs_whole(w);
+    spn_target_destroy(t);
+    spn_world_destroy(w);
+}
+
+/* A broken half of a divided capture thread: its middle particle is left
+ * with one live thread, which dangles and goes, and the particle goes with
+ * its broken spring (the rebuild used to look up the dropped particle's id). */
+static void test_broken_half_goes_with_its_particle(void **state)
+{
+    (void)state;
+    spn_world *w = inscribe_orb();
+    uint32_t np0 = spn_world_particle_count(w);
+    subdivide_capture(&w);
+    uint32_t half = SPN_REMOVED;
+    for (uint32_t s = 0; s < spn_world_spring_count(w) && half == SPN_REMOVED; s++) {
+        spn_spring_info si = spn_world_spring(w, s);
+        bool right = spn_world_position(w, si.a).x > 0.05 && spn_world_position(w, si.b).x > 0.05;
+        if (si.tag == SPN_THREAD_CAPTURE && right) half = s;
+    }
+    assert_true(half != SPN_REMOVED);
+    assert_true(spn_world_spring(w, half).a >= np0 || spn_world_spring(w, half).b >= np0); /* ends on a middle */
+    spn_world_break_spring(w, half);
+    spn_target *t = NULL;
+    assert_int_equal(spn_target_create(w, 1200, &t), SPN_OK);
+    spn_target_paint(t, left_third, NULL);
+    spn_inscribe_def d = spn_inscribe_def_default();
+    d.settle = false;
+    spn_inscribe_report rep;
+    assert_int_equal(spn_inscribe(&w, t, &d, &rep), SPN_OK);
+    assert_int_equal(rep.particles_removed, rep.removed + 1);
+    for (uint32_t s = 0; s < spn_world_spring_count(w); s++) assert_false(spn_world_spring(w, s).broken);
+    check_hangs_whole(w);
+    spn_target_destroy(t);
+    spn_world_destroy(w);
+}
+
 static void test_failure_leaves_the_web_alone(void **state)
 {
     (void)state;
@@ -145,6 +241,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_inscribed_web_is_settled_and_whole),
         cmocka_unit_test(test_subdivided_segments_go_whole),
+        cmocka_unit_test(test_compaction_keeps_the_world_settings),
+        cmocka_unit_test(test_broken_half_goes_with_its_particle),
         cmocka_unit_test(test_failure_leaves_the_web_alone),
     };
     int failed = cmocka_run_group_tests(tests, NULL, NULL);

@@ -122,8 +122,12 @@ typedef struct spn_inscribe_report {
 /// score 1..10 of each capture spring and 0 for other springs.
 SPN_API spn_status spn_inscribe_scores(const spn_world *w, const spn_target *t, uint8_t *scores);
 
-/// Inscribe the target into *w. The world may be replaced by a compacted copy
-/// (particles left without threads are taken out), so pass its address.
+/// Inscribe the target into *w. The edits are made on a copy (spn_world_clone)
+/// that replaces *w on success, so pass its address; particles left without
+/// threads are taken out of it in place (spn_world_remove_particles: ids
+/// change), and it keeps every setting of *w (callbacks, air, colliders, tag
+/// diameters and hysteresis, lattice switch, precision, preconditioner,
+/// metadata) but contacts, which spn_world_clone does not copy.
 /// On failure *w is unchanged.
 SPN_API spn_status spn_inscribe(spn_world **w, const spn_target *t, const spn_inscribe_def *def,
                                 spn_inscribe_report *report);

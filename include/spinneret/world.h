@@ -106,6 +106,25 @@ SPN_API spn_status spn_world_add_spring(spn_world *w, const spn_spring_def *def,
 /// Remove the springs whose `remove[i]` is true; the others keep their order
 /// and are renumbered densely. Particles are kept.
 SPN_API spn_status spn_world_remove_springs(spn_world *w, const bool *remove);
+/// What a removed particle or spring maps to in spn_world_remove_particles.
+#define SPN_REMOVED UINT32_MAX
+/// Remove the `count` particles ids[0..count) and every spring with an end
+/// among them, in place: everything else about the world stays (its
+/// definition, callbacks with their user pointers, air, colliders, tag
+/// diameters and hysteresis, lattice switch, precision, implicit
+/// preconditioner, metadata, time, energy ledger), and the particles and
+/// springs that remain keep their order and state bit for bit, renumbered
+/// densely: a survivor's new id is its old id minus the number of removed ids
+/// below it. Contacts keep their order, their particle ids renumbered.
+/// `particle_map` (particle_count entries, as before the call) and
+/// `spring_map` (spring_count entries), when not NULL, get each old id's new
+/// id, or SPN_REMOVED. The world compiles again at the next step. Not from a
+/// callback during a step. SPN_ERR_INVALID naming the ids[] entry that is out
+/// of range, repeats an earlier one, or is a particle a contact uses; the
+/// world is then unchanged. (Built-in colliders are fixed in space, tied to
+/// no particle.)
+SPN_API spn_status spn_world_remove_particles(spn_world *w, const uint32_t *ids, uint32_t count,
+                                              uint32_t *particle_map, uint32_t *spring_map);
 /// Build the flat stepping arrays now (stepping does it when needed).
 SPN_API spn_status spn_world_compile(spn_world *w);
 /// How the next Euler, symplectic or RK4 step of a compiled world runs:

@@ -3,7 +3,8 @@
  * laid with the web's pre-strain), and after threads are taken out nothing is
  * left hanging: a free particle with a single thread is a dangling end, so
  * that thread goes too (repeatedly); threads no longer connected to a fixed
- * particle go; particles left with no thread are taken out of the world.
+ * particle go; particles left with no thread are taken out of the world in
+ * place (spn_world_remove_particles), so it keeps every setting made on it.
  * Invariant after spn__clean: every free particle has at least two threads
  * and a path of threads to a fixed particle. */
 #include "inscribe_internal.h"
@@ -179,45 +180,13 @@ static spn_status prune_unanchored(const spn_world *w, const spn__graph *g, bool
     return SPN_OK;
 }
 
-/* A copy of w without the dead springs and without the particles in `drop`. */
-static spn_status compact(const spn_world *w, const bool *dead, const bool *drop, spn_world **out)
+spn_status spn__clean(spn_world *w, const bool *remove, uint32_t *pruned, uint32_t *particles_removed)
 {
-    uint32_t np = spn_world_particle_count(w), ns = spn_world_spring_count(w);
-    uint32_t *map = malloc(((size_t)np + 1) * sizeof *map);
-    spn_world *c = spn_world_create(spn_world_get_def(w));
-    spn_status st = map && c ? SPN_OK : spn_error(SPN_ERR_NOMEM, "out of memory");
-    for (uint32_t i = 0; i < np && st == SPN_OK; i++) {
-        if (drop[i]) continue;
-        spn_particle_def p = spn_world_particle_def(w, i);
-        st = spn_world_add_particle(c, &p, &map[i]);
-    }
-    for (uint32_t s = 0; s < ns && st == SPN_OK; s++) {
-        if (dead[s]) continue;
-        spn_spring_info si = spn_world_spring(w, s);
-        spn_spring_def d = {map[si.a], map[si.b], si.k, si.kd, si.rest, si.break_min, si.break_max,
-                            si.tension_only, si.tag, si.stage, si.order};
-        uint32_t id;
-        st = spn_world_add_spring(c, &d, &id);
-        if (st == SPN_OK && si.broken) spn_world_break_spring(c, id);
-    }
-    if (st == SPN_OK && spn_world_metadata(w)) st = spn_world_set_metadata(c, spn_world_metadata(w));
-    if (st == SPN_OK) spn_world_set_time(c, spn_world_time(w));
-    free(map);
-    if (st != SPN_OK) {
-        spn_world_destroy(c);
-        return st;
-    }
-    *out = c;
-    return SPN_OK;
-}
-
-spn_status spn__clean(spn_world **wp, const bool *remove, uint32_t *pruned, uint32_t *particles_removed)
-{
-    spn_world *w = *wp;
     uint32_t np = spn_world_particle_count(w), ns = spn_world_spring_count(w), dropped = 0;
     bool *dead = calloc((size_t)ns + 1, sizeof *dead), *reach = calloc((size_t)np + 1, sizeof *reach);
+    uint32_t *drop = malloc(((size_t)np + 1) * sizeof *drop);
     spn__graph g = {0, 0, NULL, NULL};
-    spn_status st = dead && reach ? spn__graph_build(w, NULL, &g) : spn_error(SPN_ERR_NOMEM, "out of memory");
+    spn_status st = dead && reach && drop ? spn__graph_build(w, NULL, &g) : spn_error(SPN_ERR_NOMEM, "out of memory");
     if (st == SPN_OK) {
         for (uint32_t s = 0; s < ns; s++) dead[s] = remove && remove[s];
         prune_dangling(w, &g, dead, pruned);
@@ -228,20 +197,17 @@ spn_status spn__clean(spn_world **wp, const bool *remove, uint32_t *pruned, uint
         for (uint32_t i = 0; i < np; i++) {
             bool live = false;
             for (uint32_t e = g.start[i]; e < g.start[i + 1] && !live; e++) live = !dead[g.edge[e]];
-            reach[i] = !live && !spn_world_is_fixed(w, i); /* reused: "drop" */
-            dropped += reach[i];
+            if (!live && !spn_world_is_fixed(w, i)) drop[dropped++] = i;
         }
-        if (dropped == 0) {
-            st = spn_world_remove_springs(w, dead);
-        } else {
-            spn_world *c = NULL;
-            st = compact(w, dead, reach, &c);
-            if (st == SPN_OK) spn_world_destroy(w), *wp = c;
-        }
+        /* In place, so the world keeps its callbacks, colliders and the rest;
+         * the dropped particles' broken springs go with them. */
+        st = spn_world_remove_springs(w, dead);
+        if (st == SPN_OK) st = spn_world_remove_particles(w, drop, dropped, NULL, NULL);
     }
     spn__graph_free(&g);
     if (st == SPN_OK) *particles_removed += dropped;
     free(dead);
     free(reach);
+    free(drop);
     return st;
 }

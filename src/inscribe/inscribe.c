@@ -342,12 +342,12 @@ spn_status spn_inscribe(spn_world **wp, const spn_target *t, const spn_inscribe_
     bool *remove = NULL;
     st = settle(w, &d, &rep.before);
     if (st == SPN_OK) st = edit_segments(w, t, &d, &m, &remove, &rep);
-    if (st == SPN_OK) st = spn__clean(&w, remove, &rep.pruned, &rep.particles_removed);
+    if (st == SPN_OK) st = spn__clean(w, remove, &rep.pruned, &rep.particles_removed);
     free(remove);
     if (st == SPN_OK && d.emphasis == SPN_EMPHASIS_FILL) {
         double spacing = d.fill_spacing > 0 ? d.fill_spacing : default_fill_spacing(w);
         st = spn__fill(w, t, &m, spacing, d.seed, &rep.added, &rep.split);
-        if (st == SPN_OK) st = spn__clean(&w, NULL, &rep.pruned, &rep.particles_removed);
+        if (st == SPN_OK) st = spn__clean(w, NULL, &rep.pruned, &rep.particles_removed);
     }
     if (st == SPN_OK) st = settle(w, &d, &rep.after);
     if (st != SPN_OK) {

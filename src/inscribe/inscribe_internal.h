@@ -56,10 +56,11 @@ spn__material spn__capture_material(const spn_world *w);
 spn_status spn__add_thread(spn_world *w, const spn__material *m, uint32_t a, uint32_t b, uint32_t tag);
 
 /* Take out dangling threads (free particles with one thread), threads not
- * connected to a fixed particle, and particles left with no thread; may
- * replace *w by a compacted copy. `remove` (spring_count entries, may be NULL)
- * marks springs to take out first. Counts go to *pruned and *particles_removed. */
-spn_status spn__clean(spn_world **w, const bool *remove, uint32_t *pruned, uint32_t *particles_removed);
+ * connected to a fixed particle, and particles left with no thread, all in
+ * place (spn_world_remove_particles: ids change, every world setting stays).
+ * `remove` (spring_count entries, may be NULL) marks springs to take out
+ * first. Counts go to *pruned and *particles_removed. */
+spn_status spn__clean(spn_world *w, const bool *remove, uint32_t *pruned, uint32_t *particles_removed);
 
 /* Fill emphasis (fill.c): random attachments inside the target. */
 spn_status spn__fill(spn_world *w, const spn_target *t, const spn__material *m, double spacing, uint64_t seed,
