@@ -12,6 +12,7 @@
 #include <cmocka.h>
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -112,6 +113,66 @@ static void test_bands_and_threads(void **state)
         spn_world_destroy(two);
         spn_world_destroy(gen);
     }
+}
+
+/* Steps several to a pass over memory (spn_world_advance on a web of at
+ * least def.parallel_min particles, lattice_block.c: four explicit steps or
+ * the four stages of an RK4 step to a pass): the same bits as single steps, in the state and in the energy books, on 1 and 2 threads, and a
+ * blow-up inside a pass found at the same step as without passes. */
+static void test_blocked_passes(void **state)
+{
+    (void)state;
+    const spn_integrator integs[] = {SPN_INTEGRATOR_EULER, SPN_INTEGRATOR_SYMPLECTIC, SPN_INTEGRATOR_RK4};
+    for (int k = 0; k < 3; k++) {
+        const double dt = integs[k] == SPN_INTEGRATOR_EULER ? 2e-7 : 2e-6;
+        /* explicit: 7 passes of 4 steps, 1 single step; RK4: a pass a step */
+        const int blocked = integs[k] == SPN_INTEGRATOR_RK4 ? 29 : 28;
+        spn_world *one = disturbed_orb(integs[k], 40, 50, 1, 256, true);
+        spn_world *two = disturbed_orb(integs[k], 40, 50, 2, 256, true);
+        spn_world *ref = disturbed_orb(integs[k], 40, 50, 1, 256, true);
+        assert_int_equal(spn_world_advance(one, dt, 29), SPN_OK);
+        assert_int_equal(spn_world_last_step(one).blocked, blocked);
+        assert_int_equal(spn_world_advance(two, dt, 29), SPN_OK);
+        assert_int_equal(spn_world_last_step(two).blocked, blocked);
+        for (int i = 0; i < 29; i++) assert_int_equal(spn_world_step(ref, dt), SPN_OK);
+        assert_same_state(one, ref);
+        assert_same_state(two, ref);
+        spn_energy e1 = spn_world_energy(one), e2 = spn_world_energy(two), er = spn_world_energy(ref);
+        assert_memory_equal(&e1.dissipated, &er.dissipated, sizeof(double));
+        assert_memory_equal(&e2.dissipated, &er.dissipated, sizeof(double));
+        assert_true(fastest(one) > 0.01);
+        /* a spring changed between calls reaches the blocked passes */
+        const uint32_t sp = 1234;
+        spn_spring_info info = spn_world_spring(one, sp);
+        spn_world_set_spring_rest(one, sp, 0.9 * info.rest);
+        spn_world_set_spring_rest(ref, sp, 0.9 * info.rest);
+        spn_world_set_spring_stiffness(one, sp + 1, 2 * info.k, info.kd);
+        spn_world_set_spring_stiffness(ref, sp + 1, 2 * info.k, info.kd);
+        assert_int_equal(spn_world_advance(one, dt, 8), SPN_OK);
+        assert_int_equal(spn_world_last_step(one).blocked, 8);
+        for (int i = 0; i < 8; i++) assert_int_equal(spn_world_step(ref, dt), SPN_OK);
+        assert_same_state(one, ref);
+        spn_world_destroy(one);
+        spn_world_destroy(two);
+        spn_world_destroy(ref);
+    }
+    /* a step far too long: the pass blows up, the run is replayed and the
+     * message names the same step as single steps give */
+    spn_world *blk = disturbed_orb(SPN_INTEGRATOR_SYMPLECTIC, 40, 50, 2, 256, true);
+    spn_world *ref = disturbed_orb(SPN_INTEGRATOR_SYMPLECTIC, 40, 50, 2, 256, true);
+    const double big = 6e-5;
+    int failed_at = -1;
+    for (int i = 0; i < 400 && failed_at < 0; i++)
+        if (spn_world_step(ref, big) != SPN_OK) failed_at = i;
+    assert_true(failed_at > 0);
+    char want[512];
+    snprintf(want, sizeof want, "%s", spn_last_error());
+    assert_int_equal(spn_world_advance(blk, big, 400), SPN_ERR_UNSTABLE);
+    assert_string_equal(spn_last_error(), want);
+    assert_same_state(blk, ref);
+    print_message("blow-up at step %d in both: %s\n", failed_at + 1, want);
+    spn_world_destroy(blk);
+    spn_world_destroy(ref);
 }
 
 /* Changing a spring keeps the lattice in step; breaking one hands over to the
@@ -255,6 +316,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_same_trajectory),
         cmocka_unit_test(test_bands_and_threads),
+        cmocka_unit_test(test_blocked_passes),
         cmocka_unit_test(test_changes_and_break),
         cmocka_unit_test(test_hand_built_and_breakage),
         cmocka_unit_test(test_not_a_lattice),

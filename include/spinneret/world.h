@@ -314,6 +314,8 @@ typedef struct spn_step_report {
     int halvings;         ///< times a sub-step was halved (adaptive)
     int cg_iterations;    ///< implicit: CG iterations summed over sub-steps
     int breaks;           ///< springs broken in this step
+    int blocked;          ///< spn_world_advance: steps taken several to a pass over memory
+                          ///< (the lattice step of a big web, docs/physics-lattice.md)
 } spn_step_report;
 
 /// Advance by dt seconds. On SPN_ERR_UNSTABLE the world keeps its state from

@@ -17,11 +17,17 @@
  * never has). Anything that breaks the pattern (a broken spring, an added
  * one, a force callback, air drag) sends the step back to the general path.
  *
- * The sweep. Rows are swept outwards. Row j's state is copied into structure-
- * of-arrays buffers; its radial springs (to row j - 1, whose pre-step state is
- * still in the other buffer) and its ring springs are computed; then row j - 1
- * has every force it will get and is moved. So every spring sees the state
- * from before the step, and each particle is read once and written once.
+ * State. For the length of an spn_world_advance call (or around a lone
+ * spn_world_step) the step keeps its own copy of the state, structure of
+ * arrays (x, v by component, rows one after another), loaded from w->x,
+ * w->v at its first step and written back by spn__lattice_sync.
+ *
+ * The sweep. Rows are swept outwards, read straight from those arrays: row
+ * j's radial springs (to row j - 1, not moved yet) and its ring springs are
+ * computed; then row j - 1 has every force it will get and is moved in
+ * place. So every spring sees the state from before the step, and each
+ * particle is read once and written once. Big webs take several steps to a
+ * sweep (lattice_block.c).
  *
  * Same bits as the general two-pass step. A particle's force is summed in the
  * order the gather uses for a web numbered like spn_scene_orb (radials added
@@ -49,7 +55,9 @@ static void lattice_free(spn__lattice *L)
 {
     if (!L) return;
     free(L->rk), free(L->rkd), free(L->rrest), free(L->gk), free(L->gkd), free(L->grest);
-    free(L->cut), free(L->partial), free(L->rk4);
+    free(L->cut), free(L->partial), free(L->rk4), free(L->state), free(L->partial_k);
+    for (int t = 0; t < L->nbws; t++) free(L->bws[t]);
+    free(L->bws);
     spn__lat32_free(L->f32);
     for (int t = 0; t < L->nws; t++) free(L->ws[t]);
     free(L->ws);
@@ -170,21 +178,54 @@ static bool prepare(spn_world *w, int threads)
 
 /* ---- the sweep ---- */
 
-/* The hub: its radials (ring 0's radial forces, on the hub as inner end, in
- * radial order), then its update. */
-static void hub(const lat_args *a, double *const *rad, double (*acc)[LANES])
+/* Row p0 of the evaluated state. */
+LAT_INLINE void eval_rows(const lat_args *a, size_t p0, const double **X, const double **V)
 {
-    const uint32_t n = a->L->radials;
-    const double m = a->mass[0], dm = a->drag * m;
-    spn_vec3 xh, vh;
-    state_of(a, 0, &xh, &vh);
-    double f[3] = {m * a->g.x - dm * vh.x, m * a->g.y - dm * vh.y, m * a->g.z - dm * vh.z};
-    for (uint32_t i = 0; i < n; i++) f[0] += rad[0][i], f[1] += rad[1][i], f[2] += rad[2][i];
-    double X[3] = {xh.x, xh.y, xh.z}, V[3] = {vh.x, vh.y, vh.z};
-    double T[3], Bh[6] = {0};
-    double *Xp[3] = {X, X + 1, X + 2}, *Vp[3] = {V, V + 1, V + 2}, *Fp[3] = {f, f + 1, f + 2};
-    double *Tp[3] = {T, T + 1, T + 2}, *Bp[6] = {Bh, Bh + 1, Bh + 2, Bh + 3, Bh + 4, Bh + 5};
-    update(a, 0, 1, Xp, Vp, Fp, Tp, Bp, acc);
+    for (int c = 0; c < 3; c++) X[c] = a->ex[c] + p0, V[c] = a->ev[c] + p0;
+}
+
+/* Particles p0 .. p0+n-1 of an RK4 stage, their force F (3 arrays) known. */
+LAT_INLINE void rk4_update(const lat_args *a, size_t p0, uint32_t n, double *const *F, double *const *t,
+                           double (*acc)[LANES])
+{
+    const spn__lattice *L = a->L;
+    rk4_rows R;
+    for (int c = 0; c < 3; c++) {
+        R.V[c] = a->ev[c] + p0, R.xb[c] = L->x[c] + p0, R.vb[c] = L->v[c] + p0;
+        R.xt[c] = a->tx[c] ? a->tx[c] + p0 : NULL, R.vt[c] = a->tv[c] ? a->tv[c] + p0 : NULL;
+        R.ax[c] = L->ax[c] + p0, R.av[c] = L->av[c] + p0;
+    }
+    lat_rk4_update(a, p0, n, &R, F, t, acc);
+}
+
+/* Row p0 complete (radial in, ring, radial out or NULL): its update. */
+LAT_INLINE void finish(const lat_args *a, size_t p0, uint32_t n, double *const *ri, double *const *rg,
+                       double *const *ro, double *const *t, double *const *Fw, double (*acc)[LANES])
+{
+    const spn__lattice *L = a->L;
+    if (a->mode == MODE_RK4_STAGE || a->mode == MODE_RK4_LAST) {
+        for (int c = 0; c < 3; c++)
+            assemble64(n, a->g[c], a->drag, a->mass + p0, a->ev[c] + p0, ri[c], rg[c], ro ? ro[c] : NULL, Fw[c]);
+        rk4_update(a, p0, n, Fw, t, acc);
+        return;
+    }
+    double *X[3], *V[3];
+    for (int c = 0; c < 3; c++) X[c] = L->x[c] + p0, V[c] = L->v[c] + p0;
+    lat_row_move(a, p0, n, X, V, ri, rg, ro, t, acc);
+}
+
+/* The hub: its radial forces in radial order, then its update. */
+static void hub(const lat_args *a, double *const *rad, double *const *t, double (*acc)[LANES])
+{
+    if (a->mode != MODE_RK4_STAGE && a->mode != MODE_RK4_LAST) {
+        lat_hub_move(a, rad, acc);
+        return;
+    }
+    const double v[3] = {a->ev[0][0], a->ev[1][0], a->ev[2][0]};
+    double f[3];
+    lat_hub_force(a, v, rad, f);
+    double *Fp[3] = {f, f + 1, f + 2};
+    rk4_update(a, 0, 1, Fp, t, acc);
 }
 
 /* Radial springs into band b's first row, from the state before the step. */
@@ -193,85 +234,76 @@ SPN__KERNEL static void cut_pass(const lat_args *a, double *ws, uint32_t b)
     const spn__lattice *L = a->L;
     const uint32_t n = L->radials, j = b * L->band_rows;
     const size_t st = L->stride;
-    double *X[2][3], *V[2][3], *f[3];
-    for (int r = 0; r < 2; r++) rows_of(ws, st, WS_X, r, X[r]), rows_of(ws, st, WS_V, r, V[r]);
+    const double *Xa[3], *Va[3], *Xb[3], *Vb[3];
+    double *f[3];
+    eval_rows(a, 1 + (size_t)(j - 1) * n, Xa, Va);
+    eval_rows(a, 1 + (size_t)j * n, Xb, Vb);
     for (int c = 0; c < 3; c++) f[c] = L->cut + ((size_t)b * 3 + c) * n;
-    load_row(a, j - 1, X[0], V[0]);
-    load_row(a, j, X[1], V[1]);
     double acc_e[LANES] = {0}, acc_p[LANES] = {0};
-    springs_rows(n, X[0], V[0], X[1], V[1], 0, 0, L->rk + (size_t)j * n, L->rkd + (size_t)j * n,
-                 L->rrest + (size_t)j * n, f, 0, ws + (size_t)WS_E * st, ws + (size_t)WS_P * st, acc_e, acc_p);
+    springs_rows(n, Xa, Va, Xb, Vb, 0, 0, L->rk + (size_t)j * n, L->rkd + (size_t)j * n, L->rrest + (size_t)j * n,
+                 f, 0, ws + (size_t)WS_E * st, ws + (size_t)WS_P * st, acc_e, acc_p);
     double *p = L->partial + (size_t)b * L_NSUMS;
     p[L_ELASTIC] = lane_total(acc_e), p[L_DAMP] = lane_total(acc_p);
 }
 
-/* Sweep band b (see the file comment). */
+/* Sweep band b (see the file comment): rows read straight from the state
+ * arrays, each moved in place once every spring that reads it is done. */
 SPN__KERNEL static void band_pass(const lat_args *a, double *ws, uint32_t b)
 {
     const spn__lattice *L = a->L;
     const uint32_t n = L->radials, lo = b * L->band_rows;
     const uint32_t hi = lo + L->band_rows < L->rings ? lo + L->band_rows : L->rings;
     const size_t st = L->stride;
-    double *X[2][3], *V[2][3], *RAD[2][3], *RING[2][3], *F[3];
-    for (int r = 0; r < 2; r++) {
-        rows_of(ws, st, WS_X, r, X[r]), rows_of(ws, st, WS_V, r, V[r]);
-        rows_of(ws, st, WS_RAD, r, RAD[r]), rows_of(ws, st, WS_RING, r, RING[r]);
-    }
-    rows_of(ws, st, WS_F, 0, F);
-    double *e = ws + (size_t)WS_E * st, *p = ws + (size_t)WS_P * st;
-    double *t[3] = {e, p, ws + (size_t)WS_Q * st}, *B[6];
-    for (int c = 0; c < 6; c++) B[c] = ws + (size_t)(WS_B + c) * st;
-    double acc_e[LANES] = {0}, acc_p[LANES] = {0}, acc[L_NSUMS][LANES] = {{0}};
-    double *cut[3], *next_cut[3];
+    double *RAD[2][3], *RING[2][3], *H[6], *t[3], *Fw[3], *cut[3], *next_cut[3];
     for (int c = 0; c < 3; c++) {
+        RAD[0][c] = ws + (WS_RAD + c) * st, RAD[1][c] = ws + (WS_RAD + 3 + c) * st;
+        RING[0][c] = ws + (WS_RING + c) * st, RING[1][c] = ws + (WS_RING + 3 + c) * st;
+        t[c] = ws + (WS_T + c) * st, Fw[c] = ws + (WS_F + c) * st;
         cut[c] = L->cut + ((size_t)b * 3 + c) * n;
         next_cut[c] = L->cut + ((size_t)(b + 1) * 3 + c) * n;
     }
+    for (int c = 0; c < 6; c++) H[c] = ws + (WS_HUB + c) * st;
+    double *e = ws + WS_E * st, *p = ws + WS_P * st;
+    double acc_e[LANES] = {0}, acc_p[LANES] = {0}, acc[L_NSUMS][LANES] = {{0}};
     int cur = 0;
     double **rad_cur = NULL, **rad_prev = NULL;
     for (uint32_t j = lo; j < hi; j++, cur ^= 1) {
-        const int prev = cur ^ 1;
-        const size_t s0 = (size_t)j * n;
-        load_row(a, j, X[cur], V[cur]);
+        const size_t s0 = (size_t)j * n, p0 = 1 + s0;
+        const double *X[3], *V[3];
+        eval_rows(a, p0, X, V);
         if (j == lo && j > 0) {
             rad_cur = cut; /* computed by cut_pass; its sums are in the band's partial */
         } else if (j == 0) {
-            spn_vec3 xh, vh;
-            state_of(a, 0, &xh, &vh);
-            for (uint32_t i = 0; i < n; i++) {
-                X[prev][0][i] = xh.x, X[prev][1][i] = xh.y, X[prev][2][i] = xh.z;
-                V[prev][0][i] = vh.x, V[prev][1][i] = vh.y, V[prev][2][i] = vh.z;
+            for (int c = 0; c < 3; c++) {
+                const double hx = a->ex[c][0], hv = a->ev[c][0];
+                for (uint32_t i = 0; i < n; i++) H[c][i] = hx, H[3 + c][i] = hv;
             }
-            springs_rows(n, X[prev], V[prev], X[cur], V[cur], 0, 0, L->rk, L->rkd, L->rrest, RAD[cur], 0, e, p,
-                         acc_e, acc_p);
+            springs_rows(n, (const double *const *)H, (const double *const *)H + 3, X, V, 0, 0, L->rk, L->rkd,
+                         L->rrest, RAD[cur], 0, e, p, acc_e, acc_p);
             rad_cur = RAD[cur];
-            hub(a, rad_cur, acc);
+            hub(a, rad_cur, t, acc);
         } else {
-            springs_rows(n, X[prev], V[prev], X[cur], V[cur], 0, 0, L->rk + s0, L->rkd + s0, L->rrest + s0,
-                         RAD[cur], 0, e, p, acc_e, acc_p);
+            const double *Xp[3], *Vp[3];
+            eval_rows(a, p0 - n, Xp, Vp);
+            springs_rows(n, Xp, Vp, X, V, 0, 0, L->rk + s0, L->rkd + s0, L->rrest + s0, RAD[cur], 0, e, p, acc_e,
+                         acc_p);
             rad_cur = RAD[cur];
         }
-        springs_rows(n - 1, X[cur], V[cur], X[cur], V[cur], 0, 1, L->gk + s0, L->gkd + s0, L->grest + s0,
-                     RING[cur], 0, e, p, acc_e, acc_p);
-        springs_rows(1, X[cur], V[cur], X[cur], V[cur], 0, n - 1, L->gk + s0 + n - 1, L->gkd + s0 + n - 1,
-                     L->grest + s0 + n - 1, RING[cur], n - 1, e, p, acc_e, acc_p);
-        if (j > lo) {
-            const size_t q0 = 1 + (size_t)(j - 1) * n;
-            finish_row(a, q0, n, X[prev], V[prev], rad_prev, RING[prev], (const double *const *)rad_cur, F, t, B, acc);
-        }
+        springs_rows(n - 1, X, V, X, V, 0, 1, L->gk + s0, L->gkd + s0, L->grest + s0, RING[cur], 0, e, p, acc_e,
+                     acc_p);
+        springs_rows(1, X, V, X, V, 0, n - 1, L->gk + s0 + n - 1, L->gkd + s0 + n - 1, L->grest + s0 + n - 1,
+                     RING[cur], n - 1, e, p, acc_e, acc_p);
+        if (j > lo) finish(a, p0 - n, n, rad_prev, RING[cur ^ 1], rad_cur, t, Fw, acc);
         rad_prev = rad_cur;
     }
-    const int last = cur ^ 1;
-    const size_t q0 = 1 + (size_t)(hi - 1) * n;
-    finish_row(a, q0, n, X[last], V[last], rad_prev, RING[last],
-               hi < L->rings ? (const double *const *)next_cut : NULL, F, t, B, acc);
+    finish(a, 1 + (size_t)(hi - 1) * n, n, rad_prev, RING[cur ^ 1], hi < L->rings ? next_cut : NULL, t, Fw, acc);
     store_band_sums(L->partial + (size_t)b * L_NSUMS, b == 0, acc_e, acc_p, acc);
 }
 
 /* One force evaluation and update over the whole lattice; sums into sum[]. */
-static void sweep(spn_world *w, const lat_args *a, int threads, double *sum)
+static void sweep(const lat_args *a, int threads, double *sum)
 {
-    spn__lattice *L = w->lat;
+    const spn__lattice *L = a->L;
     const uint32_t nb = L->nbands;
 #pragma omp parallel num_threads(threads)
     {
@@ -286,16 +318,90 @@ static void sweep(spn_world *w, const lat_args *a, int threads, double *sum)
         for (int k = 0; k < L_NSUMS; k++) sum[k] += L->partial[(size_t)b * L_NSUMS + k];
 }
 
-static lat_args args_of(spn_world *w)
+/* ---- state: load and write-back ---- */
+
+/* The world's state into the lattice's arrays; false when out of memory. */
+static bool load(spn_world *w, int threads)
 {
-    lat_args a;
-    memset(&a, 0, sizeof a);
-    a.L = w->lat;
-    a.xs = w->x, a.vs = w->v, a.x = w->x, a.v = w->v, a.x0 = w->x0, a.v0 = w->v0;
-    a.mass = w->mass, a.inv_mass = w->inv_mass;
-    a.g = w->def.gravity, a.drag = w->def.drag;
-    a.backup = !w->no_backup;
-    return a;
+    spn__lattice *L = w->lat;
+    const uint32_t np = w->np;
+    if (!L->state) {
+        if (!(L->state = malloc(6 * (size_t)np * sizeof *L->state))) return false;
+        for (int c = 0; c < 3; c++) L->x[c] = L->state + (size_t)c * np, L->v[c] = L->state + (size_t)(3 + c) * np;
+    }
+    const spn_vec3 *x = w->x, *v = w->v;
+    double *x0 = L->x[0], *x1 = L->x[1], *x2 = L->x[2], *v0 = L->v[0], *v1 = L->v[1], *v2 = L->v[2];
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (uint32_t i = 0; i < np; i++) {
+        x0[i] = x[i].x, x1[i] = x[i].y, x2[i] = x[i].z;
+        v0[i] = v[i].x, v1[i] = v[i].y, v2[i] = v[i].z;
+    }
+    L->live = true;
+    return true;
+}
+
+static void write_back(spn_world *w, int threads)
+{
+    spn__lattice *L = w->lat;
+    const uint32_t np = w->np;
+    spn_vec3 *x = w->x, *v = w->v;
+    const double *x0 = L->x[0], *x1 = L->x[1], *x2 = L->x[2], *v0 = L->v[0], *v1 = L->v[1], *v2 = L->v[2];
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (uint32_t i = 0; i < np; i++) x[i] = spn_v3(x0[i], x1[i], x2[i]), v[i] = spn_v3(v0[i], v1[i], v2[i]);
+    L->live = false;
+}
+
+void spn__lattice_sync(spn_world *w)
+{
+    if (!w->lat) return;
+    spn__lat32_sync(w);
+    if (w->lat->live) write_back(w, spn__threads(w, w->np));
+}
+
+void spn__lattice_discard(spn_world *w)
+{
+    if (!w->lat) return;
+    spn__lat32_discard(w->lat->f32);
+    w->lat->live = false;
+}
+
+/* The state ready for a step (loaded unless a call already holds it; a
+ * step with a backup copies it to x0, v0 first), RK4's arrays, the step's
+ * arguments in a. False, with w->x and w->v up to date, when out of memory. */
+static bool begin(spn_world *w, int threads, double dt, bool rk4, lat_args *a)
+{
+    spn__lattice *L = w->lat;
+    if (!w->no_backup) spn__lattice_sync(w); /* a step with a backup starts from w->x */
+    if (!L->live) {
+        if (!w->no_backup) {
+            memcpy(w->x0, w->x, w->np * sizeof *w->x);
+            memcpy(w->v0, w->v, w->np * sizeof *w->v);
+        }
+        if (!load(w, threads)) return false;
+    }
+    const size_t np = w->np;
+    if (rk4 && !L->rk4) {
+        if (!(L->rk4 = malloc(18 * np * sizeof *L->rk4))) {
+            spn__lattice_sync(w);
+            return false;
+        }
+        for (int k = 0; k < 6; k++) L->trial[0][k] = L->rk4 + k * np, L->trial[1][k] = L->rk4 + (6 + k) * np;
+        for (int c = 0; c < 3; c++) L->ax[c] = L->rk4 + (12 + c) * np, L->av[c] = L->rk4 + (15 + c) * np;
+    }
+    memset(a, 0, sizeof *a);
+    a->L = L;
+    a->mass = w->mass, a->inv_mass = w->inv_mass;
+    a->g[0] = w->def.gravity.x, a->g[1] = w->def.gravity.y, a->g[2] = w->def.gravity.z;
+    a->drag = w->def.drag, a->dt = dt;
+    for (int c = 0; c < 3; c++) a->ex[c] = L->x[c], a->ev[c] = L->v[c];
+    return true;
+}
+
+/* After a step with a backup (spn_world_step, or a run that does not
+ * replay), the world's arrays again. */
+static void end(spn_world *w, int threads)
+{
+    if (!w->no_backup) write_back(w, threads);
 }
 
 static bool applies(const spn_world *w)
@@ -327,8 +433,7 @@ static int ready(spn_world *w)
 
 /* float32 inside spn_world_advance's replayable runs only (and for the step
  * it retakes after a blow-up, so that the retake fails as the run did): a
- * lone step would load and write back the float32 state around itself,
- * slower than the float64 step (5k web: 5.9 against 5.2 CPU ns). */
+ * lone step would load and write back the float32 state around itself. */
 static bool float32(const spn_world *w)
 {
     return w->precision == SPN_PRECISION_FLOAT32 && (w->no_backup || spn__lat32_live(w->lat->f32));
@@ -341,23 +446,29 @@ bool spn__lattice_explicit(spn_world *w, double dt, bool symplectic, spn__step_r
         spn__lattice_sync(w);
         return false;
     }
-    if (float32(w)) return spn__lat32_explicit(w, threads, dt, symplectic, r);
-    spn__lattice_sync(w);
-    lat_args a = args_of(w);
-    a.dt = dt;
+    if (float32(w)) {
+        if (w->lat->live) write_back(w, threads);
+        return spn__lat32_explicit(w, threads, dt, symplectic, r);
+    }
+    spn__lat32_sync(w);
+    lat_args a;
+    if (!begin(w, threads, dt, false, &a)) return false;
     a.mode = symplectic ? MODE_SYMPLECTIC : MODE_EULER;
     double sum[L_NSUMS];
-    sweep(w, &a, threads, sum);
+    sweep(&a, threads, sum);
     r->elastic = sum[L_ELASTIC];
     r->e_before = 0.5 * sum[L_MV2] + sum[L_ELASTIC];
     r->gain_kp = sum[L_GAIN];
     r->work = 0;
     r->dissipated = dt * (sum[L_DAMP] + w->def.drag * sum[L_MV2]);
     r->kinetic = 0.5 * sum[L_MVN2];
+    end(w, threads);
     return true;
 }
 
-/* RK4 as in explicit.c (four fused passes), each pass one lattice sweep. */
+/* RK4 as in explicit.c (four fused passes), each pass one lattice sweep:
+ * stage s evaluated at the trial state of stage s - 1, writing the next one
+ * into the other trial array; the last stage moves the state in place. */
 bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r)
 {
     const int threads = ready(w);
@@ -365,26 +476,27 @@ bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r)
         spn__lattice_sync(w);
         return false;
     }
-    if (float32(w)) return spn__lat32_rk4(w, threads, dt, r);
-    spn__lattice_sync(w);
-    spn__lattice *L = w->lat;
-    const size_t np = w->np;
-    if (!L->rk4 && !(L->rk4 = calloc(12 * np, sizeof *L->rk4))) return false;
-    static const double weight[4] = {1, 2, 2, 1}, frac[4] = {0, 0.5, 0.5, 1};
-    lat_args a = args_of(w);
-    for (int c = 0; c < 3; c++) {
-        a.xt[c] = L->rk4 + c * np, a.vt[c] = L->rk4 + (3 + c) * np;
-        a.ax[c] = L->rk4 + (6 + c) * np, a.av[c] = L->rk4 + (9 + c) * np;
+    if (float32(w)) {
+        if (w->lat->live) write_back(w, threads);
+        return spn__lat32_rk4(w, threads, dt, r);
     }
-    a.dt = dt;
+    spn__lat32_sync(w);
+    lat_args a;
+    if (!begin(w, threads, dt, true, &a)) return false;
+    spn__lattice *L = w->lat;
+    static const double weight[4] = {1, 2, 2, 1}, frac[4] = {0, 0.5, 0.5, 1};
     double damp = 0, sum[L_NSUMS];
     for (int stage = 0; stage < 4; stage++) {
-        a.stage = stage;
+        double *const *from = L->trial[(stage + 1) % 2], *const *to = L->trial[stage % 2];
+        for (int c = 0; c < 3; c++) {
+            a.ex[c] = stage ? from[c] : L->x[c], a.ev[c] = stage ? from[3 + c] : L->v[c];
+            a.tx[c] = to[c], a.tv[c] = to[3 + c];
+        }
         a.mode = stage < 3 ? MODE_RK4_STAGE : MODE_RK4_LAST;
-        for (int c = 0; c < 3; c++) a.sx[c] = stage ? a.xt[c] : NULL, a.sv[c] = stage ? a.vt[c] : NULL;
+        a.first = stage == 0;
         a.weight = weight[stage];
-        a.h_next = stage < 3 ? frac[stage + 1] * dt : 0;
-        sweep(w, &a, threads, sum);
+        a.h = stage < 3 ? frac[stage + 1] * dt : dt / 6;
+        sweep(&a, threads, sum);
         if (stage == 0) {
             r->e_before = 0.5 * sum[L_MV2] + sum[L_ELASTIC];
             r->elastic = sum[L_ELASTIC];
@@ -395,5 +507,60 @@ bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r)
     r->kinetic = 0.5 * sum[L_MVN2];
     r->work = 0;
     r->dissipated = dt / 6 * damp;
+    end(w, threads);
     return true;
+}
+
+/* Steps as blocked passes (lattice_block.c), inside a replayable
+ * spn_world_advance on a web too big for the caches (from def.parallel_min
+ * particles, the size from which a step is spread over threads): up to k
+ * Euler or symplectic steps in one pass, or one RK4 step (its four stages)
+ * per pass. Each step's results into r[]; the count done, 0 when a blocked
+ * pass does not apply (the caller then takes single steps). */
+int spn__lattice_block_steps(spn_world *w, double dt, int k, spn__step_result *r)
+{
+    const spn_integrator in = w->def.integrator;
+    const bool rk4 = in == SPN_INTEGRATOR_RK4;
+    if (!rk4 && in != SPN_INTEGRATOR_EULER && in != SPN_INTEGRATOR_SYMPLECTIC) return 0;
+    if (k > LAT_LEVELS) k = LAT_LEVELS;
+    const uint32_t levels = rk4 ? 4 : (uint32_t)k;
+    if (levels < 2 || !w->no_backup || w->np < w->def.parallel_min || w->precision == SPN_PRECISION_FLOAT32)
+        return 0;
+    const int threads = ready(w);
+    if (!threads || !spn__lattice_block_ready(w->lat, threads, levels)) return 0;
+    spn__lat32_sync(w);
+    lat_args la[LAT_LEVELS];
+    if (!begin(w, threads, dt, false, &la[0])) return 0;
+    static const double weight[4] = {1, 2, 2, 1}, frac[4] = {0, 0.5, 0.5, 1};
+    for (uint32_t s = 0; s < levels; s++) {
+        la[s] = la[0];
+        la[s].mode = rk4 ? (s < 3 ? MODE_RK4_STAGE : MODE_RK4_LAST)
+                         : (in == SPN_INTEGRATOR_SYMPLECTIC ? MODE_SYMPLECTIC : MODE_EULER);
+        la[s].first = s == 0;
+        la[s].weight = weight[s % 4];
+        la[s].h = s < 3 ? frac[s + 1] * dt : dt / 6;
+    }
+    double sums[LAT_LEVELS][L_NSUMS];
+    if (!spn__lattice_block(w->lat, la, rk4, threads, levels, sums)) return 0;
+    if (rk4) {
+        double damp = 0;
+        for (int s = 0; s < 4; s++) damp += weight[s] * (sums[s][L_DAMP] + w->def.drag * sums[s][L_MV2]);
+        r[0].e_before = 0.5 * sums[0][L_MV2] + sums[0][L_ELASTIC];
+        r[0].elastic = sums[0][L_ELASTIC];
+        r[0].gain_kp = sums[3][L_GAIN];
+        r[0].kinetic = 0.5 * sums[3][L_MVN2];
+        r[0].work = 0;
+        r[0].dissipated = dt / 6 * damp;
+        return 1;
+    }
+    for (int q = 0; q < k; q++) {
+        const double *sum = sums[q];
+        r[q].elastic = sum[L_ELASTIC];
+        r[q].e_before = 0.5 * sum[L_MV2] + sum[L_ELASTIC];
+        r[q].gain_kp = sum[L_GAIN];
+        r[q].work = 0;
+        r[q].dissipated = dt * (sum[L_DAMP] + w->def.drag * sum[L_MV2]);
+        r[q].kinetic = 0.5 * sum[L_MVN2];
+    }
+    return k;
 }

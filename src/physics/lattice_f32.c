@@ -110,7 +110,11 @@ LAT_INLINE void rk4_update(const a32 *a, size_t p0, uint32_t n, float *const *F,
     const float *m = S->mass + p0, *im = S->inv_mass + p0;
     const float *V[3] = {a->eu[0] + p0, a->eu[1] + p0, a->eu[2] + p0};
     if (a->mode == M_RK4_STAGE) {
-        rk4_mv2_32(n, m, im, V[0], V[1], V[2], t[0], t[1], t[2]);
+        /* (m v^2 only where it counts, as in lattice_rows.h's lat_rk4_update) */
+        if (a->first || a->drag != 0) {
+            rk4_kin32(n, m, im, V[0], V[1], V[2], t[0]);
+            lane_add32(acc[L_MV2], t[0], n);
+        }
         /* (three calls, not a loop, as in lattice_rows.h's update) */
         rk4_stage32(n, a->first, a->h, a->weight, im, V[0], F[0], S->d[0] + p0, S->u[0] + p0, a->td[0] + p0,
                     a->tu[0] + p0, S->ax[0] + p0, S->av[0] + p0);
@@ -125,10 +129,10 @@ LAT_INLINE void rk4_update(const a32 *a, size_t p0, uint32_t n, float *const *F,
         rk4_last32(n, a->h, im, V[0], F[0], S->ax[0] + p0, S->av[0] + p0, S->d[0] + p0, S->u[0] + p0);
         rk4_last32(n, a->h, im, V[1], F[1], S->ax[1] + p0, S->av[1] + p0, S->d[1] + p0, S->u[1] + p0);
         rk4_last32(n, a->h, im, V[2], F[2], S->ax[2] + p0, S->av[2] + p0, S->d[2] + p0, S->u[2] + p0);
+        lane_add32(acc[L_MV2], t[0], n);
+        lane_add32(acc[L_GAIN], t[1], n);
+        lane_add32(acc[L_MVN2], t[2], n);
     }
-    lane_add32(acc[L_MV2], t[0], n);
-    lane_add32(acc[L_GAIN], t[1], n);
-    lane_add32(acc[L_MVN2], t[2], n);
 }
 
 LAT_INLINE void finish32(const a32 *a, size_t p0, uint32_t n, float *const *ri, float *const *rg,
@@ -174,7 +178,7 @@ static void hub32(const a32 *a, float *const *rad, float *const *t, double (*acc
     }
     const moved32 o = one32(f[0], f[1], f[2], F->inv_mass[0], m, F->d[0][0], F->d[1][0], F->d[2][0], F->u[0][0],
                             F->u[1][0], F->u[2][0], a->mode == M_SYMPLECTIC, a->dt, a->g);
-    for (int c = 0; c < 3; c++) F->d[c][0] = o.d[c], F->u[c][0] = o.u[c];
+    for (int c = 0; c < 3; c++) F->d[c][0] = o.x[c], F->u[c][0] = o.v[c];
     acc[L_MV2][0] += o.mv2, acc[L_GAIN][0] += o.gain, acc[L_MVN2][0] += o.mvn2;
 }
 
@@ -471,7 +475,7 @@ bool spn__lat32_rk4(spn_world *w, int threads, double dt, spn__step_result *r)
     return true;
 }
 
-void spn__lattice_sync(spn_world *w)
+void spn__lat32_sync(spn_world *w)
 {
     if (w->lat && w->lat->f32 && w->lat->f32->live) write_back(w, spn__threads(w, w->np), false);
 }
@@ -483,9 +487,9 @@ void spn__lat32_params_changed(spn__lat32 *F)
     if (F) F->params_ok = false;
 }
 
-void spn__lattice_discard(spn_world *w)
+void spn__lat32_discard(spn__lat32 *F)
 {
-    if (w->lat && w->lat->f32) w->lat->f32->live = false;
+    if (F) F->live = false;
 }
 
 void spn_world_set_precision(spn_world *w, spn_precision precision)

@@ -73,34 +73,65 @@ static spn_status integrate(spn_world *w, double dt, spn__step_result *r)
     }
 }
 
-/* One step of a compiled world. Without a backup (w->no_backup) a blow-up
- * leaves the broken state in place and returns SPN_ERR_UNSTABLE with no
- * message: spn_world_advance restores and replays. */
-static spn_status step_once(spn_world *w, double dt)
+/* The rest of a step once the integrator has moved the state and reported
+ * r: the blow-up check, collisions, deformation limits, the energy books,
+ * time and breakage. Without a backup (w->no_backup) a blow-up leaves the
+ * broken state in place and returns SPN_ERR_UNSTABLE with no message:
+ * spn_world_advance restores and replays. */
+static spn_status accept(spn_world *w, double dt, const spn__step_result *r)
 {
-    memset(&w->last, 0, sizeof w->last);
-    w->last.dt = dt;
-    w->last.substeps = 1;
-    spn__step_result r;
-    memset(&r, 0, sizeof r);
-    if (w->nhyst) spn__hysteresis_prepare(w, dt);
-    spn_status st = integrate(w, dt, &r);
-    if (st != SPN_OK) return st;
-    double gain = r.gain_kp - r.elastic - r.work;
+    double gain = r->gain_kp - r->elastic - r->work;
     /* Energy in play; gravity alone gives m g^2 dt^2 per step (forward
      * Euler gains half of that from rest). */
     double g2 = spn_v3_dot(w->def.gravity, w->def.gravity);
-    double scale = r.e_before + fabs(r.work) + w->free_mass * g2 * dt * dt;
-    if (!isfinite(r.kinetic) || !isfinite(r.gain_kp) || gain > w->def.energy_jump * scale + 1e-300)
+    double scale = r->e_before + fabs(r->work) + w->free_mass * g2 * dt * dt;
+    if (!isfinite(r->kinetic) || !isfinite(r->gain_kp) || gain > w->def.energy_jump * scale + 1e-300)
         return w->no_backup ? SPN_ERR_UNSTABLE : blew_up(w, dt, gain);
     double lost = 0;
     if (w->ncolliders || w->collide_fn) lost += spn__collide(w, dt);
     if (w->def.provot_max_strain > 0) lost += spn__provot(w, dt);
-    w->external_work += r.work;
-    w->dissipated += r.dissipated + lost;
+    w->external_work += r->work;
+    w->dissipated += r->dissipated + lost;
     w->t += dt;
     w->steps++;
     w->last.breaks = spn__check_breakage(w);
+    return SPN_OK;
+}
+
+static void reset_last(spn_world *w, double dt)
+{
+    memset(&w->last, 0, sizeof w->last);
+    w->last.dt = dt;
+    w->last.substeps = 1;
+}
+
+/* One step of a compiled world (see accept for a blow-up). */
+static spn_status step_once(spn_world *w, double dt)
+{
+    reset_last(w, dt);
+    spn__step_result r;
+    memset(&r, 0, sizeof r);
+    if (w->nhyst) spn__hysteresis_prepare(w, dt);
+    spn_status st = integrate(w, dt, &r);
+    return st != SPN_OK ? st : accept(w, dt, &r);
+}
+
+/* Up to `left` steps of a replayable run as one blocked lattice pass, each
+ * then accepted in turn; the steps accepted in *done (all, or up to the one
+ * that blew up, whose status is returned). 0 steps when no blocked pass
+ * applies. */
+static spn_status block_steps(spn_world *w, double dt, int left, int *done)
+{
+    *done = 0;
+    spn__step_result r[SPN__LAT_BLOCK_MAX];
+    memset(r, 0, sizeof r);
+    const int k = spn__lattice_block_steps(w, dt, left, r);
+    for (int q = 0; q < k; q++) {
+        reset_last(w, dt);
+        spn_status st = accept(w, dt, &r[q]);
+        if (st != SPN_OK) return st;
+        ++*done;
+    }
     return SPN_OK;
 }
 
@@ -129,6 +160,14 @@ static bool replayable(const spn_world *w)
     return !(w->def.provot_max_strain > 0) && !(w->def.breakage && w->any_limits);
 }
 
+static void add_step(spn_step_report *total, const spn_step_report *last)
+{
+    total->substeps += last->substeps;
+    total->halvings += last->halvings;
+    total->cg_iterations += last->cg_iterations;
+    total->breaks += last->breaks;
+}
+
 /* Replayable runs keep one copy of the state per call, in x0 and v0, instead
  * of one per step. On a blow-up at step j the world goes back to that copy,
  * replays the j good steps (bit-identical: same world, same calls) and takes
@@ -141,7 +180,7 @@ spn_status spn_world_advance(spn_world *w, double dt, int n)
     if (n < 1) return spn_error(SPN_ERR_INVALID, "spn_world_advance: step count must be at least 1, not %d", n);
     st = spn_world_compile(w);
     if (st != SPN_OK) return st;
-    spn_step_report total = {dt, 0, 0, 0, 0};
+    spn_step_report total = {dt, 0, 0, 0, 0, 0};
     const bool replay = n > 1 && replayable(w);
     const double t0 = w->t, work0 = w->external_work, diss0 = w->dissipated;
     const uint64_t steps0 = w->steps;
@@ -150,8 +189,14 @@ spn_status spn_world_advance(spn_world *w, double dt, int n)
         memcpy(w->v0, w->v, w->np * sizeof *w->v);
         w->no_backup = true;
     }
-    for (int j = 0; j < n; j++) {
-        st = step_once(w, dt);
+    for (int j = 0; j < n;) {
+        int done = 0;
+        st = replay ? block_steps(w, dt, n - j, &done) : SPN_OK;
+        j += done, total.substeps += done, total.blocked += done; /* (one sub-step each, no breaks) */
+        if (st == SPN_OK && done == 0) {
+            st = step_once(w, dt);
+            if (st == SPN_OK) j++, add_step(&total, &w->last);
+        }
         if (st == SPN_ERR_UNSTABLE && w->no_backup) {
             spn__lattice_discard(w);
             memcpy(w->x, w->x0, w->np * sizeof *w->x);
@@ -160,12 +205,9 @@ spn_status spn_world_advance(spn_world *w, double dt, int n)
             for (int q = 0; q < j; q++) step_once(w, dt);
             w->no_backup = false;
             st = step_once(w, dt);
+            if (st == SPN_OK) j++, add_step(&total, &w->last);
         }
         if (st != SPN_OK) break;
-        total.substeps += w->last.substeps;
-        total.halvings += w->last.halvings;
-        total.cg_iterations += w->last.cg_iterations;
-        total.breaks += w->last.breaks;
     }
     spn__lattice_sync(w);
     w->no_backup = false;

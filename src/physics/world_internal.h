@@ -306,6 +306,12 @@ void spn__lattice_spring_changed(spn_world *w, uint32_t s);
  * of memory for its buffers. */
 bool spn__lattice_explicit(spn_world *w, double dt, bool symplectic, spn__step_result *r);
 bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r);
+/* Steps of a replayable advance on a big lattice web as passes over memory
+ * that each take several levels (up to k, at most SPN__LAT_BLOCK_MAX,
+ * explicit steps, or the four stages of one RK4 step); the count of steps
+ * done (0: take single steps), results in r[]. */
+#define SPN__LAT_BLOCK_MAX 4
+int spn__lattice_block_steps(spn_world *w, double dt, int k, spn__step_result *r);
 /* The float32 lattice step (lattice_f32.c) keeps its own state during an
  * spn_world_advance call; w->x and w->v are behind it until this writes them
  * back (a no-op when it holds nothing). Called at the end of every call. */

@@ -1,0 +1,198 @@
+/* The particle updates of the lattice step, written once for both
+ * precisions: lattice_rows.h includes this file with LK_T = double and
+ * lattice_rows32.h with LK_T = float, each with LK(name) giving its names.
+ * No include guard, on purpose.
+ *
+ * Every kernel updates a row of the state in place (structure of arrays,
+ * positions x or float32 displacements d, velocities v) once the row's
+ * forces are complete. Fixed particles are selected out, not skipped, so the
+ * loops vectorise; the per-particle terms of the energy sums go to t_mv2,
+ * t_gain, t_mvn2 and from there, in a fixed order, to lane accumulators.
+ * Each expression is the general path's (chunk.h, explicit.c), so the
+ * float64 lattice gives its bits. Plain loops for GCC 12 to vectorise; where
+ * it would not, the comment says what was changed. */
+#if !defined(LK_T) || !defined(LK)
+#error "define LK_T and LK(name) before including lattice_rows_t.h"
+#endif
+
+LAT_INLINE void LK(lane_add)(double *restrict acc, const LK_T *restrict e, uint32_t n)
+{
+    uint32_t i = 0;
+    for (; i + LANES <= n; i += LANES)
+        for (int l = 0; l < LANES; l++) acc[l] += (double)e[i + l];
+    for (; i < n; i++) acc[i % LANES] += (double)e[i];
+}
+
+typedef struct LK(moved) {
+    LK_T x[3], v[3], mv2, gain, mvn2;
+} LK(moved);
+
+/* One particle of an Euler (sym false) or symplectic Euler step. */
+LAT_INLINE LK(moved) LK(one)(LK_T fx, LK_T fy, LK_T fz, LK_T im, LK_T m, LK_T xx, LK_T xy, LK_T xz, LK_T vx,
+                             LK_T vy, LK_T vz, bool sym, LK_T dt, const LK_T *g)
+{
+    LK(moved) o;
+    const LK_T s = dt * im;
+    const bool fr = im != 0;
+    const LK_T mf = fr ? m : (LK_T)0;
+    const LK_T nx = vx + fx * s, ny = vy + fy * s, nz = vz + fz * s;
+    const LK_T dx = (sym ? nx : vx) * dt, dy = (sym ? ny : vy) * dt, dz = (sym ? nz : vz) * dt;
+    o.x[0] = fr ? xx + dx : xx, o.x[1] = fr ? xy + dy : xy, o.x[2] = fr ? xz + dz : xz;
+    o.v[0] = fr ? nx : vx, o.v[1] = fr ? ny : vy, o.v[2] = fr ? nz : vz;
+    o.mv2 = mf * (vx * vx + vy * vy + vz * vz);
+    o.mvn2 = mf * (nx * nx + ny * ny + nz * nz);
+    o.gain = mf * ((LK_T)0.5 * ((nx - vx) * (nx + vx) + (ny - vy) * (ny + vy) + (nz - vz) * (nz + vz)) -
+                   (g[0] * dx + g[1] * dy + g[2] * dz));
+    return o;
+}
+
+/* An Euler or symplectic row, its force assembled on the fly in the general
+ * path's order (gravity and drag, radial out, ring to i + 1, radial in, ring
+ * from i - 1; the wrap spring at the two ends) and moved in place. `out` is
+ * NULL on the outermost ring. The ends' forces are formed before the loop
+ * moves anything. */
+LAT_INLINE void LK(row)(uint32_t n, bool sym, LK_T dt, const LK_T *g, LK_T drag, const LK_T *restrict mass,
+                        const LK_T *restrict inv_mass, LK_T *restrict xx, LK_T *restrict xy, LK_T *restrict xz,
+                        LK_T *restrict vx, LK_T *restrict vy, LK_T *restrict vz, const LK_T *restrict ix,
+                        const LK_T *restrict iy, const LK_T *restrict iz, const LK_T *restrict rx,
+                        const LK_T *restrict ry, const LK_T *restrict rz, const LK_T *restrict ox,
+                        const LK_T *restrict oy, const LK_T *restrict oz, LK_T *restrict t_mv2,
+                        LK_T *restrict t_gain, LK_T *restrict t_mvn2)
+{
+    const uint32_t l = n - 1;
+    LK_T e0[3], el[3];
+    const LK_T *V[3] = {vx, vy, vz}, *I[3] = {ix, iy, iz}, *R[3] = {rx, ry, rz}, *O[3] = {ox, oy, oz};
+    for (int c = 0; c < 3; c++) {
+        LK_T f0 = mass[0] * g[c] - (drag * mass[0]) * V[c][0], fl = mass[l] * g[c] - (drag * mass[l]) * V[c][l];
+        if (ox) f0 += O[c][0], fl += O[c][l];
+        e0[c] = ((f0 + R[c][0]) + R[c][l]) - I[c][0];
+        el[c] = ((fl - I[c][l]) - R[c][l]) - R[c][l - 1];
+    }
+#define LK_STORE(i, o)                                                                                          \
+    do {                                                                                                        \
+        xx[i] = (o).x[0], xy[i] = (o).x[1], xz[i] = (o).x[2];                                                   \
+        vx[i] = (o).v[0], vy[i] = (o).v[1], vz[i] = (o).v[2];                                                   \
+        t_mv2[i] = (o).mv2, t_gain[i] = (o).gain, t_mvn2[i] = (o).mvn2;                                         \
+    } while (0)
+    if (ox)
+        for (uint32_t i = 1; i < l; i++) {
+            const LK_T m = mass[i], dm = drag * m;
+            const LK_T fx = ((((m * g[0] - dm * vx[i]) + ox[i]) + rx[i]) - ix[i]) - rx[i - 1];
+            const LK_T fy = ((((m * g[1] - dm * vy[i]) + oy[i]) + ry[i]) - iy[i]) - ry[i - 1];
+            const LK_T fz = ((((m * g[2] - dm * vz[i]) + oz[i]) + rz[i]) - iz[i]) - rz[i - 1];
+            const LK(moved) o = LK(one)(fx, fy, fz, inv_mass[i], m, xx[i], xy[i], xz[i], vx[i], vy[i], vz[i], sym, dt, g);
+            LK_STORE(i, o);
+        }
+    else
+        for (uint32_t i = 1; i < l; i++) {
+            const LK_T m = mass[i], dm = drag * m;
+            const LK_T fx = (((m * g[0] - dm * vx[i]) + rx[i]) - ix[i]) - rx[i - 1];
+            const LK_T fy = (((m * g[1] - dm * vy[i]) + ry[i]) - iy[i]) - ry[i - 1];
+            const LK_T fz = (((m * g[2] - dm * vz[i]) + rz[i]) - iz[i]) - rz[i - 1];
+            const LK(moved) o = LK(one)(fx, fy, fz, inv_mass[i], m, xx[i], xy[i], xz[i], vx[i], vy[i], vz[i], sym, dt, g);
+            LK_STORE(i, o);
+        }
+    const uint32_t ends[2] = {0, l};
+    for (int k = 0; k < 2; k++) {
+        const uint32_t i = ends[k];
+        const LK_T *f = k ? el : e0;
+        const LK(moved) o =
+            LK(one)(f[0], f[1], f[2], inv_mass[i], mass[i], xx[i], xy[i], xz[i], vx[i], vy[i], vz[i], sym, dt, g);
+        LK_STORE(i, o);
+    }
+#undef LK_STORE
+}
+
+/* RK4 (Mehla 2005, eqs. 4.16-4.19). The state a stage is evaluated at and
+ * the trial state it writes are different arrays (the sweep alternates two),
+ * so no restrict pointer below aliases another. */
+
+/* The complete force on a row, component c, in LK(row)'s order. */
+LAT_INLINE void LK(assemble)(uint32_t n, LK_T gc, LK_T drag, const LK_T *restrict mass, const LK_T *restrict vc,
+                             const LK_T *restrict in, const LK_T *restrict ring, const LK_T *restrict out,
+                             LK_T *restrict f)
+{
+    const LK_T wrap = ring[n - 1];
+    if (out)
+        for (uint32_t i = 1; i + 1 < n; i++)
+            f[i] = ((((mass[i] * gc - (drag * mass[i]) * vc[i]) + out[i]) + ring[i]) - in[i]) - ring[i - 1];
+    else
+        for (uint32_t i = 1; i + 1 < n; i++)
+            f[i] = (((mass[i] * gc - (drag * mass[i]) * vc[i]) + ring[i]) - in[i]) - ring[i - 1];
+    const uint32_t l = n - 1;
+    LK_T f0 = mass[0] * gc - (drag * mass[0]) * vc[0], fl = mass[l] * gc - (drag * mass[l]) * vc[l];
+    if (out) f0 += out[0], fl += out[l];
+    f[0] = ((f0 + ring[0]) + wrap) - in[0];
+    f[l] = ((fl - in[l]) - wrap) - ring[l - 1];
+}
+
+/* The sum term of a stage but the last: m v^2 of the free particles (its
+ * gain and new-energy terms are zero, so they are not summed at all). */
+LAT_INLINE void LK(rk4_kin)(uint32_t n, const LK_T *restrict mass, const LK_T *restrict inv_mass,
+                            const LK_T *restrict Vx, const LK_T *restrict Vy, const LK_T *restrict Vz,
+                            LK_T *restrict t_mv2)
+{
+    for (uint32_t i = 0; i < n; i++)
+        t_mv2[i] = (inv_mass[i] != 0 ? mass[i] : (LK_T)0) * (Vx[i] * Vx[i] + Vy[i] * Vy[i] + Vz[i] * Vz[i]);
+}
+
+/* One component of a stage but the last: the weighted sums ax, av and the
+ * next trial state xt = xb + h V, vt = vb + h F / m (xb, vb: the step's
+ * base; a fixed particle stays there). */
+LAT_INLINE void LK(rk4_stage)(uint32_t n, bool first, LK_T h, LK_T wgt, const LK_T *restrict inv_mass,
+                              const LK_T *restrict Vc, const LK_T *restrict Fc, const LK_T *restrict xb,
+                              const LK_T *restrict vb, LK_T *restrict xt, LK_T *restrict vt, LK_T *restrict ax,
+                              LK_T *restrict av)
+{
+    for (uint32_t i = 0; i < n; i++) {
+        const LK_T im = inv_mass[i], s = h * im;
+        const bool fr = im != 0;
+        const LK_T vc = Vc[i], fc = Fc[i];
+        ax[i] = fr ? (first ? vc : ax[i] + vc * wgt) : ax[i];
+        av[i] = fr ? (first ? fc : av[i] + fc * wgt) : av[i];
+        xt[i] = fr ? xb[i] + vc * h : xb[i];
+        vt[i] = fr ? vb[i] + fc * s : vb[i];
+    }
+}
+
+/* The last stage's sums, from the base state before LK(rk4_last) moves it:
+ * m V^2 at the evaluated state, m v'^2 after the step and the gain of
+ * kinetic + gravitational energy. A loop of its own: GCC 12 does not
+ * vectorise the update and the sums as one loop over two dozen arrays (too
+ * many run-time alias checks). */
+LAT_INLINE void LK(rk4_sums)(uint32_t n, LK_T h6, const LK_T *g, const LK_T *restrict mass,
+                             const LK_T *restrict inv_mass, const LK_T *restrict Vx, const LK_T *restrict Vy,
+                             const LK_T *restrict Vz, const LK_T *restrict Fx, const LK_T *restrict Fy,
+                             const LK_T *restrict Fz, const LK_T *restrict axx, const LK_T *restrict axy,
+                             const LK_T *restrict axz, const LK_T *restrict avx, const LK_T *restrict avy,
+                             const LK_T *restrict avz, const LK_T *restrict ux, const LK_T *restrict uy,
+                             const LK_T *restrict uz, LK_T *restrict t_mv2, LK_T *restrict t_gain,
+                             LK_T *restrict t_mvn2)
+{
+    for (uint32_t i = 0; i < n; i++) {
+        const LK_T im = inv_mass[i], s = h6 * im;
+        const LK_T mf = im != 0 ? mass[i] : (LK_T)0;
+        const LK_T vx = Vx[i], vy = Vy[i], vz = Vz[i], wx = ux[i], wy = uy[i], wz = uz[i];
+        const LK_T ex = (axx[i] + vx) * h6, ey = (axy[i] + vy) * h6, ez = (axz[i] + vz) * h6;
+        const LK_T nx = wx + (avx[i] + Fx[i]) * s, ny = wy + (avy[i] + Fy[i]) * s, nz = wz + (avz[i] + Fz[i]) * s;
+        t_mv2[i] = mf * (vx * vx + vy * vy + vz * vz);
+        t_mvn2[i] = mf * (nx * nx + ny * ny + nz * nz);
+        t_gain[i] = mf * ((LK_T)0.5 * ((nx - wx) * (nx + wx) + (ny - wy) * (ny + wy) + (nz - wz) * (nz + wz)) -
+                          (g[0] * ex + g[1] * ey + g[2] * ez));
+    }
+}
+
+/* The last stage, one component: x += h/6 (ax + V), v += h/6 (av + F) / m
+ * (the same expressions as LK(rk4_sums)). */
+LAT_INLINE void LK(rk4_last)(uint32_t n, LK_T h6, const LK_T *restrict inv_mass, const LK_T *restrict Vc,
+                             const LK_T *restrict Fc, const LK_T *restrict axc, const LK_T *restrict avc,
+                             LK_T *restrict xc, LK_T *restrict uc)
+{
+    for (uint32_t i = 0; i < n; i++) {
+        const LK_T im = inv_mass[i], s = h6 * im;
+        const bool fr = im != 0;
+        const LK_T e = (axc[i] + Vc[i]) * h6, nu = uc[i] + (avc[i] + Fc[i]) * s;
+        xc[i] = fr ? xc[i] + e : xc[i];
+        uc[i] = fr ? nu : uc[i];
+    }
+}
