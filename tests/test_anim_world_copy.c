@@ -20,26 +20,7 @@
 #include <spinneret/spinneret.h>
 
 #include "anim/anim_internal.h"
-
-/* User pointers: only their addresses matter. */
-static int force_user, break_user, collide_user, air_user;
-
-/* A small sideways push, varying in space and time. */
-static void push(void *user, const spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v, spn_vec3 *f)
-{
-    (void)user;
-    (void)v;
-    for (uint32_t i = 0; i < spn_world_particle_count(w); i++)
-        f[i] = spn_v3_add(f[i], spn_v3(0, 0, 2e-9 * (1 + sin(30 * x[i].x + 200 * t))));
-}
-
-static void on_break(void *user, uint32_t s, double t, double length)
-{
-    (void)user;
-    (void)s;
-    (void)t;
-    (void)length;
-}
+#include "world_settings_util.h"
 
 /* A wall at z = 2e-5 that keeps half the normal speed. */
 static double wall(void *user, uint32_t i, spn_vec3 from, spn_vec3 to, spn_vec3 *normal, double *keep)
@@ -53,47 +34,12 @@ static double wall(void *user, uint32_t i, spn_vec3 from, spn_vec3 to, spn_vec3 
     return (z - from.z) / (to.z - from.z);
 }
 
-static spn_vec3 breeze(void *user, double t, spn_vec3 p)
-{
-    (void)user;
-    return spn_v3(0.1 * sin(3 * p.x), 0, 0.8 + 0.3 * sin(5 * t + 7 * p.y));
-}
-
-/* The standard web, 6 rings x 12 radials (73 particles). */
-static spn_world *small_orb(spn_integrator integ)
-{
-    spn_world_def def = spn_world_def_default();
-    def.integrator = integ;
-    def.threads = 1;
-    spn_orb_scene_def od = spn_orb_scene_def_default();
-    od.rings = 6;
-    od.radials = 12;
-    spn_world *w = NULL;
-    assert_int_equal(spn_scene_orb(&def, &od, &w), SPN_OK);
-    return w;
-}
-
-/* Everything settable outside the world's definition, none at its default. */
+/* Everything settable outside the world's definition, none at its default:
+ * a wall to collide with and a pushing contact of the hub on a capture
+ * segment, 0.1 mm deep. */
 static void set_everything(spn_world *w)
 {
-    spn_world_set_lattice(w, false);
-    spn_world_set_precision(w, SPN_PRECISION_FLOAT32);
-    assert_int_equal(spn_world_set_implicit_preconditioner(w, SPN_PRECOND_MULTIGRID), SPN_OK);
-    spn_world_set_force_callback(w, push, &force_user);
-    spn_world_set_break_callback(w, on_break, &break_user);
-    spn_world_set_collide_callback(w, wall, &collide_user);
-    spn_world_set_air(w, breeze, &air_user, 1.1, 1.9e-5);
-    spn_world_set_tag_diameter(w, SPN_THREAD_CAPTURE, 1e-5);
-    spn_world_set_tag_diameter(w, SPN_THREAD_RADIUS, 3e-6);
-    assert_int_equal(spn_world_set_tag_hysteresis(w, SPN_THREAD_RADIUS, 0.6, 2e-3), SPN_OK);
-    assert_int_equal(spn_world_add_plane(w, spn_v3(0, 1, 0), -0.2, 0.3, 0.4), SPN_OK);
-    assert_int_equal(spn_world_add_sphere(w, spn_v3(0, 0, 0.05), 0.01, 0.5, 0.1), SPN_OK);
-    assert_int_equal(spn_world_set_metadata(w, "{\"note\": \"copied\"}"), SPN_OK);
-    spn_world_set_time(w, 0.25);
-    spn_world_set_gravity(w, spn_v3(0, -9.7, 0.1));
-    spn_world_set_drag(w, 0.5);
-    assert_int_equal(spn_world_set_solver_tolerance(w, 1e-9, 400), SPN_OK);
-    /* A pushing contact of the hub on a capture segment, 0.1 mm deep. */
+    util_set_everything(w, wall, "{\"note\": \"copied\"}");
     uint32_t s = 0;
     while (spn_world_spring(w, s).tag != SPN_THREAD_CAPTURE) s++;
     spn_spring_info in = spn_world_spring(w, s);
@@ -101,45 +47,16 @@ static void set_everything(spn_world *w)
     assert_int_equal(spn_world_set_contacts(w, &c, 1), SPN_OK);
 }
 
-static void same_callbacks(const spn_world *a, const spn_world *b)
-{
-    void *ua = NULL, *ub = NULL;
-    assert_ptr_equal(spn_world_force_callback(a, &ua), spn_world_force_callback(b, &ub));
-    assert_ptr_equal(ua, ub);
-    assert_ptr_equal(spn_world_break_callback(a, &ua), spn_world_break_callback(b, &ub));
-    assert_ptr_equal(ua, ub);
-    assert_ptr_equal(spn_world_collide_callback(a, &ua), spn_world_collide_callback(b, &ub));
-    assert_ptr_equal(ua, ub);
-    double rho_a, rho_b, mu_a, mu_b;
-    assert_ptr_equal(spn_world_air(a, &ua, &rho_a, &mu_a), spn_world_air(b, &ub, &rho_b, &mu_b));
-    assert_ptr_equal(ua, ub);
-    assert_true(rho_a == rho_b && mu_a == mu_b);
-}
-
+/* The same settings (world_settings_util.h) and the same contacts. */
 static void same_settings(const spn_world *a, const spn_world *b)
 {
-    const spn_world_def *da = spn_world_get_def(a), *db = spn_world_get_def(b);
-    assert_true(spn_v3_len(spn_v3_sub(da->gravity, db->gravity)) == 0 && da->drag == db->drag);
-    assert_true(da->integrator == db->integrator && da->cg_tolerance == db->cg_tolerance &&
-                da->cg_max_iterations == db->cg_max_iterations);
-    assert_int_equal(spn_world_lattice_allowed(a), spn_world_lattice_allowed(b));
-    assert_int_equal(spn_world_precision(a), spn_world_precision(b));
-    assert_int_equal(spn_world_implicit_preconditioner(a), spn_world_implicit_preconditioner(b));
-    same_callbacks(a, b);
-    for (uint32_t tag = 0; tag <= SPN_THREAD_SHOT; tag++) {
-        double ra, rb;
-        assert_true(spn_world_tag_diameter(a, tag) == spn_world_tag_diameter(b, tag));
-        assert_true(spn_world_tag_hysteresis(a, tag, &ra) == spn_world_tag_hysteresis(b, tag, &rb) && ra == rb);
-    }
-    assert_int_equal(spn_world_collider_count(a), spn_world_collider_count(b));
+    util_same_settings(a, b);
     uint32_t na, nb;
     const spn_contact *ca = spn_world_contacts(a, &na), *cb = spn_world_contacts(b, &nb);
     assert_int_equal(na, nb);
     for (uint32_t k = 0; k < na; k++)
         assert_true(ca[k].p == cb[k].p && ca[k].a == cb[k].a && ca[k].b == cb[k].b && ca[k].u == cb[k].u &&
                     ca[k].k == cb[k].k && ca[k].depth == cb[k].depth && ca[k].pull == cb[k].pull);
-    assert_string_equal(spn_world_metadata(a), spn_world_metadata(b));
-    assert_true(spn_world_time(a) == spn_world_time(b));
 }
 
 static void same_state(const spn_world *a, const spn_world *b)
@@ -179,7 +96,7 @@ static spn_world *copy_like_prey(spn_world *w, double scale)
 static void test_copy_carries_every_setting(void **state)
 {
     (void)state;
-    spn_world *w = small_orb(SPN_INTEGRATOR_IMPLICIT);
+    spn_world *w = util_small_orb(SPN_INTEGRATOR_IMPLICIT);
     set_everything(w);
     spn_world *c = copy_like_prey(w, 1);
     assert_int_equal(spn_world_implicit_preconditioner(c), SPN_PRECOND_MULTIGRID);
@@ -203,7 +120,7 @@ static void test_copy_carries_every_setting(void **state)
 static void test_copy_mid_run_steps_on_alike(void **state)
 {
     (void)state;
-    spn_world *w = small_orb(SPN_INTEGRATOR_ADAPTIVE);
+    spn_world *w = util_small_orb(SPN_INTEGRATOR_ADAPTIVE);
     set_everything(w);
     for (int k = 0; k < 3; k++) assert_int_equal(spn_world_step(w, 2e-5), SPN_OK);
     spn_world *c = copy_like_prey(w, 0.5);
@@ -223,7 +140,7 @@ static void test_copy_keeps_lattice_and_precision(void **state)
 {
     (void)state;
     for (int allow = 0; allow <= 1; allow++) {
-        spn_world *w = small_orb(SPN_INTEGRATOR_SYMPLECTIC);
+        spn_world *w = util_small_orb(SPN_INTEGRATOR_SYMPLECTIC);
         for (uint32_t s = 0; s < spn_world_spring_count(w); s++) spn_world_set_spring_tag(w, s, SPN_THREAD_GENERIC);
         spn_world_set_lattice(w, allow);
         spn_world_set_precision(w, SPN_PRECISION_FLOAT32);
@@ -251,7 +168,7 @@ static void test_copy_keeps_lattice_and_precision(void **state)
 static void test_prey_world_keeps_settings(void **state)
 {
     (void)state;
-    spn_world *w = small_orb(SPN_INTEGRATOR_IMPLICIT);
+    spn_world *w = util_small_orb(SPN_INTEGRATOR_IMPLICIT);
     set_everything(w);
     spn_prey_def prey = {.position = spn_v3(0.01, 0.01, 0.02), .velocity = spn_v3(0, 0, -1), .mass = 1e-4,
                          .radius = 2e-3};
@@ -262,11 +179,11 @@ static void test_prey_world_keeps_settings(void **state)
     assert_false(spn_world_lattice_allowed(w));
     assert_int_equal(spn_world_precision(w), SPN_PRECISION_FLOAT32);
     void *user = NULL;
-    assert_ptr_equal(spn_world_force_callback(w, &user), push);
-    assert_ptr_equal(user, &force_user);
+    assert_ptr_equal(spn_world_force_callback(w, &user), util_push);
+    assert_ptr_equal(user, &util_force_user);
     double rho = 0;
-    assert_ptr_equal(spn_world_air(w, &user, &rho, NULL), breeze);
-    assert_true(user == &air_user && rho == 1.1);
+    assert_ptr_equal(spn_world_air(w, &user, &rho, NULL), util_breeze);
+    assert_true(user == &util_air_user && rho == 1.1);
     assert_ptr_equal(spn_world_collide_callback(w, NULL), wall);
     assert_int_equal(spn_world_collider_count(w), 2);
     assert_true(spn_world_tag_diameter(w, SPN_THREAD_CAPTURE) == 1e-5);
@@ -277,7 +194,7 @@ static void test_prey_world_keeps_settings(void **state)
 static void test_break_setter_rejects_nan(void **state)
 {
     (void)state;
-    spn_world *w = small_orb(SPN_INTEGRATOR_SYMPLECTIC);
+    spn_world *w = util_small_orb(SPN_INTEGRATOR_SYMPLECTIC);
     assert_int_equal(spn_world_set_spring_breaks(w, 3, NAN, 1), SPN_ERR_INVALID);
     assert_non_null(strstr(spn_last_error(), "spring 3"));
     assert_int_equal(spn_world_set_spring_breaks(w, 3, 0, NAN), SPN_ERR_INVALID);

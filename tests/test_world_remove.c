@@ -22,40 +22,12 @@
 #include <string.h>
 #include <spinneret/spinneret.h>
 
-/* User pointers: only their addresses matter. */
-static int force_user, break_user, collide_user, air_user;
+#include "world_settings_util.h"
 
-/* A small sideways push, varying in space and time. */
-static void push(void *user, const spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v, spn_vec3 *f)
-{
-    (void)user, (void)v;
-    for (uint32_t i = 0; i < spn_world_particle_count(w); i++)
-        f[i] = spn_v3_add(f[i], spn_v3(0, 0, 2e-9 * (1 + sin(30 * x[i].x + 200 * t))));
-}
-static void on_break(void *user, uint32_t s, double t, double length) { (void)user, (void)s, (void)t, (void)length; }
 static double no_collision(void *user, uint32_t i, spn_vec3 from, spn_vec3 to, spn_vec3 *normal, double *keep)
 {
     (void)user, (void)i, (void)from, (void)to, (void)normal, (void)keep;
     return 1;
-}
-static spn_vec3 breeze(void *user, double t, spn_vec3 p)
-{
-    (void)user;
-    return spn_v3(0.1 * sin(3 * p.x), 0, 0.8 + 0.3 * sin(5 * t + 7 * p.y));
-}
-
-/* The standard web, 6 rings x 12 radials (73 particles). */
-static spn_world *small_orb(spn_integrator integ)
-{
-    spn_world_def def = spn_world_def_default();
-    def.integrator = integ;
-    def.threads = 1;
-    spn_orb_scene_def od = spn_orb_scene_def_default();
-    od.rings = 6;
-    od.radials = 12;
-    spn_world *w = NULL;
-    assert_int_equal(spn_scene_orb(&def, &od, &w), SPN_OK);
-    return w;
 }
 
 /* Particles removed by the tests (unsorted on purpose); none is particle 50
@@ -89,55 +61,19 @@ static spn_contact hub_contact(const spn_world *w)
     return c;
 }
 
-/* Everything settable outside the world's definition, none at its default. */
+/* Everything settable outside the world's definition, none at its default,
+ * and a contact of the hub on a capture segment. */
 static void set_everything(spn_world *w)
 {
-    spn_world_set_lattice(w, false);
-    spn_world_set_precision(w, SPN_PRECISION_FLOAT32);
-    assert_int_equal(spn_world_set_implicit_preconditioner(w, SPN_PRECOND_MULTIGRID), SPN_OK);
-    spn_world_set_force_callback(w, push, &force_user);
-    spn_world_set_break_callback(w, on_break, &break_user);
-    spn_world_set_collide_callback(w, no_collision, &collide_user);
-    spn_world_set_air(w, breeze, &air_user, 1.1, 1.9e-5);
-    spn_world_set_tag_diameter(w, SPN_THREAD_CAPTURE, 1e-5);
-    assert_int_equal(spn_world_set_tag_hysteresis(w, SPN_THREAD_RADIUS, 0.6, 2e-3), SPN_OK);
-    assert_int_equal(spn_world_add_plane(w, spn_v3(0, 1, 0), -0.2, 0.3, 0.4), SPN_OK);
-    assert_int_equal(spn_world_add_sphere(w, spn_v3(0, 0, 0.05), 0.01, 0.5, 0.1), SPN_OK);
-    assert_int_equal(spn_world_set_metadata(w, "{\"note\": \"kept\"}"), SPN_OK);
-    spn_world_set_time(w, 0.25);
-    spn_world_set_gravity(w, spn_v3(0, -9.7, 0.1));
-    spn_world_set_drag(w, 0.5);
-    assert_int_equal(spn_world_set_solver_tolerance(w, 1e-9, 400), SPN_OK);
+    util_set_everything(w, no_collision, "{\"note\": \"kept\"}");
     spn_contact c = hub_contact(w);
     assert_int_equal(spn_world_set_contacts(w, &c, 1), SPN_OK);
 }
 
+/* The same settings (world_settings_util.h), step count and energy ledger. */
 static void same_settings(const spn_world *a, const spn_world *b)
 {
-    const spn_world_def *da = spn_world_get_def(a), *db = spn_world_get_def(b);
-    assert_memory_equal(da, db, sizeof *da);
-    assert_int_equal(spn_world_lattice_allowed(a), spn_world_lattice_allowed(b));
-    assert_int_equal(spn_world_precision(a), spn_world_precision(b));
-    assert_int_equal(spn_world_implicit_preconditioner(a), spn_world_implicit_preconditioner(b));
-    void *ua = NULL, *ub = NULL;
-    assert_ptr_equal(spn_world_force_callback(a, &ua), spn_world_force_callback(b, &ub));
-    assert_ptr_equal(ua, ub);
-    assert_ptr_equal(spn_world_break_callback(a, &ua), spn_world_break_callback(b, &ub));
-    assert_ptr_equal(ua, ub);
-    assert_ptr_equal(spn_world_collide_callback(a, &ua), spn_world_collide_callback(b, &ub));
-    assert_ptr_equal(ua, ub);
-    double rho_a, rho_b, mu_a, mu_b;
-    assert_ptr_equal(spn_world_air(a, &ua, &rho_a, &mu_a), spn_world_air(b, &ub, &rho_b, &mu_b));
-    assert_ptr_equal(ua, ub);
-    assert_true(rho_a == rho_b && mu_a == mu_b);
-    for (uint32_t tag = 0; tag <= SPN_THREAD_SHOT; tag++) {
-        double ra, rb;
-        assert_true(spn_world_tag_diameter(a, tag) == spn_world_tag_diameter(b, tag));
-        assert_true(spn_world_tag_hysteresis(a, tag, &ra) == spn_world_tag_hysteresis(b, tag, &rb) && ra == rb);
-    }
-    assert_int_equal(spn_world_collider_count(a), spn_world_collider_count(b));
-    assert_string_equal(spn_world_metadata(a), spn_world_metadata(b));
-    assert_true(spn_world_time(a) == spn_world_time(b));
+    util_same_settings(a, b);
     assert_int_equal(spn_world_step_count(a), spn_world_step_count(b));
     spn_energy ea = spn_world_energy(a), eb = spn_world_energy(b);
     assert_true(ea.external_work == eb.external_work && ea.dissipated == eb.dissipated);
@@ -189,7 +125,7 @@ static void springs_kept(const spn_world *before, const spn_world *after, const 
 static void test_removal_keeps_settings_and_state(void **state)
 {
     (void)state;
-    spn_world *w = small_orb(SPN_INTEGRATOR_IMPLICIT);
+    spn_world *w = util_small_orb(SPN_INTEGRATOR_IMPLICIT);
     set_everything(w);
     for (int k = 0; k < 3; k++) assert_int_equal(spn_world_step(w, 1e-3), SPN_OK);
     spn_world *before = spn_world_clone(w);
@@ -251,7 +187,7 @@ static void removed_energy(const spn_world *w, double *kinetic, double *elastic)
 static void test_energy_is_that_of_the_survivors(void **state)
 {
     (void)state;
-    spn_world *w = small_orb(SPN_INTEGRATOR_SYMPLECTIC);
+    spn_world *w = util_small_orb(SPN_INTEGRATOR_SYMPLECTIC);
     for (uint32_t i = 0; i < spn_world_particle_count(w); i++)
         if (!spn_world_is_fixed(w, i)) spn_world_set_velocity(w, i, spn_v3(1e-3 * sin(i), 0, 2e-3 * cos(3.0 * i)));
     spn_world *ref = built_from_survivors(w);
@@ -294,7 +230,7 @@ static void unchanged(const spn_world *w, const spn_world *before, const uint32_
 static void test_bad_ids_change_nothing(void **state)
 {
     (void)state;
-    spn_world *w = small_orb(SPN_INTEGRATOR_SYMPLECTIC), *before = spn_world_clone(w);
+    spn_world *w = util_small_orb(SPN_INTEGRATOR_SYMPLECTIC), *before = spn_world_clone(w);
     spn_contact c = hub_contact(w);
     c.p = 5;
     assert_int_equal(spn_world_set_contacts(w, &c, 1), SPN_OK);
@@ -327,7 +263,7 @@ static void test_bad_ids_change_nothing(void **state)
 static void test_none_all_and_compiled(void **state)
 {
     (void)state;
-    spn_world *w = small_orb(SPN_INTEGRATOR_SYMPLECTIC);
+    spn_world *w = util_small_orb(SPN_INTEGRATOR_SYMPLECTIC);
     assert_int_equal(spn_world_compile(w), SPN_OK);
     assert_string_equal(spn_world_step_path(w), "lattice");
     uint32_t np = spn_world_particle_count(w), ns = spn_world_spring_count(w);

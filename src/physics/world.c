@@ -199,17 +199,7 @@ spn_status spn_world_remove_springs(spn_world *w, const bool *remove)
     uint32_t n = 0;
     for (uint32_t s = 0; s < w->ns; s++) {
         if (remove[s]) continue;
-        w->sa[n] = w->sa[s];
-        w->sb[n] = w->sb[s];
-        w->k[n] = w->k[s];
-        w->kd[n] = w->kd[s];
-        w->rest[n] = w->rest[s];
-        w->bmin[n] = w->bmin[s];
-        w->bmax[n] = w->bmax[s];
-        w->sflags[n] = w->sflags[s];
-        w->stag[n] = w->stag[s];
-        w->sstage[n] = w->sstage[s];
-        w->sorder[n] = w->sorder[s];
+        spn__move_spring(w, s, n, w->sa[s], w->sb[s]);
         n++;
     }
     w->ns = n;

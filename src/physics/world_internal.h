@@ -215,6 +215,17 @@ int spn__threads(const spn_world *w, uint32_t n);
 spn_status spn__scratch(spn_world *w, int count);
 /* Sum the SPN_NSUMS partials of `blocks` blocks in block order into out[]. */
 void spn__sum_partials(const spn_world *w, uint32_t blocks, double *out);
+/* Spring record `from` into slot `to` (to <= from: compacting the list),
+ * its ends renumbered to a, b. */
+static inline void spn__move_spring(spn_world *w, uint32_t from, uint32_t to, uint32_t a, uint32_t b)
+{
+    w->sa[to] = a, w->sb[to] = b;
+    w->k[to] = w->k[from], w->kd[to] = w->kd[from], w->rest[to] = w->rest[from];
+    w->bmin[to] = w->bmin[from], w->bmax[to] = w->bmax[from];
+    w->sflags[to] = w->sflags[from], w->stag[to] = w->stag[from];
+    w->sstage[to] = w->sstage[from], w->sorder[to] = w->sorder[from];
+}
+
 static inline uint32_t spn__blocks(uint32_t n) { return (n + SPN_BLOCK - 1) / SPN_BLOCK; }
 
 /* True when air drag acts on some segment. */

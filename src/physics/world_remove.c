@@ -89,17 +89,7 @@ static void compact_springs(spn_world *w, const uint32_t *map, uint32_t *spring_
         const uint32_t a = map[w->sa[s]], b = map[w->sb[s]];
         if (spring_map) spring_map[s] = (a == SPN_REMOVED || b == SPN_REMOVED) ? SPN_REMOVED : n;
         if (a == SPN_REMOVED || b == SPN_REMOVED) continue;
-        w->sa[n] = a;
-        w->sb[n] = b;
-        w->k[n] = w->k[s];
-        w->kd[n] = w->kd[s];
-        w->rest[n] = w->rest[s];
-        w->bmin[n] = w->bmin[s];
-        w->bmax[n] = w->bmax[s];
-        w->sflags[n] = w->sflags[s];
-        w->stag[n] = w->stag[s];
-        w->sstage[n] = w->sstage[s];
-        w->sorder[n] = w->sorder[s];
+        spn__move_spring(w, s, n, a, b);
         n++;
     }
     w->ns = n;
