@@ -26,8 +26,9 @@
  * j's radial springs (to row j - 1, not moved yet) and its ring springs are
  * computed; then row j - 1 has every force it will get and is moved in
  * place. So every spring sees the state from before the step, and each
- * particle is read once and written once. Big webs take several steps to a
- * sweep (lattice_block.c).
+ * particle is read once and written once (lattice_sweep_t.h, the float32
+ * step's sweep too). Big webs take several steps to a sweep
+ * (lattice_block.c).
  *
  * Same bits as the general two-pass step. A particle's force is summed in the
  * order the gather uses for a web numbered like spn_scene_orb (radials added
@@ -179,9 +180,9 @@ static bool prepare(spn_world *w, int threads)
 /* ---- the sweep ---- */
 
 /* Row p0 of the evaluated state. */
-LAT_INLINE void eval_rows(const lat_args *a, size_t p0, const double **X, const double **V)
+LAT_INLINE void eval_rows(const lat_args *a, size_t p0, double **X, double **V)
 {
-    for (int c = 0; c < 3; c++) X[c] = a->ex[c] + p0, V[c] = a->ev[c] + p0;
+    for (int c = 0; c < 3; c++) X[c] = (double *)a->ex[c] + p0, V[c] = (double *)a->ev[c] + p0;
 }
 
 /* Particles p0 .. p0+n-1 of an RK4 stage, their force F (3 arrays) known. */
@@ -228,95 +229,51 @@ static void hub(const lat_args *a, double *const *rad, double *const *t, double 
     rk4_update(a, 0, 1, Fp, t, acc);
 }
 
-/* Radial springs into band b's first row, from the state before the step. */
-SPN__KERNEL static void cut_pass(const lat_args *a, double *ws, uint32_t b)
+/* The sweep (lattice_sweep_t.h) on the float64 state. */
+LAT_INLINE void radials64(const lat_args *a, double *const *Xa, double *const *Va, double *const *Xb,
+                          double *const *Vb, uint32_t j, double *const *f, double *e, double *p, double *acc_e,
+                          double *acc_p)
 {
     const spn__lattice *L = a->L;
-    const uint32_t n = L->radials, j = b * L->band_rows;
-    const size_t st = L->stride;
-    const double *Xa[3], *Va[3], *Xb[3], *Vb[3];
-    double *f[3];
-    eval_rows(a, 1 + (size_t)(j - 1) * n, Xa, Va);
-    eval_rows(a, 1 + (size_t)j * n, Xb, Vb);
-    for (int c = 0; c < 3; c++) f[c] = L->cut + ((size_t)b * 3 + c) * n;
-    double acc_e[LANES] = {0}, acc_p[LANES] = {0};
-    springs_rows(n, Xa, Va, Xb, Vb, 0, 0, L->rk + (size_t)j * n, L->rkd + (size_t)j * n, L->rrest + (size_t)j * n,
-                 f, 0, ws + (size_t)WS_E * st, ws + (size_t)WS_P * st, acc_e, acc_p);
-    double *p = L->partial + (size_t)b * L_NSUMS;
-    p[L_ELASTIC] = lane_total(acc_e), p[L_DAMP] = lane_total(acc_p);
+    const size_t s0 = (size_t)j * L->radials;
+    springs_rows(L->radials, (const double *const *)Xa, (const double *const *)Va, (const double *const *)Xb,
+                 (const double *const *)Vb, 0, 0, L->rk + s0, L->rkd + s0, L->rrest + s0, f, 0, e, p, acc_e, acc_p);
 }
 
-/* Sweep band b (see the file comment): rows read straight from the state
- * arrays, each moved in place once every spring that reads it is done. */
-SPN__KERNEL static void band_pass(const lat_args *a, double *ws, uint32_t b)
+LAT_INLINE void rings64(const lat_args *a, double *const *X, double *const *V, uint32_t j, double *const *f,
+                        double *e, double *p, double *acc_e, double *acc_p)
 {
     const spn__lattice *L = a->L;
-    const uint32_t n = L->radials, lo = b * L->band_rows;
-    const uint32_t hi = lo + L->band_rows < L->rings ? lo + L->band_rows : L->rings;
-    const size_t st = L->stride;
-    double *RAD[2][3], *RING[2][3], *H[6], *t[3], *Fw[3], *cut[3], *next_cut[3];
-    for (int c = 0; c < 3; c++) {
-        RAD[0][c] = ws + (WS_RAD + c) * st, RAD[1][c] = ws + (WS_RAD + 3 + c) * st;
-        RING[0][c] = ws + (WS_RING + c) * st, RING[1][c] = ws + (WS_RING + 3 + c) * st;
-        t[c] = ws + (WS_T + c) * st, Fw[c] = ws + (WS_F + c) * st;
-        cut[c] = L->cut + ((size_t)b * 3 + c) * n;
-        next_cut[c] = L->cut + ((size_t)(b + 1) * 3 + c) * n;
-    }
-    for (int c = 0; c < 6; c++) H[c] = ws + (WS_HUB + c) * st;
-    double *e = ws + WS_E * st, *p = ws + WS_P * st;
-    double acc_e[LANES] = {0}, acc_p[LANES] = {0}, acc[L_NSUMS][LANES] = {{0}};
-    int cur = 0;
-    double **rad_cur = NULL, **rad_prev = NULL;
-    for (uint32_t j = lo; j < hi; j++, cur ^= 1) {
-        const size_t s0 = (size_t)j * n, p0 = 1 + s0;
-        const double *X[3], *V[3];
-        eval_rows(a, p0, X, V);
-        if (j == lo && j > 0) {
-            rad_cur = cut; /* computed by cut_pass; its sums are in the band's partial */
-        } else if (j == 0) {
-            for (int c = 0; c < 3; c++) {
-                const double hx = a->ex[c][0], hv = a->ev[c][0];
-                for (uint32_t i = 0; i < n; i++) H[c][i] = hx, H[3 + c][i] = hv;
-            }
-            springs_rows(n, (const double *const *)H, (const double *const *)H + 3, X, V, 0, 0, L->rk, L->rkd,
-                         L->rrest, RAD[cur], 0, e, p, acc_e, acc_p);
-            rad_cur = RAD[cur];
-            hub(a, rad_cur, t, acc);
-        } else {
-            const double *Xp[3], *Vp[3];
-            eval_rows(a, p0 - n, Xp, Vp);
-            springs_rows(n, Xp, Vp, X, V, 0, 0, L->rk + s0, L->rkd + s0, L->rrest + s0, RAD[cur], 0, e, p, acc_e,
-                         acc_p);
-            rad_cur = RAD[cur];
-        }
-        springs_rows(n - 1, X, V, X, V, 0, 1, L->gk + s0, L->gkd + s0, L->grest + s0, RING[cur], 0, e, p, acc_e,
-                     acc_p);
-        springs_rows(1, X, V, X, V, 0, n - 1, L->gk + s0 + n - 1, L->gkd + s0 + n - 1, L->grest + s0 + n - 1,
-                     RING[cur], n - 1, e, p, acc_e, acc_p);
-        if (j > lo) finish(a, p0 - n, n, rad_prev, RING[cur ^ 1], rad_cur, t, Fw, acc);
-        rad_prev = rad_cur;
-    }
-    finish(a, 1 + (size_t)(hi - 1) * n, n, rad_prev, RING[cur ^ 1], hi < L->rings ? next_cut : NULL, t, Fw, acc);
-    store_band_sums(L->partial + (size_t)b * L_NSUMS, b == 0, acc_e, acc_p, acc);
+    const uint32_t n = L->radials;
+    const size_t s0 = (size_t)j * n;
+    const double *const *cX = (const double *const *)X, *const *cV = (const double *const *)V;
+    springs_rows(n - 1, cX, cV, cX, cV, 0, 1, L->gk + s0, L->gkd + s0, L->grest + s0, f, 0, e, p, acc_e, acc_p);
+    springs_rows(1, cX, cV, cX, cV, 0, n - 1, L->gk + s0 + n - 1, L->gkd + s0 + n - 1, L->grest + s0 + n - 1, f,
+                 n - 1, e, p, acc_e, acc_p);
 }
 
-/* One force evaluation and update over the whole lattice; sums into sum[]. */
-static void sweep(const lat_args *a, int threads, double *sum)
+LAT_INLINE void hub_state64(const lat_args *a, double *x, double *v)
 {
-    const spn__lattice *L = a->L;
-    const uint32_t nb = L->nbands;
-#pragma omp parallel num_threads(threads)
-    {
-        double *ws = L->ws[spn__thread_num()];
-#pragma omp for schedule(static)
-        for (uint32_t b = 1; b < nb; b++) cut_pass(a, ws, b);
-#pragma omp for schedule(static)
-        for (uint32_t b = 0; b < nb; b++) band_pass(a, ws, b);
-    }
-    for (int k = 0; k < L_NSUMS; k++) sum[k] = 0;
-    for (uint32_t b = 0; b < nb; b++)
-        for (int k = 0; k < L_NSUMS; k++) sum[k] += L->partial[(size_t)b * L_NSUMS + k];
+    for (int c = 0; c < 3; c++) x[c] = a->ex[c][0], v[c] = a->ev[c][0];
 }
+
+static double *cut64(const lat_args *a) { return a->L->cut; }
+static double *ws64(const lat_args *a, int thread) { return a->L->ws[thread]; }
+static size_t stride64(const lat_args *a) { return a->L->stride; }
+
+#define LK_T double
+#define LK(name) name##64
+#define LK_ARGS lat_args
+#define eval64 eval_rows
+#define hub64 hub
+#define finish64 finish
+#include "lattice_sweep_t.h"
+#undef eval64
+#undef hub64
+#undef finish64
+#undef LK_ARGS
+#undef LK
+#undef LK_T
 
 /* ---- state: load and write-back ---- */
 
@@ -455,7 +412,7 @@ bool spn__lattice_explicit(spn_world *w, double dt, bool symplectic, spn__step_r
     if (!begin(w, threads, dt, false, &a)) return false;
     a.mode = symplectic ? MODE_SYMPLECTIC : MODE_EULER;
     double sum[L_NSUMS];
-    sweep(&a, threads, sum);
+    sweep64(&a, threads, sum);
     r->elastic = sum[L_ELASTIC];
     r->e_before = 0.5 * sum[L_MV2] + sum[L_ELASTIC];
     r->gain_kp = sum[L_GAIN];
@@ -496,7 +453,7 @@ bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r)
         a.first = stage == 0;
         a.weight = weight[stage];
         a.h = stage < 3 ? frac[stage + 1] * dt : dt / 6;
-        sweep(&a, threads, sum);
+        sweep64(&a, threads, sum);
         if (stage == 0) {
             r->e_before = 0.5 * sum[L_MV2] + sum[L_ELASTIC];
             r->elastic = sum[L_ELASTIC];

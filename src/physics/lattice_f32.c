@@ -21,7 +21,7 @@
  * before the difference would lose |x| / |L| times more: 1e-3 of a 2% stretch
  * on the 1M web's radials (docs/physics-lattice.md).
  *
- * The sweep is lattice.c's: rows swept outwards, the radials into a row
+ * The sweep is lattice.c's, from the same source (lattice_sweep_t.h): rows swept outwards, the radials into a row
  * computed from the previous row's state before that row moves, bands fixed
  * whatever the thread count, the radials between bands first, sums added in
  * band order. The rows are read straight from the state arrays (no copies)
@@ -41,17 +41,7 @@
  * 2^-24 of that, 4e-6 of one step's increment. */
 #define REBASE 64u
 
-/* Arrays of a thread's workspace, `stride` floats each. */
-enum {
-    F_RAD = 0,   /* 2 rows x 3: radial force on the inner end */
-    F_RING = 6,  /* 2 rows x 3: ring force on the lower end */
-    F_HUB = 12,  /* 6: the hub's d and u, replicated along a row */
-    F_E = 18,    /* per-spring elastic energy */
-    F_P = 19,    /* per-spring damping power */
-    F_T = 20,    /* 3: per-particle sum terms */
-    F_F = 23,    /* 3: RK4: the assembled force on the row being moved */
-    F_COUNT = 26
-};
+/* A thread's workspace: lattice_rows.h's WS_* arrays, `stride` floats each. */
 
 struct spn__lat32 {
     size_t np, m;
@@ -182,96 +172,48 @@ static void hub32(const a32 *a, float *const *rad, float *const *t, double (*acc
     acc[L_MV2][0] += o.mv2, acc[L_GAIN][0] += o.gain, acc[L_MVN2][0] += o.mvn2;
 }
 
-/* Radial springs into band b's first row, from the state before the step. */
-SPN__KERNEL static void cut32(const a32 *a, float *ws, uint32_t b)
+/* The sweep (lattice_sweep_t.h) on the float32 state: a spring's
+ * difference is its slot's reference difference plus the displacements'. */
+LAT_INLINE void radials32(const a32 *a, float *const *Da, float *const *Ua, float *const *Db, float *const *Ub,
+                          uint32_t j, float *const *f, float *e, float *p, double *acc_e, double *acc_p)
 {
-    const spn__lattice *L = a->L;
     const spn__lat32 *F = a->F;
-    const uint32_t n = L->radials, j = b * L->band_rows;
-    float *Da[3], *Ua[3], *Db[3], *Ub[3], *f[3];
-    eval_rows(a, 1 + (size_t)(j - 1) * n, Da, Ua);
-    eval_rows(a, 1 + (size_t)j * n, Db, Ub);
-    for (int c = 0; c < 3; c++) f[c] = F->cut + ((size_t)b * 3 + c) * n;
-    double acc_e[LANES] = {0}, acc_p[LANES] = {0};
-    spring_rows(n, Da, Ua, Db, Ub, (float *const *)F->rl, (size_t)j * n, F->rk, F->rkd, F->rr, f, 0,
-                ws + F_E * F->stride, ws + F_P * F->stride, acc_e, acc_p);
-    double *p = L->partial + (size_t)b * L_NSUMS;
-    p[L_ELASTIC] = lane_total(acc_e), p[L_DAMP] = lane_total(acc_p);
+    spring_rows(a->L->radials, Da, Ua, Db, Ub, (float *const *)F->rl, (size_t)j * a->L->radials, F->rk, F->rkd,
+                F->rr, f, 0, e, p, acc_e, acc_p);
 }
 
-/* Sweep band b (lattice.c's band_pass on the float32 state). */
-SPN__KERNEL static void band32(const a32 *a, float *ws, uint32_t b)
+LAT_INLINE void rings32(const a32 *a, float *const *D, float *const *U, uint32_t j, float *const *f, float *e,
+                        float *p, double *acc_e, double *acc_p)
 {
-    const spn__lattice *L = a->L;
-    spn__lat32 *F = a->F;
-    const uint32_t n = L->radials, lo = b * L->band_rows;
-    const uint32_t hi = lo + L->band_rows < L->rings ? lo + L->band_rows : L->rings;
-    const size_t st = F->stride;
-    float *RAD[2][3], *RING[2][3], *H[6], *t[3], *Fw[3], *cut[3], *next_cut[3];
-    for (int c = 0; c < 3; c++) {
-        RAD[0][c] = ws + (F_RAD + c) * st, RAD[1][c] = ws + (F_RAD + 3 + c) * st;
-        RING[0][c] = ws + (F_RING + c) * st, RING[1][c] = ws + (F_RING + 3 + c) * st;
-        t[c] = ws + (F_T + c) * st, Fw[c] = ws + (F_F + c) * st;
-        cut[c] = F->cut + ((size_t)b * 3 + c) * n;
-        next_cut[c] = F->cut + ((size_t)(b + 1) * 3 + c) * n;
-    }
-    for (int c = 0; c < 6; c++) H[c] = ws + (F_HUB + c) * st;
-    float *e = ws + F_E * st, *p = ws + F_P * st;
-    double acc_e[LANES] = {0}, acc_p[LANES] = {0}, acc[L_NSUMS][LANES] = {{0}};
-    int cur = 0;
-    float **rad_cur = NULL, **rad_prev = NULL;
-    for (uint32_t j = lo; j < hi; j++, cur ^= 1) {
-        const size_t s0 = (size_t)j * n, p0 = 1 + s0;
-        float *D[3], *U[3];
-        eval_rows(a, p0, D, U);
-        if (j == lo && j > 0) {
-            rad_cur = cut; /* computed by cut32; its sums are in the band's partial */
-        } else if (j == 0) {
-            for (int c = 0; c < 3; c++) {
-                const float hd = a->ed[c][0], hu = a->eu[c][0];
-                for (uint32_t i = 0; i < n; i++) H[c][i] = hd, H[3 + c][i] = hu;
-            }
-            spring_rows(n, H, H + 3, D, U, (float *const *)F->rl, 0, F->rk, F->rkd, F->rr, RAD[cur], 0, e, p, acc_e,
-                        acc_p);
-            rad_cur = RAD[cur];
-            hub32(a, rad_cur, t, acc);
-        } else {
-            float *Dp[3], *Up[3];
-            eval_rows(a, p0 - n, Dp, Up);
-            spring_rows(n, Dp, Up, D, U, (float *const *)F->rl, s0, F->rk, F->rkd, F->rr, RAD[cur], 0, e, p, acc_e,
-                        acc_p);
-            rad_cur = RAD[cur];
-        }
-        float *D1[3], *U1[3], *Dl[3], *Ul[3];
-        eval_rows(a, p0 + 1, D1, U1);
-        eval_rows(a, p0 + n - 1, Dl, Ul);
-        spring_rows(n - 1, D, U, D1, U1, (float *const *)F->gl, s0, F->gk, F->gkd, F->gr, RING[cur], 0, e, p, acc_e,
-                    acc_p);
-        spring_rows(1, D, U, Dl, Ul, (float *const *)F->gl, s0 + n - 1, F->gk, F->gkd, F->gr, RING[cur], n - 1, e, p,
-                    acc_e, acc_p);
-        if (j > lo) finish32(a, p0 - n, n, rad_prev, RING[cur ^ 1], rad_cur, t, Fw, acc);
-        rad_prev = rad_cur;
-    }
-    finish32(a, 1 + (size_t)(hi - 1) * n, n, rad_prev, RING[cur ^ 1], hi < L->rings ? next_cut : NULL, t, Fw, acc);
-    store_band_sums(L->partial + (size_t)b * L_NSUMS, b == 0, acc_e, acc_p, acc);
+    const spn__lat32 *F = a->F;
+    const uint32_t n = a->L->radials;
+    const size_t s0 = (size_t)j * n, p0 = 1 + s0;
+    float *D1[3], *U1[3], *Dl[3], *Ul[3];
+    eval_rows(a, p0 + 1, D1, U1);
+    eval_rows(a, p0 + n - 1, Dl, Ul);
+    spring_rows(n - 1, D, U, D1, U1, (float *const *)F->gl, s0, F->gk, F->gkd, F->gr, f, 0, e, p, acc_e, acc_p);
+    spring_rows(1, D, U, Dl, Ul, (float *const *)F->gl, s0 + n - 1, F->gk, F->gkd, F->gr, f, n - 1, e, p, acc_e,
+                acc_p);
 }
 
-static void sweep32(const a32 *a, int threads, double *sum)
+LAT_INLINE void hub_state32(const a32 *a, float *x, float *v)
 {
-    const spn__lattice *L = a->L;
-    const uint32_t nb = L->nbands;
-#pragma omp parallel num_threads(threads)
-    {
-        float *ws = a->F->ws[spn__thread_num()];
-#pragma omp for schedule(static)
-        for (uint32_t b = 1; b < nb; b++) cut32(a, ws, b);
-#pragma omp for schedule(static)
-        for (uint32_t b = 0; b < nb; b++) band32(a, ws, b);
-    }
-    for (int k = 0; k < L_NSUMS; k++) sum[k] = 0;
-    for (uint32_t b = 0; b < nb; b++)
-        for (int k = 0; k < L_NSUMS; k++) sum[k] += L->partial[(size_t)b * L_NSUMS + k];
+    for (int c = 0; c < 3; c++) x[c] = a->ed[c][0], v[c] = a->eu[c][0];
 }
+
+static float *cut32(const a32 *a) { return a->F->cut; }
+static float *ws32(const a32 *a, int thread) { return a->F->ws[thread]; }
+static size_t stride32(const a32 *a) { return a->F->stride; }
+
+#define LK_T float
+#define LK(name) name##32
+#define LK_ARGS a32
+#define eval32 eval_rows
+#include "lattice_sweep_t.h"
+#undef eval32
+#undef LK_ARGS
+#undef LK
+#undef LK_T
 
 /* ---- state: load, reference differences, write-back ---- */
 
@@ -376,7 +318,7 @@ static bool prepare32(spn__lattice *L, int threads)
         F->ws = ws;
         F->stride = ((size_t)L->radials + 15) & ~(size_t)15;
         for (; F->nws < threads; F->nws++)
-            if (!(F->ws[F->nws] = malloc(F_COUNT * F->stride * sizeof **F->ws))) return false;
+            if (!(F->ws[F->nws] = malloc(WS_COUNT * F->stride * sizeof **F->ws))) return false;
     }
     return true;
 }

@@ -1,0 +1,107 @@
+/* One sweep of the lattice step (lattice.c's file comment), written once for
+ * both precisions: lattice.c includes this file with LK_T = double,
+ * lattice_f32.c with LK_T = float. No include guard, on purpose.
+ *
+ * The including file defines LK(name), LK_ARGS (its step arguments, with a
+ * member L, the spn__lattice) and, for its precision:
+ *   LK(eval)(a, p0, X, V)        row p0 of the evaluated state (3 + 3 arrays)
+ *   LK(radials)(a, Xa, Va, Xb, Vb, j, f, e, p, acc_e, acc_p)
+ *                                the radial springs from row a into row j
+ *                                (b), forces on the inner end into f
+ *   LK(rings)(a, X, V, j, f, e, p, acc_e, acc_p)
+ *                                row j's ring springs, wrap included
+ *   LK(hub_state)(a, x, v)       the hub's evaluated state (3 each)
+ *   LK(hub)(a, rad, t, acc)      the hub's force from its radials, and its update
+ *   LK(finish)(a, p0, n, ri, rg, ro, t, F, acc)
+ *                                a row whose forces are complete, moved
+ *   LK(cut)(a)                   the radial forces into each band's first row
+ *   LK(ws)(a, thread), LK(stride)(a)
+ *                                the per-thread workspaces (WS_* arrays)
+ * Sums go to the band partials in L->partial, added in band order. */
+#if !defined(LK_T) || !defined(LK) || !defined(LK_ARGS)
+#error "define LK_T, LK(name) and LK_ARGS before including lattice_sweep_t.h"
+#endif
+
+/* Radial springs into band b's first row, from the state before the step;
+ * their sums start the band's partial. */
+SPN__KERNEL static void LK(cut_pass)(const LK_ARGS *a, LK_T *ws, uint32_t b)
+{
+    const spn__lattice *L = a->L;
+    const uint32_t n = L->radials, j = b * L->band_rows;
+    const size_t st = LK(stride)(a);
+    LK_T *Xa[3], *Va[3], *Xb[3], *Vb[3], *f[3];
+    LK(eval)(a, 1 + (size_t)(j - 1) * n, Xa, Va);
+    LK(eval)(a, 1 + (size_t)j * n, Xb, Vb);
+    for (int c = 0; c < 3; c++) f[c] = LK(cut)(a) + ((size_t)b * 3 + c) * n;
+    double acc_e[LANES] = {0}, acc_p[LANES] = {0};
+    LK(radials)(a, Xa, Va, Xb, Vb, j, f, ws + (size_t)WS_E * st, ws + (size_t)WS_P * st, acc_e, acc_p);
+    double *p = L->partial + (size_t)b * L_NSUMS;
+    p[L_ELASTIC] = lane_total(acc_e), p[L_DAMP] = lane_total(acc_p);
+}
+
+/* Sweep band b: rows read straight from the state arrays, each moved in
+ * place once every spring that reads it is done. */
+SPN__KERNEL static void LK(band_pass)(const LK_ARGS *a, LK_T *ws, uint32_t b)
+{
+    const spn__lattice *L = a->L;
+    const uint32_t n = L->radials, lo = b * L->band_rows;
+    const uint32_t hi = lo + L->band_rows < L->rings ? lo + L->band_rows : L->rings;
+    const size_t st = LK(stride)(a);
+    LK_T *RAD[2][3], *RING[2][3], *H[6], *t[3], *Fw[3], *cut[3], *next_cut[3];
+    for (int c = 0; c < 3; c++) {
+        RAD[0][c] = ws + (WS_RAD + c) * st, RAD[1][c] = ws + (WS_RAD + 3 + c) * st;
+        RING[0][c] = ws + (WS_RING + c) * st, RING[1][c] = ws + (WS_RING + 3 + c) * st;
+        t[c] = ws + (WS_T + c) * st, Fw[c] = ws + (WS_F + c) * st;
+        cut[c] = LK(cut)(a) + ((size_t)b * 3 + c) * n;
+        next_cut[c] = LK(cut)(a) + ((size_t)(b + 1) * 3 + c) * n;
+    }
+    for (int c = 0; c < 6; c++) H[c] = ws + (WS_HUB + c) * st;
+    LK_T *e = ws + WS_E * st, *p = ws + WS_P * st;
+    double acc_e[LANES] = {0}, acc_p[LANES] = {0}, acc[L_NSUMS][LANES] = {{0}};
+    int cur = 0;
+    LK_T **rad_cur = NULL, **rad_prev = NULL;
+    for (uint32_t j = lo; j < hi; j++, cur ^= 1) {
+        const size_t p0 = 1 + (size_t)j * n;
+        LK_T *X[3], *V[3];
+        LK(eval)(a, p0, X, V);
+        if (j == lo && j > 0) {
+            rad_cur = cut; /* computed by the cut pass; its sums are in the band's partial */
+        } else if (j == 0) {
+            LK_T hx[3], hv[3];
+            LK(hub_state)(a, hx, hv);
+            for (int c = 0; c < 3; c++)
+                for (uint32_t i = 0; i < n; i++) H[c][i] = hx[c], H[3 + c][i] = hv[c];
+            LK(radials)(a, H, H + 3, X, V, 0, RAD[cur], e, p, acc_e, acc_p);
+            rad_cur = RAD[cur];
+            LK(hub)(a, rad_cur, t, acc);
+        } else {
+            LK_T *Xp[3], *Vp[3];
+            LK(eval)(a, p0 - n, Xp, Vp);
+            LK(radials)(a, Xp, Vp, X, V, j, RAD[cur], e, p, acc_e, acc_p);
+            rad_cur = RAD[cur];
+        }
+        LK(rings)(a, X, V, j, RING[cur], e, p, acc_e, acc_p);
+        if (j > lo) LK(finish)(a, p0 - n, n, rad_prev, RING[cur ^ 1], rad_cur, t, Fw, acc);
+        rad_prev = rad_cur;
+    }
+    LK(finish)(a, 1 + (size_t)(hi - 1) * n, n, rad_prev, RING[cur ^ 1], hi < L->rings ? next_cut : NULL, t, Fw, acc);
+    store_band_sums(L->partial + (size_t)b * L_NSUMS, b == 0, acc_e, acc_p, acc);
+}
+
+/* One force evaluation and update over the whole lattice; sums into sum[]. */
+static void LK(sweep)(const LK_ARGS *a, int threads, double *sum)
+{
+    const spn__lattice *L = a->L;
+    const uint32_t nb = L->nbands;
+#pragma omp parallel num_threads(threads)
+    {
+        LK_T *ws = LK(ws)(a, spn__thread_num());
+#pragma omp for schedule(static)
+        for (uint32_t b = 1; b < nb; b++) LK(cut_pass)(a, ws, b);
+#pragma omp for schedule(static)
+        for (uint32_t b = 0; b < nb; b++) LK(band_pass)(a, ws, b);
+    }
+    for (int k = 0; k < L_NSUMS; k++) sum[k] = 0;
+    for (uint32_t b = 0; b < nb; b++)
+        for (int k = 0; k < L_NSUMS; k++) sum[k] += L->partial[(size_t)b * L_NSUMS + k];
+}
