@@ -21,8 +21,9 @@
  * before the difference would lose |x| / |L| times more: 1e-3 of a 2% stretch
  * on the 1M web's radials (docs/physics-lattice.md).
  *
- * The sweep is lattice.c's, from the same source (lattice_sweep_t.h): rows swept outwards, the radials into a row
- * computed from the previous row's state before that row moves, bands fixed
+ * The sweep is lattice.c's, from the same source (lattice_sweep_t.h): rows
+ * swept outwards, the radials into a row computed from the previous row's
+ * state before that row moves, bands fixed
  * whatever the thread count, the radials between bands first, sums added in
  * band order. The rows are read straight from the state arrays (no copies)
  * and moved in place: a row moves only after every spring that reads it has
