@@ -413,12 +413,7 @@ bool spn__lattice_explicit(spn_world *w, double dt, bool symplectic, spn__step_r
     a.mode = symplectic ? MODE_SYMPLECTIC : MODE_EULER;
     double sum[L_NSUMS];
     sweep64(&a, threads, sum);
-    r->elastic = sum[L_ELASTIC];
-    r->e_before = 0.5 * sum[L_MV2] + sum[L_ELASTIC];
-    r->gain_kp = sum[L_GAIN];
-    r->work = 0;
-    r->dissipated = dt * (sum[L_DAMP] + w->def.drag * sum[L_MV2]);
-    r->kinetic = 0.5 * sum[L_MVN2];
+    lat_explicit_result(sum, dt, w->def.drag, r);
     end(w, threads);
     return true;
 }
@@ -442,7 +437,7 @@ bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r)
     if (!begin(w, threads, dt, true, &a)) return false;
     spn__lattice *L = w->lat;
     static const double weight[4] = {1, 2, 2, 1}, frac[4] = {0, 0.5, 0.5, 1};
-    double damp = 0, sum[L_NSUMS];
+    double sums[4][L_NSUMS];
     for (int stage = 0; stage < 4; stage++) {
         double *const *from = L->trial[(stage + 1) % 2], *const *to = L->trial[stage % 2];
         for (int c = 0; c < 3; c++) {
@@ -453,17 +448,9 @@ bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r)
         a.first = stage == 0;
         a.weight = weight[stage];
         a.h = stage < 3 ? frac[stage + 1] * dt : dt / 6;
-        sweep64(&a, threads, sum);
-        if (stage == 0) {
-            r->e_before = 0.5 * sum[L_MV2] + sum[L_ELASTIC];
-            r->elastic = sum[L_ELASTIC];
-        }
-        damp += weight[stage] * (sum[L_DAMP] + w->def.drag * sum[L_MV2]);
+        sweep64(&a, threads, sums[stage]);
     }
-    r->gain_kp = sum[L_GAIN];
-    r->kinetic = 0.5 * sum[L_MVN2];
-    r->work = 0;
-    r->dissipated = dt / 6 * damp;
+    lat_rk4_result(sums, dt, w->def.drag, r);
     end(w, threads);
     return true;
 }
@@ -500,24 +487,9 @@ int spn__lattice_block_steps(spn_world *w, double dt, int k, spn__step_result *r
     double sums[LAT_LEVELS][L_NSUMS];
     if (!spn__lattice_block(w->lat, la, rk4, threads, levels, sums)) return 0;
     if (rk4) {
-        double damp = 0;
-        for (int s = 0; s < 4; s++) damp += weight[s] * (sums[s][L_DAMP] + w->def.drag * sums[s][L_MV2]);
-        r[0].e_before = 0.5 * sums[0][L_MV2] + sums[0][L_ELASTIC];
-        r[0].elastic = sums[0][L_ELASTIC];
-        r[0].gain_kp = sums[3][L_GAIN];
-        r[0].kinetic = 0.5 * sums[3][L_MVN2];
-        r[0].work = 0;
-        r[0].dissipated = dt / 6 * damp;
+        lat_rk4_result(sums, dt, w->def.drag, &r[0]);
         return 1;
     }
-    for (int q = 0; q < k; q++) {
-        const double *sum = sums[q];
-        r[q].elastic = sum[L_ELASTIC];
-        r[q].e_before = 0.5 * sum[L_MV2] + sum[L_ELASTIC];
-        r[q].gain_kp = sum[L_GAIN];
-        r[q].work = 0;
-        r[q].dissipated = dt * (sum[L_DAMP] + w->def.drag * sum[L_MV2]);
-        r[q].kinetic = 0.5 * sum[L_MVN2];
-    }
+    for (int q = 0; q < k; q++) lat_explicit_result(sums[q], dt, w->def.drag, &r[q]);
     return k;
 }

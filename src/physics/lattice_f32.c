@@ -374,12 +374,7 @@ bool spn__lat32_explicit(spn_world *w, int threads, double dt, bool symplectic, 
     a.mode = symplectic ? M_SYMPLECTIC : M_EULER;
     double sum[L_NSUMS];
     sweep32(&a, threads, sum);
-    r->elastic = sum[L_ELASTIC];
-    r->e_before = 0.5 * sum[L_MV2] + sum[L_ELASTIC];
-    r->gain_kp = sum[L_GAIN];
-    r->work = 0;
-    r->dissipated = dt * (sum[L_DAMP] + w->def.drag * sum[L_MV2]);
-    r->kinetic = 0.5 * sum[L_MVN2];
+    lat_explicit_result(sum, dt, w->def.drag, r);
     end(w, threads);
     return true;
 }
@@ -392,7 +387,7 @@ bool spn__lat32_rk4(spn_world *w, int threads, double dt, spn__step_result *r)
     if (!begin(w, threads, dt, true, &a)) return false;
     spn__lat32 *F = w->lat->f32;
     static const float weight[4] = {1, 2, 2, 1}, frac[4] = {0, 0.5f, 0.5f, 1};
-    double damp = 0, sum[L_NSUMS];
+    double sums[4][L_NSUMS];
     for (int stage = 0; stage < 4; stage++) {
         float *const *from = F->trial[(stage + 1) % 2], *const *to = F->trial[stage % 2];
         for (int c = 0; c < 3; c++) {
@@ -403,17 +398,9 @@ bool spn__lat32_rk4(spn_world *w, int threads, double dt, spn__step_result *r)
         a.first = stage == 0;
         a.weight = weight[stage];
         a.h = stage < 3 ? frac[stage + 1] * (float)dt : (float)dt / 6;
-        sweep32(&a, threads, sum);
-        if (stage == 0) {
-            r->e_before = 0.5 * sum[L_MV2] + sum[L_ELASTIC];
-            r->elastic = sum[L_ELASTIC];
-        }
-        damp += weight[stage] * (sum[L_DAMP] + w->def.drag * sum[L_MV2]);
+        sweep32(&a, threads, sums[stage]);
     }
-    r->gain_kp = sum[L_GAIN];
-    r->kinetic = 0.5 * sum[L_MVN2];
-    r->work = 0;
-    r->dissipated = dt / 6 * damp;
+    lat_rk4_result(sums, dt, w->def.drag, r);
     end(w, threads);
     return true;
 }

@@ -244,6 +244,33 @@ LAT_INLINE void lat_rk4_update(const lat_args *a, size_t p0, uint32_t n, const r
     }
 }
 
+/* An Euler or symplectic step's results from its sweep's sums. */
+static inline void lat_explicit_result(const double *sum, double dt, double drag, spn__step_result *r)
+{
+    r->elastic = sum[L_ELASTIC];
+    r->e_before = 0.5 * sum[L_MV2] + sum[L_ELASTIC];
+    r->gain_kp = sum[L_GAIN];
+    r->work = 0;
+    r->dissipated = dt * (sum[L_DAMP] + drag * sum[L_MV2]);
+    r->kinetic = 0.5 * sum[L_MVN2];
+}
+
+/* An RK4 step's results from its four stages' sums: the energy before from
+ * the first, the losses weighted 1, 2, 2, 1, the gain and new energy from
+ * the last. */
+static inline void lat_rk4_result(double sums[4][L_NSUMS], double dt, double drag, spn__step_result *r)
+{
+    static const double weight[4] = {1, 2, 2, 1};
+    double damp = 0;
+    for (int s = 0; s < 4; s++) damp += weight[s] * (sums[s][L_DAMP] + drag * sums[s][L_MV2]);
+    r->e_before = 0.5 * sums[0][L_MV2] + sums[0][L_ELASTIC];
+    r->elastic = sums[0][L_ELASTIC];
+    r->gain_kp = sums[3][L_GAIN];
+    r->kinetic = 0.5 * sums[3][L_MVN2];
+    r->work = 0;
+    r->dissipated = dt / 6 * damp;
+}
+
 /* Whether K explicit steps can go as one blocked pass on `threads` threads
  * (each thread's run of bands deep enough for its ghost rows). */
 bool spn__lattice_block_ready(const spn__lattice *L, int threads, uint32_t K);
