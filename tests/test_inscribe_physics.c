@@ -97,24 +97,31 @@ static uint32_t subdivide_capture(spn_world **wp)
 
 static double left_third(void *user, double x, double y) { return (void)user, (void)y, x < -0.05 ? 1 : 0; }
 
+/* The left third of *w inscribed, without settling; the report. */
+static spn_inscribe_report inscribe_left_third(spn_world **w)
+{
+    spn_target *t = NULL;
+    assert_int_equal(spn_target_create(*w, 1200, &t), SPN_OK);
+    spn_target_paint(t, left_third, NULL);
+    spn_inscribe_def d = spn_inscribe_def_default();
+    d.settle = false;
+    spn_inscribe_report rep;
+    assert_int_equal(spn_inscribe(w, t, &d, &rep), SPN_OK);
+    spn_target_destroy(t);
+    return rep;
+}
+
 static void test_subdivided_segments_go_whole(void **state)
 {
     (void)state;
     spn_world *w = inscribe_orb();
     uint32_t mids = subdivide_capture(&w), np = spn_world_particle_count(w);
-    spn_target *t = NULL;
-    assert_int_equal(spn_target_create(w, 1200, &t), SPN_OK);
-    spn_target_paint(t, left_third, NULL);
-    spn_inscribe_def d = spn_inscribe_def_default();
-    d.settle = false;
-    spn_inscribe_report rep;
-    assert_int_equal(spn_inscribe(&w, t, &d, &rep), SPN_OK);
+    spn_inscribe_report rep = inscribe_left_third(&w);
     assert_int_equal(rep.segments, mids); /* one segment per pair of springs */
     assert_true(rep.removed > 20);
     assert_int_equal(rep.particles_removed, rep.removed); /* each middle particle went with its segment */
     assert_int_equal(spn_world_particle_count(w), np - rep.removed);
     check_hangs_whole(w);
-    spn_target_destroy(t);
     spn_world_destroy(w);
 }
 
@@ -151,13 +158,7 @@ static void test_compaction_keeps_the_world_settings(void **state)
     spn_world_set_precision(w, SPN_PRECISION_FLOAT32);
     assert_int_equal(spn_world_set_implicit_preconditioner(w, SPN_PRECOND_MULTIGRID), SPN_OK);
     spn_world_set_time(w, 0.75);
-    spn_target *t = NULL;
-    assert_int_equal(spn_target_create(w, 1200, &t), SPN_OK);
-    spn_target_paint(t, left_third, NULL);
-    spn_inscribe_def d = spn_inscribe_def_default();
-    d.settle = false;
-    spn_inscribe_report rep;
-    assert_int_equal(spn_inscribe(&w, t, &d, &rep), SPN_OK);
+    spn_inscribe_report rep = inscribe_left_third(&w);
     assert_true(rep.particles_removed > 20); /* the compaction did run */
     void *user = NULL;
     assert_ptr_equal(spn_world_force_callback(w, &user), no_force);
@@ -178,7 +179,6 @@ static void test_compaction_keeps_the_world_settings(void **state)
     assert_int_equal(spn_world_implicit_preconditioner(w), SPN_PRECOND_MULTIGRID);
     assert_true(spn_world_time(w) == 0.75);
     check_hangs_whole(w);
-    spn_target_destroy(t);
     spn_world_destroy(w);
 }
 
@@ -200,17 +200,10 @@ static void test_broken_half_goes_with_its_particle(void **state)
     assert_true(half != SPN_REMOVED);
     assert_true(spn_world_spring(w, half).a >= np0 || spn_world_spring(w, half).b >= np0); /* ends on a middle */
     spn_world_break_spring(w, half);
-    spn_target *t = NULL;
-    assert_int_equal(spn_target_create(w, 1200, &t), SPN_OK);
-    spn_target_paint(t, left_third, NULL);
-    spn_inscribe_def d = spn_inscribe_def_default();
-    d.settle = false;
-    spn_inscribe_report rep;
-    assert_int_equal(spn_inscribe(&w, t, &d, &rep), SPN_OK);
+    spn_inscribe_report rep = inscribe_left_third(&w);
     assert_int_equal(rep.particles_removed, rep.removed + 1);
     for (uint32_t s = 0; s < spn_world_spring_count(w); s++) assert_false(spn_world_spring(w, s).broken);
     check_hangs_whole(w);
-    spn_target_destroy(t);
     spn_world_destroy(w);
 }
 

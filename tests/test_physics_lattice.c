@@ -55,6 +55,17 @@ static void assert_same_state(const spn_world *a, const spn_world *b)
     assert_memory_equal(spn_world_velocities(a), spn_world_velocities(b), n * sizeof(spn_vec3));
 }
 
+/* The same change in a and b: spring s 10% shorter at rest, spring s + 1
+ * twice as stiff (each from a's values). */
+static void change_springs(spn_world *a, spn_world *b, uint32_t s)
+{
+    spn_spring_info info = spn_world_spring(a, s);
+    spn_world_set_spring_rest(a, s, 0.9 * info.rest);
+    spn_world_set_spring_rest(b, s, 0.9 * info.rest);
+    spn_world_set_spring_stiffness(a, s + 1, 2 * info.k, info.kd);
+    spn_world_set_spring_stiffness(b, s + 1, 2 * info.k, info.kd);
+}
+
 static double fastest(const spn_world *w)
 {
     double top = 0;
@@ -142,12 +153,7 @@ static void test_blocked_passes(void **state)
         assert_memory_equal(&e2.dissipated, &er.dissipated, sizeof(double));
         assert_true(fastest(one) > 0.01);
         /* a spring changed between calls reaches the blocked passes */
-        const uint32_t sp = 1234;
-        spn_spring_info info = spn_world_spring(one, sp);
-        spn_world_set_spring_rest(one, sp, 0.9 * info.rest);
-        spn_world_set_spring_rest(ref, sp, 0.9 * info.rest);
-        spn_world_set_spring_stiffness(one, sp + 1, 2 * info.k, info.kd);
-        spn_world_set_spring_stiffness(ref, sp + 1, 2 * info.k, info.kd);
+        change_springs(one, ref, 1234);
         assert_int_equal(spn_world_advance(one, dt, 8), SPN_OK);
         assert_int_equal(spn_world_last_step(one).blocked, 8);
         for (int i = 0; i < 8; i++) assert_int_equal(spn_world_step(ref, dt), SPN_OK);
@@ -185,11 +191,7 @@ static void test_changes_and_break(void **state)
     assert_int_equal(spn_world_advance(lat, 2e-6, 50), SPN_OK);
     assert_int_equal(spn_world_advance(gen, 2e-6, 50), SPN_OK);
     const uint32_t s = 40;
-    spn_spring_info info = spn_world_spring(lat, s);
-    spn_world_set_spring_rest(lat, s, 0.9 * info.rest);
-    spn_world_set_spring_rest(gen, s, 0.9 * info.rest);
-    spn_world_set_spring_stiffness(lat, s + 1, 2 * info.k, info.kd);
-    spn_world_set_spring_stiffness(gen, s + 1, 2 * info.k, info.kd);
+    change_springs(lat, gen, s);
     assert_string_equal(spn_world_step_path(lat), "lattice");
     assert_int_equal(spn_world_advance(lat, 2e-6, 50), SPN_OK);
     assert_int_equal(spn_world_advance(gen, 2e-6, 50), SPN_OK);
