@@ -8,6 +8,8 @@
  *   bench_step --parallel-min N   def.parallel_min = N (default 32,768): the
  *                         size from which loops, and the lattice, use threads
  *   bench_step --integrator NAME  that integrator only
+ *   bench_step --size 5k|100k|1M  that web only (e.g. the 1M figures alone,
+ *                         repeated, on a shared machine)
  *
  * Explicit steps use dt = 1e-7 s, divided down to inside the stability limit
  * of each web (spn_anim_stable_substeps: the 1M web takes a third of it); the
@@ -128,6 +130,7 @@ int main(int argc, char **argv)
     int ncases = 3;
     long parallel_min = 0; /* 0: the world's default */
     int only = -1;         /* one integrator, or all */
+    int first = 0;         /* the first web */
     for (int i = 1; i < argc; i++) {
         char *end = NULL;
         if (strcmp(argv[i], "--quick") == 0) ncases = 1;
@@ -141,12 +144,23 @@ int main(int argc, char **argv)
                 return 2;
             }
             only = (int)in;
+        } else if (strcmp(argv[i], "--size") == 0 && i + 1 < argc) {
+            static const char *const names[3] = {"5k", "100k", "1M"};
+            const char *name = argv[++i];
+            int c = 0;
+            while (c < 3 && strcmp(name, names[c]) != 0) c++;
+            if (c == 3) {
+                fprintf(stderr, "bench_step: --size: '%s' is not 5k, 100k or 1M\n", name);
+                return 2;
+            }
+            first = c, ncases = c + 1;
         } else {
-            fprintf(stderr, "usage: bench_step [--quick] [--parallel-min N (1..2^31-1)] [--integrator NAME]\n");
+            fprintf(stderr, "usage: bench_step [--quick] [--parallel-min N (1..2^31-1)] [--integrator NAME] "
+                            "[--size 5k|100k|1M]\n");
             return 2;
         }
     }
-    for (int c = 0; c < ncases; c++)
+    for (int c = first; c < ncases; c++)
         for (int integ = 0; integ < SPN_INTEGRATOR_COUNT; integ++)
             for (int threads = 1; threads <= 2 && (only < 0 || only == integ); threads++) {
                 const spn_integrator in = (spn_integrator)integ;
