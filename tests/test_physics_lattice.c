@@ -4,7 +4,8 @@
  * same order of force sums on a web numbered like spn_scene_orb), hands over
  * to the general path when a spring breaks (by hand or at its break length)
  * with the trajectories still identical, follows stiffness and rest-length
- * changes, and gives the same bits on 1 and 2 threads. */
+ * changes, and gives the same bits on 1 and 2 threads; big webs' blocked
+ * passes give the bits of single steps, in float64 and in float32. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -181,6 +182,78 @@ static void test_blocked_passes(void **state)
     spn_world_destroy(ref);
 }
 
+/* disturbed_orb on the float32 step (spn_world_set_precision). */
+static spn_world *disturbed_orb32(spn_integrator integ, int threads, uint32_t parallel_min)
+{
+    spn_world *w = disturbed_orb(integ, 40, 50, threads, parallel_min, true);
+    spn_world_set_precision(w, SPN_PRECISION_FLOAT32);
+    return w;
+}
+
+/* The float32 step's blocked passes (lattice_block_t.h instantiated for
+ * float): the bits of float32 single-step sweeps, in the state and in the
+ * energy books, on 1 and 2 threads, across a rebase of the float32
+ * displacements (every 64 steps) inside a call, and a blow-up inside a pass
+ * replayed to the same step and message. Single float32 steps come from
+ * spn_world_advance only (spn_world_step takes float64 ones), so the
+ * reference is the same web at parallel_min 8192: above its 2,001
+ * particles, so no passes, with the same bands as at 256 (SPN_BLOCK
+ * particles, which both parallel_min / 8 are below), which fix the order of
+ * the energy sums. */
+static void test_blocked_passes_float32(void **state)
+{
+    (void)state;
+    const spn_integrator integs[] = {SPN_INTEGRATOR_EULER, SPN_INTEGRATOR_SYMPLECTIC, SPN_INTEGRATOR_RK4};
+    for (int k = 0; k < 3; k++) {
+        const double dt = integs[k] == SPN_INTEGRATOR_EULER ? 2e-7 : 2e-6;
+        /* explicit: 17 passes of 4 steps (a rebase after the 16th), 1 single
+         * step; RK4: a pass a step */
+        const int blocked = integs[k] == SPN_INTEGRATOR_RK4 ? 69 : 68;
+        spn_world *one = disturbed_orb32(integs[k], 1, 256);
+        spn_world *two = disturbed_orb32(integs[k], 2, 256);
+        spn_world *ref = disturbed_orb32(integs[k], 1, 8192);
+        assert_int_equal(spn_world_advance(one, dt, 69), SPN_OK);
+        assert_int_equal(spn_world_last_step(one).blocked, blocked);
+        assert_int_equal(spn_world_advance(two, dt, 69), SPN_OK);
+        assert_int_equal(spn_world_last_step(two).blocked, blocked);
+        assert_int_equal(spn_world_advance(ref, dt, 69), SPN_OK);
+        assert_int_equal(spn_world_last_step(ref).blocked, 0);
+        assert_same_state(one, ref);
+        assert_same_state(two, ref);
+        spn_energy e1 = spn_world_energy(one), e2 = spn_world_energy(two), er = spn_world_energy(ref);
+        assert_memory_equal(&e1.dissipated, &er.dissipated, sizeof(double));
+        assert_memory_equal(&e2.dissipated, &er.dissipated, sizeof(double));
+        assert_true(fastest(one) > 0.01);
+        /* a spring changed between calls reaches the float32 passes */
+        change_springs(one, ref, 1234);
+        assert_int_equal(spn_world_advance(one, dt, 8), SPN_OK);
+        assert_int_equal(spn_world_last_step(one).blocked, 8);
+        assert_int_equal(spn_world_advance(ref, dt, 8), SPN_OK);
+        assert_same_state(one, ref);
+        spn_world_destroy(one);
+        spn_world_destroy(two);
+        spn_world_destroy(ref);
+    }
+    /* a step far too long: the float32 pass blows up, the run is replayed
+     * and ends as the unblocked run does, at the same step, with the same
+     * message, in the same state */
+    spn_world *blk = disturbed_orb32(SPN_INTEGRATOR_SYMPLECTIC, 2, 256);
+    spn_world *ref = disturbed_orb32(SPN_INTEGRATOR_SYMPLECTIC, 2, 8192);
+    const double big = 5e-5; /* (float32 overflows sooner than float64: at step 10) */
+    assert_int_equal(spn_world_advance(ref, big, 400), SPN_ERR_UNSTABLE);
+    const uint64_t good = spn_world_step_count(ref);
+    assert_true(good > 0 && good % 4 != 0); /* the failing step is inside a pass */
+    char want[512];
+    snprintf(want, sizeof want, "%s", spn_last_error());
+    assert_int_equal(spn_world_advance(blk, big, 400), SPN_ERR_UNSTABLE);
+    assert_string_equal(spn_last_error(), want);
+    assert_int_equal(spn_world_step_count(blk), good);
+    assert_same_state(blk, ref);
+    print_message("float32 blow-up at step %llu in both: %s\n", (unsigned long long)good + 1, want);
+    spn_world_destroy(blk);
+    spn_world_destroy(ref);
+}
+
 /* Changing a spring keeps the lattice in step; breaking one hands over to the
  * general path, and the trajectories stay identical through both. */
 static void test_changes_and_break(void **state)
@@ -319,6 +392,7 @@ int main(void)
         cmocka_unit_test(test_same_trajectory),
         cmocka_unit_test(test_bands_and_threads),
         cmocka_unit_test(test_blocked_passes),
+        cmocka_unit_test(test_blocked_passes_float32),
         cmocka_unit_test(test_changes_and_break),
         cmocka_unit_test(test_hand_built_and_breakage),
         cmocka_unit_test(test_not_a_lattice),

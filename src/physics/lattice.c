@@ -28,7 +28,7 @@
  * place. So every spring sees the state from before the step, and each
  * particle is read once and written once (lattice_sweep_t.h, the float32
  * step's sweep too). Big webs take several steps to a sweep
- * (lattice_block.c).
+ * (lattice_block_t.h, both precisions too).
  *
  * Same bits as the general two-pass step. A particle's force is summed in the
  * order the gather uses for a web numbered like spn_scene_orb (radials added
@@ -190,13 +190,14 @@ LAT_INLINE void rk4_update(const lat_args *a, size_t p0, uint32_t n, double *con
                            double (*acc)[LANES])
 {
     const spn__lattice *L = a->L;
-    rk4_rows R;
+    rk4_rows64 R;
     for (int c = 0; c < 3; c++) {
         R.V[c] = a->ev[c] + p0, R.xb[c] = L->x[c] + p0, R.vb[c] = L->v[c] + p0;
         R.xt[c] = a->tx[c] ? a->tx[c] + p0 : NULL, R.vt[c] = a->tv[c] ? a->tv[c] + p0 : NULL;
         R.ax[c] = L->ax[c] + p0, R.av[c] = L->av[c] + p0;
     }
-    lat_rk4_update(a, p0, n, &R, F, t, acc);
+    rk4_update64(n, a->mode == MODE_RK4_LAST, a->first, a->h, a->weight, a->drag, a->g, a->mass + p0,
+                 a->inv_mass + p0, &R, F, t, acc);
 }
 
 /* Row p0 complete (radial in, ring, radial out or NULL): its update. */
@@ -212,19 +213,22 @@ LAT_INLINE void finish(const lat_args *a, size_t p0, uint32_t n, double *const *
     }
     double *X[3], *V[3];
     for (int c = 0; c < 3; c++) X[c] = L->x[c] + p0, V[c] = L->v[c] + p0;
-    lat_row_move(a, p0, n, X, V, ri, rg, ro, t, acc);
+    row_move64(n, a->mode == MODE_SYMPLECTIC, a->dt, a->g, a->drag, a->mass + p0, a->inv_mass + p0, X, V, ri, rg,
+               ro, t, acc);
 }
 
 /* The hub: its radial forces in radial order, then its update. */
 static void hub(const lat_args *a, double *const *rad, double *const *t, double (*acc)[LANES])
 {
+    const spn__lattice *L = a->L;
     if (a->mode != MODE_RK4_STAGE && a->mode != MODE_RK4_LAST) {
-        lat_hub_move(a, rad, acc);
+        hub_move64(L->radials, a->mode == MODE_SYMPLECTIC, a->dt, a->g, a->drag, a->mass[0], a->inv_mass[0], L->x,
+                   L->v, rad, acc);
         return;
     }
     const double v[3] = {a->ev[0][0], a->ev[1][0], a->ev[2][0]};
     double f[3];
-    lat_hub_force(a, v, rad, f);
+    hub_force64(L->radials, a->mass[0], a->drag, a->g, v, rad, f);
     double *Fp[3] = {f, f + 1, f + 2};
     rk4_update(a, 0, 1, Fp, t, acc);
 }
@@ -271,6 +275,17 @@ static size_t stride64(const lat_args *a) { return a->L->stride; }
 #undef eval64
 #undef hub64
 #undef finish64
+
+/* The blocked pass (lattice_block_t.h) on the float64 state. */
+static void state64(const lat_args *a, double **X, double **V)
+{
+    for (int c = 0; c < 3; c++) X[c] = a->L->x[c], V[c] = a->L->v[c];
+}
+
+static const double *mass64(const lat_args *a) { return a->mass; }
+static const double *inv_mass64(const lat_args *a) { return a->inv_mass; }
+
+#include "lattice_block_t.h"
 #undef LK_ARGS
 #undef LK
 #undef LK_T
@@ -455,12 +470,13 @@ bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r)
     return true;
 }
 
-/* Steps as blocked passes (lattice_block.c), inside a replayable
+/* Steps as blocked passes (lattice_block_t.h), inside a replayable
  * spn_world_advance on a web too big for the caches (from def.parallel_min
  * particles, the size from which a step is spread over threads): up to k
  * Euler or symplectic steps in one pass, or one RK4 step (its four stages)
- * per pass. Each step's results into r[]; the count done, 0 when a blocked
- * pass does not apply (the caller then takes single steps). */
+ * per pass, in float64 or (spn_world_set_precision) float32. Each step's
+ * results into r[]; the count done, 0 when a blocked pass does not apply
+ * (the caller then takes single steps). */
 int spn__lattice_block_steps(spn_world *w, double dt, int k, spn__step_result *r)
 {
     const spn_integrator in = w->def.integrator;
@@ -468,24 +484,27 @@ int spn__lattice_block_steps(spn_world *w, double dt, int k, spn__step_result *r
     if (!rk4 && in != SPN_INTEGRATOR_EULER && in != SPN_INTEGRATOR_SYMPLECTIC) return 0;
     if (k > LAT_LEVELS) k = LAT_LEVELS;
     const uint32_t levels = rk4 ? 4 : (uint32_t)k;
-    if (levels < 2 || !w->no_backup || w->np < w->def.parallel_min || w->precision == SPN_PRECISION_FLOAT32)
-        return 0;
+    if (levels < 2 || !w->no_backup || w->np < w->def.parallel_min) return 0;
     const int threads = ready(w);
     if (!threads || !spn__lattice_block_ready(w->lat, threads, levels)) return 0;
+    const int mode = rk4 ? MODE_RK4_STAGE : in == SPN_INTEGRATOR_SYMPLECTIC ? MODE_SYMPLECTIC : MODE_EULER;
+    if (float32(w)) {
+        if (w->lat->live) write_back(w, threads);
+        return spn__lat32_block_steps(w, threads, dt, mode, k, r);
+    }
     spn__lat32_sync(w);
     lat_args la[LAT_LEVELS];
     if (!begin(w, threads, dt, false, &la[0])) return 0;
     static const double weight[4] = {1, 2, 2, 1}, frac[4] = {0, 0.5, 0.5, 1};
     for (uint32_t s = 0; s < levels; s++) {
         la[s] = la[0];
-        la[s].mode = rk4 ? (s < 3 ? MODE_RK4_STAGE : MODE_RK4_LAST)
-                         : (in == SPN_INTEGRATOR_SYMPLECTIC ? MODE_SYMPLECTIC : MODE_EULER);
+        la[s].mode = rk4 ? (s < 3 ? MODE_RK4_STAGE : MODE_RK4_LAST) : mode;
         la[s].first = s == 0;
         la[s].weight = weight[s % 4];
         la[s].h = s < 3 ? frac[s + 1] * dt : dt / 6;
     }
     double sums[LAT_LEVELS][L_NSUMS];
-    if (!spn__lattice_block(w->lat, la, rk4, threads, levels, sums)) return 0;
+    if (!block_pass64(w->lat, la, rk4, threads, levels, sums)) return 0;
     if (rk4) {
         lat_rk4_result(sums, dt, w->def.drag, &r[0]);
         return 1;

@@ -23,13 +23,16 @@
  *
  * The sweep is lattice.c's, from the same source (lattice_sweep_t.h): rows
  * swept outwards, the radials into a row computed from the previous row's
- * state before that row moves, bands fixed
- * whatever the thread count, the radials between bands first, sums added in
- * band order. The rows are read straight from the state arrays (no copies)
- * and moved in place: a row moves only after every spring that reads it has
- * been computed. Every operation is a correctly rounded float32 or float64
- * operation (no FMA: -ffp-contract=off, no approximate reciprocal), so the
- * bits are the same on any thread count and vector width. */
+ * state before that row moves, bands fixed whatever the thread count, the
+ * radials between bands first, sums added in band order. The rows are read
+ * straight from the state arrays (no copies) and moved in place: a row
+ * moves only after every spring that reads it has been computed. On big
+ * webs, inside spn_world_advance, several steps (or an RK4 step's four
+ * stages) go to one pass over memory as in float64, from the same source
+ * again (lattice_block_t.h); a pass never spans a rebase, so its bits are
+ * those of single steps. Every operation is a correctly rounded float32 or
+ * float64 operation (no FMA: -ffp-contract=off, no approximate reciprocal),
+ * so the bits are the same on any thread count and vector width. */
 #include "lattice_rows32.h"
 #include "world_internal.h"
 
@@ -64,16 +67,13 @@ struct spn__lat32 {
     uint32_t since;       /* steps since the last rebase */
 };
 
-/* What a sweep does with a row once its forces are complete. */
-enum { M_EULER, M_SYMPLECTIC, M_RK4_STAGE, M_RK4_LAST };
-
 typedef struct a32 {
     const spn__lattice *L;
     spn__lat32 *F;
     const float *ed[3], *eu[3]; /* the state the forces are evaluated at */
     float *td[3], *tu[3];       /* RK4 stage: the next trial state */
     float g[3], drag, dt, h, weight;
-    int mode;
+    int mode;                   /* MODE_* (lattice_rows.h) */
     bool first;                 /* RK4: stage 0 */
 } a32;
 
@@ -98,39 +98,21 @@ LAT_INLINE void rk4_update(const a32 *a, size_t p0, uint32_t n, float *const *F,
                            double (*acc)[LANES])
 {
     const spn__lat32 *S = a->F;
-    const float *m = S->mass + p0, *im = S->inv_mass + p0;
-    const float *V[3] = {a->eu[0] + p0, a->eu[1] + p0, a->eu[2] + p0};
-    if (a->mode == M_RK4_STAGE) {
-        /* (m v^2 only where it counts, as in lattice_rows.h's lat_rk4_update) */
-        if (a->first || a->drag != 0) {
-            rk4_kin32(n, m, im, V[0], V[1], V[2], t[0]);
-            lane_add32(acc[L_MV2], t[0], n);
-        }
-        /* (three calls, not a loop, as in lattice_rows.h's update) */
-        rk4_stage32(n, a->first, a->h, a->weight, im, V[0], F[0], S->d[0] + p0, S->u[0] + p0, a->td[0] + p0,
-                    a->tu[0] + p0, S->ax[0] + p0, S->av[0] + p0);
-        rk4_stage32(n, a->first, a->h, a->weight, im, V[1], F[1], S->d[1] + p0, S->u[1] + p0, a->td[1] + p0,
-                    a->tu[1] + p0, S->ax[1] + p0, S->av[1] + p0);
-        rk4_stage32(n, a->first, a->h, a->weight, im, V[2], F[2], S->d[2] + p0, S->u[2] + p0, a->td[2] + p0,
-                    a->tu[2] + p0, S->ax[2] + p0, S->av[2] + p0);
-    } else {
-        rk4_sums32(n, a->h, a->g, m, im, V[0], V[1], V[2], F[0], F[1], F[2], S->ax[0] + p0, S->ax[1] + p0,
-                   S->ax[2] + p0, S->av[0] + p0, S->av[1] + p0, S->av[2] + p0, S->u[0] + p0, S->u[1] + p0,
-                   S->u[2] + p0, t[0], t[1], t[2]);
-        rk4_last32(n, a->h, im, V[0], F[0], S->ax[0] + p0, S->av[0] + p0, S->d[0] + p0, S->u[0] + p0);
-        rk4_last32(n, a->h, im, V[1], F[1], S->ax[1] + p0, S->av[1] + p0, S->d[1] + p0, S->u[1] + p0);
-        rk4_last32(n, a->h, im, V[2], F[2], S->ax[2] + p0, S->av[2] + p0, S->d[2] + p0, S->u[2] + p0);
-        lane_add32(acc[L_MV2], t[0], n);
-        lane_add32(acc[L_GAIN], t[1], n);
-        lane_add32(acc[L_MVN2], t[2], n);
+    rk4_rows32 R;
+    for (int c = 0; c < 3; c++) {
+        R.V[c] = a->eu[c] + p0, R.xb[c] = S->d[c] + p0, R.vb[c] = S->u[c] + p0;
+        R.xt[c] = a->td[c] ? a->td[c] + p0 : NULL, R.vt[c] = a->tu[c] ? a->tu[c] + p0 : NULL;
+        R.ax[c] = S->ax[c] + p0, R.av[c] = S->av[c] + p0;
     }
+    rk4_update32(n, a->mode == MODE_RK4_LAST, a->first, a->h, a->weight, a->drag, a->g, S->mass + p0,
+                 S->inv_mass + p0, &R, F, t, acc);
 }
 
 LAT_INLINE void finish32(const a32 *a, size_t p0, uint32_t n, float *const *ri, float *const *rg,
                          float *const *ro, float *const *t, float *const *Fw, double (*acc)[LANES])
 {
     const spn__lat32 *F = a->F;
-    if (a->mode == M_RK4_STAGE || a->mode == M_RK4_LAST) {
+    if (a->mode == MODE_RK4_STAGE || a->mode == MODE_RK4_LAST) {
         for (int c = 0; c < 3; c++)
             assemble32(n, a->g[c], a->drag, F->mass + p0, a->eu[c] + p0, ri[c], rg[c], ro ? ro[c] : NULL, Fw[c]);
         rk4_update(a, p0, n, Fw, t, acc);
@@ -138,17 +120,8 @@ LAT_INLINE void finish32(const a32 *a, size_t p0, uint32_t n, float *const *ri, 
     }
     float *D[3], *U[3];
     for (int c = 0; c < 3; c++) D[c] = F->d[c] + p0, U[c] = F->u[c] + p0;
-    /* (sym a constant in each call: GCC 12 does not vectorise a select on a
-     * run-time bool between floats) */
-#define ROW32(sym)                                                                                              \
-    row32(n, sym, a->dt, a->g, a->drag, F->mass + p0, F->inv_mass + p0, D[0], D[1], D[2], U[0], U[1], U[2], ri[0], \
-          ri[1], ri[2], rg[0], rg[1], rg[2], ro ? ro[0] : NULL, ro ? ro[1] : NULL, ro ? ro[2] : NULL, t[0], t[1], t[2])
-    if (a->mode == M_SYMPLECTIC) ROW32(true);
-    else ROW32(false);
-#undef ROW32
-    lane_add32(acc[L_MV2], t[0], n);
-    lane_add32(acc[L_GAIN], t[1], n);
-    lane_add32(acc[L_MVN2], t[2], n);
+    row_move32(n, a->mode == MODE_SYMPLECTIC, a->dt, a->g, a->drag, F->mass + p0, F->inv_mass + p0, D, U, ri, rg,
+               ro, t, acc);
 }
 
 /* The hub: its radial forces in radial order, then its update. */
@@ -156,21 +129,15 @@ static void hub32(const a32 *a, float *const *rad, float *const *t, double (*acc
 {
     spn__lat32 *F = a->F;
     const uint32_t n = a->L->radials;
-    const float m = F->mass[0], dm = a->drag * m;
-    float f[3];
-    for (int c = 0; c < 3; c++) {
-        f[c] = m * a->g[c] - dm * a->eu[c][0];
-        for (uint32_t i = 0; i < n; i++) f[c] += rad[c][i];
-    }
-    if (a->mode == M_RK4_STAGE || a->mode == M_RK4_LAST) {
-        float *Fp[3] = {f, f + 1, f + 2};
-        rk4_update(a, 0, 1, Fp, t, acc);
+    if (a->mode != MODE_RK4_STAGE && a->mode != MODE_RK4_LAST) {
+        hub_move32(n, a->mode == MODE_SYMPLECTIC, a->dt, a->g, a->drag, F->mass[0], F->inv_mass[0], F->d, F->u, rad,
+                   acc);
         return;
     }
-    const moved32 o = one32(f[0], f[1], f[2], F->inv_mass[0], m, F->d[0][0], F->d[1][0], F->d[2][0], F->u[0][0],
-                            F->u[1][0], F->u[2][0], a->mode == M_SYMPLECTIC, a->dt, a->g);
-    for (int c = 0; c < 3; c++) F->d[c][0] = o.x[c], F->u[c][0] = o.v[c];
-    acc[L_MV2][0] += o.mv2, acc[L_GAIN][0] += o.gain, acc[L_MVN2][0] += o.mvn2;
+    const float v[3] = {a->eu[0][0], a->eu[1][0], a->eu[2][0]};
+    float f[3], *Fp[3] = {f, f + 1, f + 2};
+    hub_force32(n, F->mass[0], a->drag, a->g, v, rad, f);
+    rk4_update(a, 0, 1, Fp, t, acc);
 }
 
 /* The sweep (lattice_sweep_t.h) on the float32 state: a spring's
@@ -188,10 +155,9 @@ LAT_INLINE void rings32(const a32 *a, float *const *D, float *const *U, uint32_t
 {
     const spn__lat32 *F = a->F;
     const uint32_t n = a->L->radials;
-    const size_t s0 = (size_t)j * n, p0 = 1 + s0;
-    float *D1[3], *U1[3], *Dl[3], *Ul[3];
-    eval_rows(a, p0 + 1, D1, U1);
-    eval_rows(a, p0 + n - 1, Dl, Ul);
+    const size_t s0 = (size_t)j * n;
+    float *D1[3], *U1[3], *Dl[3], *Ul[3]; /* the row from its second and its last particle */
+    for (int c = 0; c < 3; c++) D1[c] = D[c] + 1, U1[c] = U[c] + 1, Dl[c] = D[c] + n - 1, Ul[c] = U[c] + n - 1;
     spring_rows(n - 1, D, U, D1, U1, (float *const *)F->gl, s0, F->gk, F->gkd, F->gr, f, 0, e, p, acc_e, acc_p);
     spring_rows(1, D, U, Dl, Ul, (float *const *)F->gl, s0 + n - 1, F->gk, F->gkd, F->gr, f, n - 1, e, p, acc_e,
                 acc_p);
@@ -212,6 +178,17 @@ static size_t stride32(const a32 *a) { return a->F->stride; }
 #define eval32 eval_rows
 #include "lattice_sweep_t.h"
 #undef eval32
+
+/* The blocked pass (lattice_block_t.h) on the float32 state. */
+static void state32(const a32 *a, float **D, float **U)
+{
+    for (int c = 0; c < 3; c++) D[c] = a->F->d[c], U[c] = a->F->u[c];
+}
+
+static const float *mass32(const a32 *a) { return a->F->mass; }
+static const float *inv_mass32(const a32 *a) { return a->F->inv_mass; }
+
+#include "lattice_block_t.h"
 #undef LK_ARGS
 #undef LK
 #undef LK_T
@@ -371,7 +348,7 @@ bool spn__lat32_explicit(spn_world *w, int threads, double dt, bool symplectic, 
 {
     a32 a;
     if (!begin(w, threads, dt, false, &a)) return false;
-    a.mode = symplectic ? M_SYMPLECTIC : M_EULER;
+    a.mode = symplectic ? MODE_SYMPLECTIC : MODE_EULER;
     double sum[L_NSUMS];
     sweep32(&a, threads, sum);
     lat_explicit_result(sum, dt, w->def.drag, r);
@@ -394,7 +371,7 @@ bool spn__lat32_rk4(spn_world *w, int threads, double dt, spn__step_result *r)
             a.ed[c] = stage ? from[c] : F->d[c], a.eu[c] = stage ? from[3 + c] : F->u[c];
             a.td[c] = to[c], a.tu[c] = to[3 + c];
         }
-        a.mode = stage < 3 ? M_RK4_STAGE : M_RK4_LAST;
+        a.mode = stage < 3 ? MODE_RK4_STAGE : MODE_RK4_LAST;
         a.first = stage == 0;
         a.weight = weight[stage];
         a.h = stage < 3 ? frac[stage + 1] * (float)dt : (float)dt / 6;
@@ -403,6 +380,38 @@ bool spn__lat32_rk4(spn_world *w, int threads, double dt, spn__step_result *r)
     lat_rk4_result(sums, dt, w->def.drag, r);
     end(w, threads);
     return true;
+}
+
+/* Blocked passes (lattice_block_t.h; lattice.c decides when). A pass never
+ * spans a rebase: the rebase changes the references the springs are formed
+ * from, so the steps of a pass are the single steps' only if they all come
+ * between the same two rebases, after the same number of steps. */
+int spn__lat32_block_steps(spn_world *w, int threads, double dt, int mode, int k, spn__step_result *r)
+{
+    const bool rk4 = mode == MODE_RK4_STAGE || mode == MODE_RK4_LAST;
+    const spn__lat32 *F0 = w->lat->f32;
+    if (!rk4 && F0 && F0->live && k > (int)(REBASE - F0->since)) k = (int)(REBASE - F0->since);
+    const uint32_t levels = rk4 ? 4 : (uint32_t)k;
+    a32 la[LAT_LEVELS];
+    if (levels < 2 || !begin(w, threads, dt, false, &la[0])) return 0;
+    static const float weight[4] = {1, 2, 2, 1}, frac[4] = {0, 0.5f, 0.5f, 1};
+    for (uint32_t s = 0; s < levels; s++) {
+        la[s] = la[0];
+        la[s].mode = rk4 ? (s < 3 ? MODE_RK4_STAGE : MODE_RK4_LAST) : mode;
+        la[s].first = s == 0;
+        la[s].weight = weight[s % 4];
+        la[s].h = s < 3 ? frac[s + 1] * (float)dt : (float)dt / 6;
+    }
+    double sums[LAT_LEVELS][L_NSUMS];
+    if (!block_pass32(w->lat, la, rk4, threads, levels, sums)) return 0;
+    const int steps = rk4 ? 1 : k;
+    if (rk4) lat_rk4_result(sums, dt, w->def.drag, &r[0]);
+    else
+        for (int q = 0; q < k; q++) lat_explicit_result(sums[q], dt, w->def.drag, &r[q]);
+    spn__lat32 *F = w->lat->f32;
+    F->since += (uint32_t)steps;
+    if (F->since >= REBASE) write_back(w, threads, true); /* (as `end` after the pass's last step) */
+    return steps;
 }
 
 void spn__lat32_sync(spn_world *w)

@@ -18,7 +18,7 @@
  * evaluated state, energy gain of the update, sum m v^2 after it. */
 enum { L_ELASTIC, L_DAMP, L_MV2, L_GAIN, L_MVN2, L_NSUMS };
 #define LANES 8
-/* Steps a pass of the blocked sweep takes (lattice_block.c). */
+/* Steps a pass of the blocked sweep takes (lattice_block_t.h). */
 #define LAT_LEVELS SPN__LAT_BLOCK_MAX
 #define LAT_INLINE static inline __attribute__((always_inline))
 
@@ -66,9 +66,9 @@ struct spn__lattice {
     bool live;       /* inside spn_world_advance: x, v above are ahead of w->x, w->v */
     double *rk4;     /* RK4 (on first use): two trial states, 6 x np each, ax, av */
     double *trial[2][6], *ax[3], *av[3];
-    double **bws;      /* temporal blocking (lattice_block.c): per-thread workspaces */
-    int nbws;
-    size_t block_size; /* doubles in each */
+    void **bws;        /* temporal blocking (lattice_block_t.h): per-thread workspaces, */
+    int nbws;          /* shared by the two precisions */
+    size_t block_size; /* bytes in each */
     double *partial_k; /* per level and band: L_NSUMS */
     uint32_t npartial_k;
     spn__lat32 *f32; /* the float32 step (on first use) */
@@ -156,94 +156,6 @@ LAT_INLINE void springs_rows(uint32_t n, const double *const *ax, const double *
 }
 
 
-/* The hub's force: gravity and drag at its evaluated velocity v, then its
- * radial forces in radial order. */
-LAT_INLINE void lat_hub_force(const lat_args *a, const double *v, double *const *rad, double *f)
-{
-    const uint32_t n = a->L->radials;
-    const double m = a->mass[0], dm = a->drag * m;
-    for (int c = 0; c < 3; c++) {
-        f[c] = m * a->g[c] - dm * v[c];
-        for (uint32_t i = 0; i < n; i++) f[c] += rad[c][i];
-    }
-}
-
-/* The explicit hub: its radial forces (in radial order) added to gravity and
- * drag, then moved in place; its sum terms into acc. */
-LAT_INLINE void lat_hub_move(const lat_args *a, double *const *rad, double (*acc)[LANES])
-{
-    const spn__lattice *L = a->L;
-    const double v[3] = {L->v[0][0], L->v[1][0], L->v[2][0]};
-    double f[3];
-    lat_hub_force(a, v, rad, f);
-    const moved64 o = one64(f[0], f[1], f[2], a->inv_mass[0], a->mass[0], L->x[0][0], L->x[1][0], L->x[2][0],
-                            v[0], v[1], v[2], a->mode == MODE_SYMPLECTIC, a->dt, a->g);
-    for (int c = 0; c < 3; c++) L->x[c][0] = o.x[c], L->v[c][0] = o.v[c];
-    acc[L_MV2][0] += o.mv2, acc[L_GAIN][0] += o.gain, acc[L_MVN2][0] += o.mvn2;
-}
-
-/* An explicit row (particles p0 .., state arrays X, V) with its forces
- * complete (radial in, ring, radial out or NULL), moved in place; its sum
- * terms through t into acc. */
-LAT_INLINE void lat_row_move(const lat_args *a, size_t p0, uint32_t n, double *const *X, double *const *V,
-                             double *const *ri, double *const *rg, double *const *ro, double *const *t,
-                             double (*acc)[LANES])
-{
-    /* (sym a constant in each call: GCC 12 does not vectorise a select on a
-     * run-time bool) */
-#define ROW64(sym)                                                                                              \
-    row64(n, sym, a->dt, a->g, a->drag, a->mass + p0, a->inv_mass + p0, X[0], X[1], X[2], V[0], V[1], V[2], ri[0], \
-          ri[1], ri[2], rg[0], rg[1], rg[2], ro ? ro[0] : NULL, ro ? ro[1] : NULL, ro ? ro[2] : NULL, t[0], t[1], t[2])
-    if (a->mode == MODE_SYMPLECTIC) ROW64(true);
-    else ROW64(false);
-#undef ROW64
-    lane_add64(acc[L_MV2], t[0], n);
-    lane_add64(acc[L_GAIN], t[1], n);
-    lane_add64(acc[L_MVN2], t[2], n);
-}
-
-/* The rows an RK4 stage reads and writes (3 arrays each, at the row): the
- * velocity it is evaluated at, the step's base state, the next trial state
- * and the weighted sums. */
-typedef struct rk4_rows {
-    const double *V[3];
-    double *xb[3], *vb[3], *xt[3], *vt[3], *ax[3], *av[3];
-} rk4_rows;
-
-/* Particles p0 .. p0+n-1 of an RK4 stage (a->mode, first, h, weight), their
- * force F known; sum terms through t into acc. */
-LAT_INLINE void lat_rk4_update(const lat_args *a, size_t p0, uint32_t n, const rk4_rows *R, double *const *F,
-                               double *const *t, double (*acc)[LANES])
-{
-    const double *m = a->mass + p0, *im = a->inv_mass + p0;
-    if (a->mode == MODE_RK4_STAGE) {
-        /* m v^2 at a stage's state serves the drag's loss (and, at the first
-         * stage, the energy before the step); without drag the later stages
-         * skip it, as drag * m v^2 would add exactly zero */
-        if (a->first || a->drag != 0) {
-            rk4_kin64(n, m, im, R->V[0], R->V[1], R->V[2], t[0]);
-            lane_add64(acc[L_MV2], t[0], n);
-        }
-        /* (three calls, not a loop: GCC 12 does not vectorise an inlined
-         * function with restrict parameters inside a loop) */
-        rk4_stage64(n, a->first, a->h, a->weight, im, R->V[0], F[0], R->xb[0], R->vb[0], R->xt[0], R->vt[0],
-                    R->ax[0], R->av[0]);
-        rk4_stage64(n, a->first, a->h, a->weight, im, R->V[1], F[1], R->xb[1], R->vb[1], R->xt[1], R->vt[1],
-                    R->ax[1], R->av[1]);
-        rk4_stage64(n, a->first, a->h, a->weight, im, R->V[2], F[2], R->xb[2], R->vb[2], R->xt[2], R->vt[2],
-                    R->ax[2], R->av[2]);
-    } else {
-        rk4_sums64(n, a->h, a->g, m, im, R->V[0], R->V[1], R->V[2], F[0], F[1], F[2], R->ax[0], R->ax[1], R->ax[2],
-                   R->av[0], R->av[1], R->av[2], R->vb[0], R->vb[1], R->vb[2], t[0], t[1], t[2]);
-        rk4_last64(n, a->h, im, R->V[0], F[0], R->ax[0], R->av[0], R->xb[0], R->vb[0]);
-        rk4_last64(n, a->h, im, R->V[1], F[1], R->ax[1], R->av[1], R->xb[1], R->vb[1]);
-        rk4_last64(n, a->h, im, R->V[2], F[2], R->ax[2], R->av[2], R->xb[2], R->vb[2]);
-        lane_add64(acc[L_MV2], t[0], n);
-        lane_add64(acc[L_GAIN], t[1], n);
-        lane_add64(acc[L_MVN2], t[2], n);
-    }
-}
-
 /* An Euler or symplectic step's results from its sweep's sums. */
 static inline void lat_explicit_result(const double *sum, double dt, double drag, spn__step_result *r)
 {
@@ -271,14 +183,18 @@ static inline void lat_rk4_result(double sums[4][L_NSUMS], double dt, double dra
     r->dissipated = dt / 6 * damp;
 }
 
-/* Whether K explicit steps can go as one blocked pass on `threads` threads
- * (each thread's run of bands deep enough for its ghost rows). */
+/* Temporal blocking (lattice_block_t.h, helpers in lattice_block.c). */
+/* Whether K levels can go as one blocked pass on `threads` threads (each
+ * thread's run of bands deep enough for its ghost rows). */
 bool spn__lattice_block_ready(const spn__lattice *L, int threads, uint32_t K);
-/* K levels (2 .. LAT_LEVELS) in one blocked pass over the state in L->x,
- * L->v: K explicit steps, or (rk4) the four stages of one RK4 step; la[s]
- * the arguments of level s + 1, the sums of each into sums[s]. False when
- * out of memory (nothing done). */
-bool spn__lattice_block(spn__lattice *L, const lat_args *la, bool rk4, int threads, uint32_t K,
-                        double sums[][L_NSUMS]);
+/* Per-thread workspaces of `bytes` each and the per-level band partials;
+ * false when out of memory. */
+bool spn__lattice_block_alloc(spn__lattice *L, int threads, size_t bytes);
+/* Each level's sums from its band partials, in band order. */
+void spn__lattice_block_sums(const spn__lattice *L, uint32_t K, double sums[][L_NSUMS]);
+/* Up to k float32 Euler or symplectic steps (mode), or one RK4 step, as one
+ * blocked pass on `threads` threads (block ready); each step's results
+ * into r[], the count done (0: none, nothing done). */
+int spn__lat32_block_steps(spn_world *w, int threads, double dt, int mode, int k, spn__step_result *r);
 
 #endif

@@ -3,9 +3,10 @@
  * lattice_rows32.h with LK_T = float, each with LK(name) giving its names.
  * No include guard, on purpose.
  *
- * Every kernel updates a row of the state in place (structure of arrays,
- * positions x or float32 displacements d, velocities v) once the row's
- * forces are complete. Fixed particles are selected out, not skipped, so the
+ * The sweeps (lattice_sweep_t.h) and the blocked passes (lattice_block_t.h)
+ * of both precisions call these. Every kernel updates a row of the state in
+ * place (structure of arrays, positions x or float32 displacements d,
+ * velocities v) once the row's forces are complete. Fixed particles are selected out, not skipped, so the
  * loops vectorise; the per-particle terms of the energy sums go to t_mv2,
  * t_gain, t_mvn2 and from there, in a fixed order, to lane accumulators.
  * Each expression is the general path's (chunk.h, explicit.c), so the
@@ -195,4 +196,95 @@ LAT_INLINE void LK(rk4_last)(uint32_t n, LK_T h6, const LK_T *restrict inv_mass,
         xc[i] = fr ? xc[i] + e : xc[i];
         uc[i] = fr ? nu : uc[i];
     }
+}
+
+/* ---- a row or the hub moved, with its sum terms (the sweeps of both
+ * precisions and the blocked passes; MODE_* from lattice_rows.h) ---- */
+
+/* The hub's force: gravity and drag at its evaluated velocity v, then its
+ * radial forces in radial order. */
+LAT_INLINE void LK(hub_force)(uint32_t n, LK_T m, LK_T drag, const LK_T *g, const LK_T *v, LK_T *const *rad,
+                              LK_T *f)
+{
+    const LK_T dm = drag * m;
+    for (int c = 0; c < 3; c++) {
+        f[c] = m * g[c] - dm * v[c];
+        for (uint32_t i = 0; i < n; i++) f[c] += rad[c][i];
+    }
+}
+
+/* The explicit hub (particle 0 of the state X, V; mass m, inverse im): its
+ * force from its n radials, then moved in place; its sum terms into acc. */
+LAT_INLINE void LK(hub_move)(uint32_t n, bool sym, LK_T dt, const LK_T *g, LK_T drag, LK_T m, LK_T im,
+                             LK_T *const *X, LK_T *const *V, LK_T *const *rad, double (*acc)[LANES])
+{
+    const LK_T v[3] = {V[0][0], V[1][0], V[2][0]};
+    LK_T f[3];
+    LK(hub_force)(n, m, drag, g, v, rad, f);
+    const LK(moved) o = LK(one)(f[0], f[1], f[2], im, m, X[0][0], X[1][0], X[2][0], v[0], v[1], v[2], sym, dt, g);
+    for (int c = 0; c < 3; c++) X[c][0] = o.x[c], V[c][0] = o.v[c];
+    acc[L_MV2][0] += o.mv2, acc[L_GAIN][0] += o.gain, acc[L_MVN2][0] += o.mvn2;
+}
+
+/* An explicit row (n particles, state rows X, V, masses from mass and
+ * inv_mass) with its forces complete (radial in, ring, radial out or NULL),
+ * moved in place; its sum terms through t into acc. */
+LAT_INLINE void LK(row_move)(uint32_t n, bool sym, LK_T dt, const LK_T *g, LK_T drag, const LK_T *mass,
+                             const LK_T *inv_mass, LK_T *const *X, LK_T *const *V, LK_T *const *ri,
+                             LK_T *const *rg, LK_T *const *ro, LK_T *const *t, double (*acc)[LANES])
+{
+    /* (sym a constant in each call: GCC 12 does not vectorise a select on a
+     * run-time bool) */
+#define LK_ROW(sym)                                                                                             \
+    LK(row)(n, sym, dt, g, drag, mass, inv_mass, X[0], X[1], X[2], V[0], V[1], V[2], ri[0], ri[1], ri[2], rg[0], \
+            rg[1], rg[2], ro ? ro[0] : NULL, ro ? ro[1] : NULL, ro ? ro[2] : NULL, t[0], t[1], t[2])
+    if (sym) LK_ROW(true);
+    else LK_ROW(false);
+#undef LK_ROW
+    LK(lane_add)(acc[L_MV2], t[0], n);
+    LK(lane_add)(acc[L_GAIN], t[1], n);
+    LK(lane_add)(acc[L_MVN2], t[2], n);
+}
+
+/* The rows an RK4 stage reads and writes (3 arrays each, at the row): the
+ * velocity it is evaluated at, the step's base state, the next trial state
+ * (NULL at the last stage) and the weighted sums. */
+typedef struct LK(rk4_rows) {
+    const LK_T *V[3];
+    LK_T *xb[3], *vb[3], *xt[3], *vt[3], *ax[3], *av[3];
+} LK(rk4_rows);
+
+/* n particles of an RK4 stage (the last one when `last`; weighted `wgt`,
+ * step fraction h, or h = dt / 6 at the last), their force F known and
+ * masses from mass and inv_mass; sum terms through t into acc. */
+LAT_INLINE void LK(rk4_update)(uint32_t n, bool last, bool first, LK_T h, LK_T wgt, LK_T drag, const LK_T *g,
+                               const LK_T *mass, const LK_T *inv_mass, const LK(rk4_rows) *R, LK_T *const *F,
+                               LK_T *const *t, double (*acc)[LANES])
+{
+    if (!last) {
+        /* m v^2 at a stage's state serves the drag's loss (and, at the first
+         * stage, the energy before the step); without drag the later stages
+         * skip it, as drag * m v^2 would add exactly zero */
+        if (first || drag != 0) {
+            LK(rk4_kin)(n, mass, inv_mass, R->V[0], R->V[1], R->V[2], t[0]);
+            LK(lane_add)(acc[L_MV2], t[0], n);
+        }
+        /* (three calls, not a loop: GCC 12 does not vectorise an inlined
+         * function with restrict parameters inside a loop) */
+        LK(rk4_stage)(n, first, h, wgt, inv_mass, R->V[0], F[0], R->xb[0], R->vb[0], R->xt[0], R->vt[0], R->ax[0],
+                      R->av[0]);
+        LK(rk4_stage)(n, first, h, wgt, inv_mass, R->V[1], F[1], R->xb[1], R->vb[1], R->xt[1], R->vt[1], R->ax[1],
+                      R->av[1]);
+        LK(rk4_stage)(n, first, h, wgt, inv_mass, R->V[2], F[2], R->xb[2], R->vb[2], R->xt[2], R->vt[2], R->ax[2],
+                      R->av[2]);
+        return;
+    }
+    LK(rk4_sums)(n, h, g, mass, inv_mass, R->V[0], R->V[1], R->V[2], F[0], F[1], F[2], R->ax[0], R->ax[1],
+                 R->ax[2], R->av[0], R->av[1], R->av[2], R->vb[0], R->vb[1], R->vb[2], t[0], t[1], t[2]);
+    LK(rk4_last)(n, h, inv_mass, R->V[0], F[0], R->ax[0], R->av[0], R->xb[0], R->vb[0]);
+    LK(rk4_last)(n, h, inv_mass, R->V[1], F[1], R->ax[1], R->av[1], R->xb[1], R->vb[1]);
+    LK(rk4_last)(n, h, inv_mass, R->V[2], F[2], R->ax[2], R->av[2], R->xb[2], R->vb[2]);
+    LK(lane_add)(acc[L_MV2], t[0], n);
+    LK(lane_add)(acc[L_GAIN], t[1], n);
+    LK(lane_add)(acc[L_MVN2], t[2], n);
 }

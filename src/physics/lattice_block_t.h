@@ -1,0 +1,311 @@
+/* Several Euler or symplectic Euler steps of the lattice, or the four stages
+ * of an RK4 step, in one pass over memory (temporal blocking), written once
+ * for both precisions: lattice.c includes this file with LK_T = double,
+ * lattice_f32.c with LK_T = float, each after lattice_sweep_t.h. No include
+ * guard, on purpose.
+ *
+ * Why. A web of a million particles keeps 160 bytes per particle in play
+ * (state, spring slots, masses; 80 in float32), far more than the caches,
+ * so one step per pass is bound by memory bandwidth. Here a pass takes the
+ * state K = LAT_LEVELS levels forward: each row is read from memory once per
+ * pass, and the rows in flight stay in the caches.
+ *
+ * The schedule. One row step, op(s, j), is the sweep's loop body at level s
+ * (the state after s steps of the pass, or the RK4 stage s): the radial
+ * springs into row j and the ring springs of row j at level s - 1, then row
+ * j - 1 moved to level s. It needs rows j - 1 and j at level s - 1 and moves
+ * row j - 1 in place, so it must come after op(s - 1, j + 1) (which brought
+ * row j to level s - 1) and after op(s, j - 1). Fronts J = 0, 1, ... run
+ * op(s, J - s + 1) for s = 1 .. K in that order: a wavefront K rows deep.
+ * RK4 keeps its trial states and weighted sums only for the rows in flight
+ * (by row mod 4 and mod 8).
+ *
+ * Threads. Each thread takes a contiguous run of bands. It needs the rows
+ * within K of its run from its neighbours at every level before they move,
+ * so it copies those ghost rows (level 0) into its own buffers first, and,
+ * after a barrier, steps them along privately: the rows it may step at level
+ * s shrink by one at each side per level (a trapezoid), and at level K they
+ * are its own rows exactly. Ghost rows are stepped twice (by each side),
+ * 2 K rows per boundary.
+ *
+ * Same bits. Every particle gets the same arithmetic as in one-step sweeps
+ * (the same row kernels, lattice_rows_t.h, and spring hooks), so the
+ * trajectory is bit-identical to K single steps whatever the thread count.
+ * The energy sums of each step are kept per band and per level, in the
+ * order of lattice_sweep_t.h's band_pass (the first row's radial springs,
+ * the "cut", summed apart), so they are bit-identical too.
+ *
+ * The including file defines LK_T, LK(name), LK_ARGS (its step arguments:
+ * members L, g, drag, dt, h, weight, mode, first, in LK_T where they are
+ * numbers) and, besides lattice_sweep_t.h's LK(radials), LK(rings) and
+ * LK(stride):
+ *   LK(state)(a, X, V)   the state arrays (3 + 3, whole; float32:
+ *                        displacements and velocities)
+ *   LK(mass)(a), LK(inv_mass)(a)   the masses (whole arrays) */
+#if !defined(LK_T) || !defined(LK) || !defined(LK_ARGS)
+#error "define LK_T, LK(name) and LK_ARGS before including lattice_block_t.h"
+#endif
+
+/* Per level: the two latest rows' radial and ring forces, the lane sums of
+ * two bands (the band whose springs and the band whose particles are being
+ * summed differ at a band's first row) and of the current band's cut. */
+typedef struct LK(level) {
+    LK_T *rad[2][3], *ring[2][3];
+    LK_T **rad_prev;
+    int cur;
+    double acc_e[2][LANES], acc_p[2][LANES], cut_e[2][LANES], cut_p[2][LANES], acc[2][L_NSUMS][LANES];
+} LK(level);
+
+typedef struct LK(block) {
+    const LK_ARGS *la;        /* per level: the step's arguments (RK4: the stage's) */
+    const spn__lattice *L;
+    bool rk4;
+    uint32_t R0, R1, K;       /* own rows [R0, R1), levels */
+    LK_T *X[3], *V[3];        /* the state */
+    const LK_T *mass, *inv_mass;
+    LK_T *ghost[2 * LAT_LEVELS][6];
+    LK_T *hub[6], *e, *p, *t[3], *F[3];
+    /* RK4: the trial state of levels 1-3 by row mod 4 and the weighted sums
+     * ax, av by row mod 8 (a row's live for at most 2 and 5 fronts), and
+     * the hub's */
+    LK_T *trial[LAT_LEVELS - 1][4][6], *sums[8][6];
+    LK_T hub_trial[LAT_LEVELS - 1][6], hub_sums[6];
+    double dummy[L_NSUMS + 4][LANES];
+    LK(level) lv[LAT_LEVELS];
+} LK(block);
+
+/* Row j's x and v arrays: the state for own rows, a ghost buffer else. */
+static void LK(row_ptrs)(const LK(block) *B, uint32_t j, LK_T **X, LK_T **V)
+{
+    if (j >= B->R0 && j < B->R1) {
+        const size_t p0 = 1 + (size_t)j * B->L->radials;
+        for (int c = 0; c < 3; c++) X[c] = B->X[c] + p0, V[c] = B->V[c] + p0;
+        return;
+    }
+    const uint32_t g = j < B->R0 ? j - (B->R0 - B->K) : B->K + (j - B->R1);
+    for (int c = 0; c < 3; c++) X[c] = B->ghost[g][c], V[c] = B->ghost[g][3 + c];
+}
+
+static bool LK(own)(const LK(block) *B, uint32_t j) { return j >= B->R0 && j < B->R1; }
+
+/* Row j at level s - 1, the state the forces of level s are taken at: the
+ * state itself, or an RK4 trial state. */
+static void LK(eval_ptrs)(const LK(block) *B, uint32_t s, uint32_t j, LK_T **X, LK_T **V)
+{
+    if (!B->rk4 || s == 1) {
+        LK(row_ptrs)(B, j, X, V);
+        return;
+    }
+    LK_T *const *T = B->trial[s - 2][j % 4];
+    for (int c = 0; c < 3; c++) X[c] = T[c], V[c] = T[3 + c];
+}
+
+/* Lowest and one past the highest row this block steps at level s. */
+static uint32_t LK(low)(const LK(block) *B, uint32_t s) { return B->R0 ? B->R0 - B->K + s : 0; }
+
+static uint32_t LK(high)(const LK(block) *B, uint32_t s)
+{
+    const uint32_t rings = B->L->rings;
+    return B->R1 == rings ? rings : B->R1 + B->K - s;
+}
+
+/* Band b's sums at level s (index s - 1) into its partial, as cut_pass and
+ * band_pass leave them. */
+static void LK(store_level)(LK(block) *B, double *partial, uint32_t s, uint32_t b)
+{
+    LK(level) *lv = &B->lv[s - 1];
+    const int q = (int)(b & 1);
+    const spn__lattice *L = B->L;
+    double *out = partial + ((size_t)(s - 1) * L->nbands + b) * L_NSUMS;
+    if (b) out[L_ELASTIC] = lane_total(lv->cut_e[q]), out[L_DAMP] = lane_total(lv->cut_p[q]);
+    store_band_sums(out, b == 0, lv->acc_e[q], lv->acc_p[q], lv->acc[q]);
+    memset(lv->acc_e[q], 0, sizeof lv->acc_e[q]), memset(lv->acc_p[q], 0, sizeof lv->acc_p[q]);
+    memset(lv->cut_e[q], 0, sizeof lv->cut_e[q]), memset(lv->cut_p[q], 0, sizeof lv->cut_p[q]);
+    memset(lv->acc[q], 0, sizeof lv->acc[q]);
+}
+
+/* The hub at level s: its radial springs into ring 0 (forces into rad, sums
+ * into ae, ap), then its update (sum terms into acc). */
+LAT_INLINE void LK(block_hub)(LK(block) *B, uint32_t s, LK_T *const *X, LK_T *const *V, LK_T *const *rad,
+                              double *ae, double *ap, double (*acc)[LANES])
+{
+    const LK_ARGS *a = &B->la[s - 1];
+    const uint32_t n = B->L->radials;
+    LK_T hx[3], hv[3];
+    const bool base = !B->rk4 || s == 1;
+    for (int c = 0; c < 3; c++) {
+        hx[c] = base ? B->X[c][0] : B->hub_trial[s - 2][c];
+        hv[c] = base ? B->V[c][0] : B->hub_trial[s - 2][3 + c];
+        for (uint32_t i = 0; i < n; i++) B->hub[c][i] = hx[c], B->hub[3 + c][i] = hv[c];
+    }
+    LK(radials)(a, B->hub, B->hub + 3, X, V, 0, rad, B->e, B->p, ae, ap);
+    if (!B->rk4) {
+        LK(hub_move)(n, a->mode == MODE_SYMPLECTIC, a->dt, a->g, a->drag, B->mass[0], B->inv_mass[0], B->X, B->V,
+                     rad, acc);
+        return;
+    }
+    LK_T f[3], *Fp[3] = {f, f + 1, f + 2};
+    LK(hub_force)(n, B->mass[0], a->drag, a->g, hv, rad, f);
+    LK(rk4_rows) R;
+    for (int c = 0; c < 3; c++) {
+        R.V[c] = &hv[c], R.xb[c] = &B->X[c][0], R.vb[c] = &B->V[c][0];
+        R.xt[c] = s < 4 ? &B->hub_trial[s - 1][c] : NULL;
+        R.vt[c] = s < 4 ? &B->hub_trial[s - 1][3 + c] : NULL;
+        R.ax[c] = &B->hub_sums[c], R.av[c] = &B->hub_sums[3 + c];
+    }
+    LK(rk4_update)(1, a->mode == MODE_RK4_LAST, a->first, a->h, a->weight, a->drag, a->g, B->mass, B->inv_mass, &R,
+                   Fp, B->t, acc);
+}
+
+/* Row r (particles from p0) moved to level s, its forces complete (radial
+ * in ri, ring rg, radial out ro or NULL); sum terms into acc. */
+LAT_INLINE void LK(block_move)(LK(block) *B, uint32_t s, uint32_t r, LK_T *const *ri, LK_T *const *rg,
+                               LK_T *const *ro, double (*acc)[LANES])
+{
+    const LK_ARGS *a = &B->la[s - 1];
+    const uint32_t n = B->L->radials;
+    const size_t p0 = 1 + (size_t)r * n;
+    LK_T *X[3], *V[3];
+    LK(row_ptrs)(B, r, X, V);
+    if (!B->rk4) {
+        LK(row_move)(n, a->mode == MODE_SYMPLECTIC, a->dt, a->g, a->drag, B->mass + p0, B->inv_mass + p0, X, V, ri,
+                     rg, ro, B->t, acc);
+        return;
+    }
+    LK_T *EX[3], *EV[3];
+    LK(eval_ptrs)(B, s, r, EX, EV);
+    LK(rk4_rows) R;
+    for (int c = 0; c < 3; c++) {
+        LK(assemble)(n, a->g[c], a->drag, B->mass + p0, EV[c], ri[c], rg[c], ro ? ro[c] : NULL, B->F[c]);
+        R.V[c] = EV[c], R.xb[c] = X[c], R.vb[c] = V[c];
+        R.xt[c] = s < 4 ? B->trial[s - 1][r % 4][c] : NULL;
+        R.vt[c] = s < 4 ? B->trial[s - 1][r % 4][3 + c] : NULL;
+        R.ax[c] = B->sums[r % 8][c], R.av[c] = B->sums[r % 8][3 + c];
+    }
+    LK(rk4_update)(n, a->mode == MODE_RK4_LAST, a->first, a->h, a->weight, a->drag, a->g, B->mass + p0,
+                   B->inv_mass + p0, &R, B->F, B->t, acc);
+}
+
+/* op(s, j): see the file comment. (Inlined into run_block, so that each
+ * target_clones version of it vectorises its own copy.) */
+LAT_INLINE void LK(op)(LK(block) *B, double *partial, uint32_t s, uint32_t j)
+{
+    const LK_ARGS *a = &B->la[s - 1];
+    const spn__lattice *L = B->L;
+    LK(level) *lv = &B->lv[s - 1];
+    const uint32_t rings = L->rings, hi = LK(high)(B, s);
+    const int cur = lv->cur;
+    if (j < rings) {
+        LK_T *X[3], *V[3];
+        LK(eval_ptrs)(B, s, j, X, V);
+        const bool mine = LK(own)(B, j) && j < hi;
+        const int q = (int)((j / L->band_rows) & 1);
+        const bool cut = j > 0 && j % L->band_rows == 0;
+        double *ae = mine ? (cut ? lv->cut_e[q] : lv->acc_e[q]) : B->dummy[0];
+        double *ap = mine ? (cut ? lv->cut_p[q] : lv->acc_p[q]) : B->dummy[1];
+        if (j == 0) {
+            LK(block_hub)(B, s, X, V, lv->rad[cur], ae, ap, lv->acc[q]);
+        } else {
+            LK_T *Xp[3], *Vp[3];
+            LK(eval_ptrs)(B, s, j - 1, Xp, Vp);
+            LK(radials)(a, Xp, Vp, X, V, j, lv->rad[cur], B->e, B->p, ae, ap);
+        }
+        if (j < hi) {
+            double *re = mine ? lv->acc_e[q] : B->dummy[0], *rp = mine ? lv->acc_p[q] : B->dummy[1];
+            LK(rings)(a, X, V, j, lv->ring[cur], B->e, B->p, re, rp);
+        }
+    }
+    if (j > LK(low)(B, s)) {
+        const uint32_t r = j - 1, b = r / L->band_rows;
+        const bool mine = LK(own)(B, r);
+        LK(block_move)(B, s, r, lv->rad_prev, lv->ring[cur ^ 1], j < rings ? lv->rad[cur] : NULL,
+                       mine ? lv->acc[b & 1] : B->dummy + 2);
+        const uint32_t band_end = (b + 1) * L->band_rows < rings ? (b + 1) * L->band_rows : rings;
+        if (mine && r + 1 == band_end) LK(store_level)(B, partial, s, b);
+    }
+    lv->rad_prev = lv->rad[cur];
+    lv->cur ^= 1;
+}
+
+/* The workspace of one thread, stride numbers per array. */
+static size_t LK(block_numbers)(size_t stride)
+{
+    const size_t levels = 12 * LAT_LEVELS, ghosts = 12 * LAT_LEVELS, rk4 = 6 * 4 * (LAT_LEVELS - 1) + 6 * 8;
+    return (levels + ghosts + rk4 + 14) * stride;
+}
+
+static void LK(block_init)(LK(block) *B, const LK_ARGS *la, bool rk4, LK_T *ws, uint32_t R0, uint32_t R1,
+                           uint32_t K)
+{
+    const size_t st = LK(stride)(la);
+    memset(B, 0, sizeof *B);
+    B->la = la, B->L = la->L, B->rk4 = rk4, B->R0 = R0, B->R1 = R1, B->K = K;
+    LK(state)(la, B->X, B->V);
+    B->mass = LK(mass)(la), B->inv_mass = LK(inv_mass)(la);
+    LK_T *q = ws;
+    for (uint32_t s = 0; s < LAT_LEVELS; s++)
+        for (int r = 0; r < 2; r++)
+            for (int c = 0; c < 3; c++) B->lv[s].rad[r][c] = q, q += st, B->lv[s].ring[r][c] = q, q += st;
+    for (uint32_t g = 0; g < 2 * LAT_LEVELS; g++)
+        for (int c = 0; c < 6; c++) B->ghost[g][c] = q, q += st;
+    for (uint32_t s = 0; s + 1 < LAT_LEVELS; s++)
+        for (int r = 0; r < 4; r++)
+            for (int c = 0; c < 6; c++) B->trial[s][r][c] = q, q += st;
+    for (int r = 0; r < 8; r++)
+        for (int c = 0; c < 6; c++) B->sums[r][c] = q, q += st;
+    for (int c = 0; c < 6; c++) B->hub[c] = q, q += st;
+    B->e = q, q += st, B->p = q, q += st;
+    for (int c = 0; c < 3; c++) B->t[c] = q, q += st, B->F[c] = q, q += st;
+}
+
+/* Level 0 of the ghost rows, from the state before anyone moves it. */
+static void LK(copy_ghosts)(LK(block) *B)
+{
+    const spn__lattice *L = B->L;
+    const uint32_t n = L->radials;
+    for (uint32_t g = 0; g < 2 * B->K; g++) {
+        const uint32_t j = g < B->K ? B->R0 - B->K + g : B->R1 + (g - B->K);
+        if ((g < B->K && !B->R0) || (g >= B->K && j >= L->rings)) continue;
+        const size_t p0 = 1 + (size_t)j * n;
+        for (int c = 0; c < 3; c++) {
+            memcpy(B->ghost[g][c], B->X[c] + p0, n * sizeof(LK_T));
+            memcpy(B->ghost[g][3 + c], B->V[c] + p0, n * sizeof(LK_T));
+        }
+    }
+}
+
+SPN__KERNEL static void LK(run_block)(LK(block) *B, double *partial)
+{
+    const uint32_t K = B->K, first = LK(low)(B, 1), last = LK(high)(B, K) + K - 1;
+    for (uint32_t J = first; J <= last; J++)
+        for (uint32_t s = 1; s <= K; s++) {
+            if (J + 1 < s) break;
+            const uint32_t j = J + 1 - s;
+            if (j >= LK(low)(B, s) && j <= LK(high)(B, s)) LK(op)(B, partial, s, j);
+        }
+}
+
+/* K levels (2 .. LAT_LEVELS, spn__lattice_block_ready) in one pass over the
+ * state on `threads` threads: K explicit steps, or (rk4) the four stages of
+ * one RK4 step; la[s] the arguments of level s + 1, the sums of each into
+ * sums[s]. False when out of memory (nothing done). */
+static bool LK(block_pass)(spn__lattice *L, const LK_ARGS *la, bool rk4, int threads, uint32_t K,
+                           double sums[][L_NSUMS])
+{
+    if (!spn__lattice_block_alloc(L, threads, LK(block_numbers)(LK(stride)(la)) * sizeof(LK_T))) return false;
+    const uint32_t nb = L->nbands;
+#pragma omp parallel num_threads(threads)
+    {
+        const int t = spn__thread_num();
+        const uint32_t b0 = (uint32_t)((uint64_t)nb * (uint32_t)t / (uint32_t)threads);
+        const uint32_t b1 = (uint32_t)((uint64_t)nb * (uint32_t)(t + 1) / (uint32_t)threads);
+        const uint32_t R0 = b0 * L->band_rows, R1 = b1 * L->band_rows < L->rings ? b1 * L->band_rows : L->rings;
+        LK(block) B;
+        LK(block_init)(&B, la, rk4, (LK_T *)L->bws[t], R0, R1, K);
+        LK(copy_ghosts)(&B);
+#pragma omp barrier
+        LK(run_block)(&B, L->partial_k);
+    }
+    spn__lattice_block_sums(L, K, sums);
+    return true;
+}
