@@ -416,22 +416,6 @@ fail:
 }
 
 
-/* The pivot after step k - 1: out = D - U^T M U with M = Dinv_{k-1} (6),
- * U = U_{k-1} and D = D_k (9 each); w = M U, the factor the back
- * substitution needs. Level-0 blocks are symmetric (sums of H_s or -H_s), so
- * U^T M U = U w is too and only its six distinct entries are formed. */
-static void schur(const double *d, const double *m, const double *u, double *w, double *out)
-{
-    double mm[9] = {m[0], m[3], m[4], m[3], m[1], m[5], m[4], m[5], m[2]};
-    memset(w, 0, 9 * sizeof *w);
-    spn__blk_mul_add(mm, u, w);
-    static const int R[6] = {0, 1, 2, 0, 0, 1}, C[6] = {0, 1, 2, 1, 2, 2};
-    for (int q = 0; q < 6; q++) {
-        const double *ur = u + 3 * R[q];
-        out[q] = d[3 * R[q] + C[q]] - (ur[0] * w[C[q]] + ur[1] * w[3 + C[q]] + ur[2] * w[6 + C[q]]);
-    }
-}
-
 /* The six distinct entries of a symmetric 3x3 block, as floats at stride W
  * (zeros for NONE): 0 1 2 the diagonal, 3 4 5 the entries (0,1) (0,2) (1,2). */
 static void to_float6(const spn__bsr *a0, uint32_t entry, float *f)
@@ -439,6 +423,73 @@ static void to_float6(const spn__bsr *a0, uint32_t entry, float *f)
     static const int src[6] = {0, 4, 8, 1, 2, 5};
     const double *v = entry == NONE ? NULL : a0->val + 9 * (size_t)entry;
     for (int q = 0; q < 6; q++) f[W * q] = v ? (float)v[src[q]] : 0.0f;
+}
+
+/* Block Thomas factorisation of group g's lines, all eight lanes at once:
+ * each lane's pivots P_0 = D_0, P_s = D_s - U^T P_{s-1}^-1 U (U = U_{s-1})
+ * in float64, each lane in the order of the line-by-line factorisation this
+ * replaced and of spn__sym_inverse, so the bits are the same. A padded lane (past its line's
+ * end) factors an identity pivot and stores zeros. False if a pivot is not
+ * positive definite. */
+SPN__KERNEL static bool factor_group(spn__lines *L, const spn__bsr *a0, uint32_t g)
+{
+    static const double ident[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, zero[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+    static const int R[6] = {0, 1, 2, 0, 0, 1}, C[6] = {0, 1, 2, 1, 2, 2};
+    double prev[6][W]; /* the last pivot's inverse */
+    bool ok = true;
+    for (size_t s = L->group_step[g]; s < L->group_step[g + 1]; s++) {
+        const bool first = s == L->group_step[g];
+        double d[9][W], u[9][W], w[9][W], piv[6][W];
+        bool on[W];
+        for (uint32_t q = 0; q < W; q++) {
+            const uint32_t i = L->snode[W * s + q], up = first ? NONE : L->supos[W * (s - 1) + q];
+            on[q] = i != NONE;
+            const double *dd = on[q] ? a0->val + 9 * (size_t)a0->start[i] : ident;
+            const double *uu = up == NONE ? zero : a0->val + 9 * (size_t)up;
+            for (int f = 0; f < 9; f++) d[f][q] = dd[f], u[f][q] = uu[f];
+        }
+        if (first) {
+            for (uint32_t q = 0; q < W; q++) {
+                piv[0][q] = d[0][q], piv[1][q] = d[4][q], piv[2][q] = d[8][q];
+                piv[3][q] = d[1][q], piv[4][q] = d[2][q], piv[5][q] = d[5][q];
+            }
+        } else { /* w = P^-1 U, then D - U^T w: level-0 blocks are symmetric (sums of H_s or
+                  * -H_s), so U^T P^-1 U is too and only its six distinct entries are formed */
+            static const int M[9] = {0, 3, 4, 3, 1, 5, 4, 5, 2};
+            for (int r = 0; r < 3; r++)
+                for (int c = 0; c < 3; c++)
+                    for (uint32_t q = 0; q < W; q++) {
+                        double v = 0;
+                        v += prev[M[3 * r]][q] * u[c][q];
+                        v += prev[M[3 * r + 1]][q] * u[3 + c][q];
+                        v += prev[M[3 * r + 2]][q] * u[6 + c][q];
+                        w[3 * r + c][q] = v;
+                    }
+            for (int k = 0; k < 6; k++)
+                for (uint32_t q = 0; q < W; q++)
+                    piv[k][q] = d[3 * R[k] + C[k]][q] - ((u[3 * R[k]][q] * w[C[k]][q] + u[3 * R[k] + 1][q] * w[3 + C[k]][q]) +
+                                                         u[3 * R[k] + 2][q] * w[6 + C[k]][q]);
+            float *cu = L->cu + 9 * W * (s - 1); /* Dinv_{s-1} U_{s-1}, by columns */
+            for (int f = 0; f < 9; f++)
+                for (uint32_t q = 0; q < W; q++) cu[W * (3 * (f % 3) + f / 3) + q] = (float)w[f][q];
+        }
+        /* spn__sym_inverse, lane by lane */
+        float *dinv = L->dinv + 6 * W * s;
+        for (uint32_t q = 0; q < W; q++) {
+            const double a = piv[0][q], b = piv[1][q], c = piv[2][q], dd = piv[3][q], e = piv[4][q], f = piv[5][q];
+            const double c00 = b * c - f * f, c01 = e * f - dd * c, c02 = dd * f - b * e;
+            const double det = a * c00 + dd * c01 + e * c02;
+            ok &= a > 0 && det > 1e-300 && det < HUGE_VAL;
+            const double id = 1 / det;
+            prev[0][q] = c00 * id, prev[1][q] = (a * c - e * e) * id, prev[2][q] = (a * b - dd * dd) * id;
+            prev[3][q] = c01 * id, prev[4][q] = c02 * id, prev[5][q] = (dd * e - a * f) * id;
+            for (int k = 0; k < 6; k++) dinv[W * k + q] = on[q] ? (float)prev[k][q] : 0.0f;
+        }
+    }
+    float *last = L->cu + 9 * W * (size_t)(L->group_step[g + 1] - 1);
+    if (L->group_step[g + 1] > L->group_step[g])
+        for (uint32_t f = 0; f < 9 * W; f++) last[f] = 0;
+    return ok;
 }
 
 bool spn__lines_factor(spn__lines *L, const spn__bsr *a0)
@@ -450,32 +501,9 @@ bool spn__lines_factor(spn__lines *L, const spn__bsr *a0)
         for (uint32_t q = 0; q < W; q++) to_float6(a0, L->soff[W * j + q], L->offval + 6 * W * j + q);
     for (size_t s = 0; s < S; s++)
         for (uint32_t q = 0; q < W; q++) to_float6(a0, L->supos[W * s + q], L->uval + 6 * W * s + q);
-    for (uint32_t g = 0; g < L->groups; g++)
-        for (uint32_t q = 0; q < W; q++) {
-            double prev[6] = {0, 0, 0, 0, 0, 0}; /* the last pivot's inverse, in float64 */
-            for (size_t s = L->group_step[g]; s < L->group_step[g + 1]; s++) {
-                const uint32_t i = L->snode[W * s + q];
-                float *cu = L->cu + 9 * W * s + q, *dinv = L->dinv + 6 * W * s + q;
-                for (int f = 0; f < 9; f++) cu[W * f] = 0; /* written by the next step, if the line goes on */
-                if (i == NONE) { /* past the end of the line: nothing moves */
-                    for (int f = 0; f < 6; f++) dinv[W * f] = 0;
-                    continue;
-                }
-                const double *d = a0->val + 9 * (size_t)a0->start[i];
-                double piv[6], inv[6], w[9];
-                if (s == L->group_step[g]) { /* the plain diagonal */
-                    piv[0] = d[0], piv[1] = d[4], piv[2] = d[8], piv[3] = d[1], piv[4] = d[2], piv[5] = d[5];
-                } else {
-                    schur(d, prev, a0->val + 9 * (size_t)L->supos[W * (s - 1) + q], w, piv);
-                    for (int f = 0; f < 9; f++) /* Dinv_{s-1} U_{s-1}, by columns */
-                        L->cu[9 * W * (s - 1) + q + W * (3 * (f % 3) + f / 3)] = (float)w[f];
-                }
-                if (!spn__sym_inverse(piv, inv)) return false;
-                for (int f = 0; f < 6; f++) dinv[W * f] = (float)inv[f];
-                memcpy(prev, inv, sizeof prev);
-            }
-        }
-    return true;
+    bool ok = true;
+    for (uint32_t g = 0; g < L->groups; g++) ok &= factor_group(L, a0, g);
+    return ok;
 }
 
 /* o -= h v on the W lanes, h a symmetric float block at stride W (entries
