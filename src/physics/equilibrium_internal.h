@@ -12,6 +12,8 @@
 #include "spinneret/equilibrium.h"
 
 #define SPN__EQ_CHUNK 512u
+#define SPN__EQ_LANES 8u      /* divides SPN__EQ_CHUNK */
+#define SPN__EQ_LANE_SLOTS 8u
 
 typedef struct spn__mg spn__mg;
 
@@ -39,6 +41,14 @@ typedef struct spn__eq {
     double *fs;   /* 3 m: force on end a */
     double *diag; /* 6 n: diagonal blocks (springs + shift) */
     double *offd; /* 6 per adjacency entry: -H_s of the row's spring (0 to a fixed end) */
+    /* The product's copy of diag and offd: rows in groups of SPN__EQ_LANES
+     * side by side (equilibrium_system.c); a group with a row of more than
+     * SPN__EQ_LANE_SLOTS entries (a hub) has no slots and goes row by row. */
+    uint32_t *lane_start; /* groups + 1: the group's slots */
+    uint8_t *lane_by_row; /* per group: 1 when it goes row by row */
+    int32_t *lane_col;    /* SPN__EQ_LANES per slot: adj_col, or the row itself past a row's end */
+    double *lane_val;     /* 6 SPN__EQ_LANES per slot: entry f of lane q at (6 slot + f) LANES + q */
+    double *lane_diag;    /* 6 SPN__EQ_LANES per group, likewise */
     double *kscale; /* n: sum of incident k, the scale of the Levenberg shift */
     double lambda;  /* the shift of the last assembly */
     double *f;    /* 3 n: net force = -gradient */

@@ -33,15 +33,24 @@
  * Newton step; A - T the couplings off the line (on a web, the crossing
  * thread's two springs), read with the current values. This is the same as
  * adding T^-1 times the residual to x, but reads two blocks a particle
- * instead of five (the 5k web: the sweeps 97M -> 67M instructions). Lines
- * of a colour go in groups of GROUP, a step along all of them at a time: a radial of a ring-major web strides through memory,
- * but neighbouring radials step through neighbouring memory together.
+ * instead of five (the 5k web: the sweeps 97M -> 67M instructions).
  *
- * Layout: the sweep reads its blocks in the order it uses them, copied per
- * line node when the line is factored (the couplings off the line with
- * their columns, and the line's own U blocks), not through indices into the
- * level-0 matrix: on the 1M web those indirect loads missed the cache and
- * were about 40% of the sweep's time (perf).
+ * Layout: the lines of a colour go in groups of W = 8, side by side: step t
+ * of the group's eight lines is one record of the sweep's arrays, each field
+ * eight values long, one per line (a lane). The sweep then does each 3x3
+ * product on all eight lines at once as plain loops over the lanes, which
+ * the compiler turns into vector instructions, and reads its blocks in the
+ * order it uses them, as contiguous streams. A lane past its line's end is
+ * padded with zero blocks, which change nothing (a zero pivot inverse, a
+ * zero coupling). Each lane's arithmetic is the order the first, line by
+ * line, sweep had, so the bits did not change; the 5k web's solve went from
+ * 23.8 to 18.6 ms, the 100k web's from 1.54 to 1.22 s and the 1M web's from
+ * 38.3 to 33.2 s (one thread, CPU time). Before, a line's blocks were
+ * stored line after line and the group stepped along eight separate
+ * streams; about 190 instructions a line node, mostly moving single values
+ * in and out of vector registers. (Earlier still, the blocks were read
+ * through indices into the level-0 matrix: on the 1M web those indirect
+ * loads missed the cache and were about 40% of the sweep's time.)
  *
  * Precision: the sweep reads float32 copies of the level-0 blocks (6 numbers
  * each: every block of a spring system is symmetric) and of the factors,
@@ -54,6 +63,7 @@
  * factors touches the whole value; the counts stayed the same: 12 and 24.)*/
 #include "equilibrium_bsr.h"
 #include "equilibrium_internal.h"
+#include "world_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -61,41 +71,42 @@
 
 #define COLLINEAR 0.9    /* springs at a junction continue one line when cos(angle) < -this */
 #define JUNCTION 8u      /* particles with more springs end every line through them */
-#define GROUP 8u         /* lines of a colour stepped together */
+#define W 8u             /* lines of a colour stepped together, side by side */
+#define NONE UINT32_MAX
 #define PAR_MIN 4096u    /* particles in a colour below which it stays on one thread */
 
 struct spn__lines {
     uint32_t count;      /* lines */
     uint32_t *start;     /* count + 1: into node */
     uint32_t *node;      /* particles of each line, in order */
-    uint32_t *upos;      /* per line node k (not the last): the BSR entry (node[k], node[k+1]) */
-    uint32_t *off_start; /* per line node k: its row's entries off the line's tridiagonal part are */
-    uint32_t *off;       /* ... off[off_start[k] .. off_start[k + 1]) (BSR entries of level 0) */
-    uint32_t *offcol;    /* per off entry: its column (the particle coupled) */
-    /* float32 copies (see the file comment): the sweep's operands */
-    float *offval;       /* 6 per off entry: its symmetric block, in line order */
-    float *uval;         /* 6 per line node k (not the last): the block U_k = A(node[k], node[k+1]) */
-    float *dinv;         /* 6 per line node: inverted pivots of the factorisation */
-    float *cu;           /* 9 per line node (not the last): Dinv_k U_k by columns, for the back substitution */
-    double *work;        /* 3 per line node */
     uint32_t colours, *colour_start; /* lines [colour_start[c], colour_start[c + 1]) have colour c */
+    /* The sweep's layout (see the file comment): the lines of a colour in
+     * groups of W side by side, lane q of group g being line
+     * colour_start[c] + W (g - colour_group[c]) + q; a group's step t is one
+     * step s of the arrays below, W entries each, a lane past its line's
+     * end padded (NONE, zero blocks). */
+    uint32_t groups, *colour_group; /* colours + 1: groups [colour_group[c], colour_group[c + 1]) */
+    uint32_t steps, *group_step;    /* groups + 1: steps [group_step[g], group_step[g + 1]) */
+    uint32_t *snode;                /* W per step: the lane's particle, or NONE */
+    uint32_t *supos;                /* W per step: the BSR entry (particle, next particle), or NONE */
+    uint32_t *off_step;             /* steps + 1: off blocks [off_step[s], off_step[s + 1]) of step s */
+    uint32_t *soff;                 /* W per off block: the BSR entry off the line's tridiagonal part, or NONE */
+    uint32_t *soffcol;              /* W per off block: the particle it couples (0 in a padded lane) */
+    /* float32 copies (see the file comment): entry f of lane q at (n j + f) W + q */
+    float *offval;                  /* n = 6 per off block: its symmetric block */
+    float *uval;                    /* 6 per step: U = A(particle, next particle) */
+    float *dinv;                    /* 6 per step: the inverted pivot */
+    float *cu;                      /* 9 per step: Dinv U by columns, for the back substitution */
+    double *work;                   /* 3 per step */
 };
 
 void spn__lines_free(spn__lines *L)
 {
     if (!L) return;
-    free(L->start);
-    free(L->node);
-    free(L->upos);
-    free(L->off_start);
-    free(L->off);
-    free(L->offcol);
-    free(L->offval);
-    free(L->uval);
-    free(L->dinv);
-    free(L->cu);
-    free(L->work);
-    free(L->colour_start);
+    free(L->start), free(L->node), free(L->colour_start);
+    free(L->colour_group), free(L->group_step), free(L->snode), free(L->supos);
+    free(L->off_step), free(L->soff), free(L->soffcol);
+    free(L->offval), free(L->uval), free(L->dinv), free(L->cu), free(L->work);
     free(L);
 }
 
@@ -294,34 +305,89 @@ static bool colour_lines(spn__lines *L, const spn__bsr *a)
     return ok;
 }
 
-/* Per line node, the entries of its row outside the line's block
- * tridiagonal part T (not the diagonal, not the previous or next node): the
- * sweep solves T x_line = b - (A - T) x over those alone. */
-static bool off_entries(spn__lines *L, const spn__bsr *a0)
+/* The entries of line node k's row off the line's block tridiagonal part T
+ * (not the diagonal, not the previous or next node of line l): the sweep
+ * solves T x_line = b - (A - T) x over those alone. Their count, and, with
+ * `put`, the entries themselves into ent[], col[] at stride W. */
+static uint32_t off_entries(const spn__lines *L, const spn__bsr *a0, uint32_t l, uint32_t k, uint32_t *ent,
+                            uint32_t *col)
 {
-    uint32_t total = L->start[L->count];
-    L->off_start = malloc(((size_t)total + 1) * sizeof *L->off_start);
-    if (!L->off_start) return false;
+    uint32_t i = L->node[k], prev = k > L->start[l] ? L->node[k - 1] : i;
+    uint32_t next = k + 1 < L->start[l + 1] ? L->node[k + 1] : i, cnt = 0;
+    for (uint32_t p = a0->start[i]; p < a0->start[i + 1]; p++) {
+        uint32_t c = a0->col[p];
+        if (c == i || c == prev || c == next) continue;
+        if (ent) ent[(size_t)W * cnt] = p, col[(size_t)W * cnt] = c;
+        cnt++;
+    }
+    return cnt;
+}
+
+/* The line of lane q of group g in colour c, or UINT32_MAX. */
+static uint32_t lane_line(const spn__lines *L, uint32_t c, uint32_t g, uint32_t q)
+{
+    uint32_t l = L->colour_start[c] + W * (g - L->colour_group[c]) + q;
+    return l < L->colour_start[c + 1] ? l : UINT32_MAX;
+}
+
+/* Steps of the lines laid side by side: group and step offsets first (a
+ * group's steps: its longest line; a step's off blocks: the most any lane
+ * has), then the particles and BSR entries of each lane. */
+static bool lay_out(spn__lines *L, const spn__bsr *a0)
+{
+    L->colour_group = malloc(((size_t)L->colours + 1) * sizeof *L->colour_group);
+    if (!L->colour_group) return false;
+    L->colour_group[0] = 0;
+    for (uint32_t c = 0; c < L->colours; c++)
+        L->colour_group[c + 1] = L->colour_group[c] + (L->colour_start[c + 1] - L->colour_start[c] + W - 1) / W;
+    L->groups = L->colour_group[L->colours];
+    L->group_step = malloc(((size_t)L->groups + 1) * sizeof *L->group_step);
+    if (!L->group_step) return false;
+    L->group_step[0] = 0;
+    for (uint32_t c = 0; c < L->colours; c++)
+        for (uint32_t g = L->colour_group[c]; g < L->colour_group[c + 1]; g++) {
+            uint32_t longest = 0;
+            for (uint32_t q = 0, l; q < W && (l = lane_line(L, c, g, q)) != UINT32_MAX; q++)
+                if (L->start[l + 1] - L->start[l] > longest) longest = L->start[l + 1] - L->start[l];
+            L->group_step[g + 1] = L->group_step[g] + longest;
+        }
+    const size_t S = L->steps = L->group_step[L->groups];
+    L->off_step = calloc(S + 1, sizeof *L->off_step);
+    L->snode = malloc(W * (S ? S : 1) * sizeof *L->snode);
+    L->supos = malloc(W * (S ? S : 1) * sizeof *L->supos);
+    if (!L->off_step || !L->snode || !L->supos) return false;
     for (int pass = 0; pass < 2; pass++) {
-        uint32_t cnt = 0;
-        for (uint32_t l = 0; l < L->count; l++)
-            for (uint32_t k = L->start[l]; k < L->start[l + 1]; k++) {
-                uint32_t i = L->node[k], prev = k > L->start[l] ? L->node[k - 1] : i;
-                uint32_t next = k + 1 < L->start[l + 1] ? L->node[k + 1] : i;
-                if (pass == 0) L->off_start[k] = cnt;
-                for (uint32_t p = a0->start[i]; p < a0->start[i + 1]; p++) {
-                    uint32_t c = a0->col[p];
-                    if (c == i || c == prev || c == next) continue;
-                    if (pass == 1) L->off[cnt] = p, L->offcol[cnt] = c;
-                    cnt++;
+        for (uint32_t c = 0; c < L->colours; c++)
+            for (uint32_t g = L->colour_group[c]; g < L->colour_group[c + 1]; g++)
+                for (uint32_t q = 0; q < W; q++) {
+                    uint32_t l = lane_line(L, c, g, q), len = l == UINT32_MAX ? 0 : L->start[l + 1] - L->start[l];
+                    for (uint32_t s = L->group_step[g], t = 0; s < L->group_step[g + 1]; s++, t++) {
+                        const size_t e = W * (size_t)s + q;
+                        uint32_t k = t < len ? L->start[l] + t : UINT32_MAX;
+                        if (pass == 0) {
+                            uint32_t cnt = k == UINT32_MAX ? 0 : off_entries(L, a0, l, k, NULL, NULL);
+                            if (cnt > L->off_step[s + 1]) L->off_step[s + 1] = cnt;
+                            L->snode[e] = k == UINT32_MAX ? NONE : L->node[k];
+                            L->supos[e] = k == UINT32_MAX || t + 1 >= len ? NONE : find_entry(a0, L->node[k], L->node[k + 1]);
+                            continue;
+                        }
+                        size_t j0 = L->off_step[s], j1 = L->off_step[s + 1];
+                        uint32_t cnt = k == UINT32_MAX ? 0
+                                                       : off_entries(L, a0, l, k, L->soff + W * j0 + q, L->soffcol + W * j0 + q);
+                        for (size_t j = j0 + cnt; j < j1; j++) L->soff[W * j + q] = NONE, L->soffcol[W * j + q] = 0;
+                    }
                 }
-            }
         if (pass == 0) {
-            L->off_start[total] = cnt;
-            L->off = malloc((cnt ? cnt : 1) * sizeof *L->off);
-            L->offcol = malloc((cnt ? cnt : 1) * sizeof *L->offcol);
-            L->offval = malloc(6 * (size_t)(cnt ? cnt : 1) * sizeof *L->offval);
-            if (!L->off || !L->offcol || !L->offval) return false;
+            for (size_t s = 0; s < S; s++) L->off_step[s + 1] += L->off_step[s];
+            const size_t nb = L->off_step[S] ? L->off_step[S] : 1, ns = S ? S : 1;
+            L->soff = malloc(W * nb * sizeof *L->soff);
+            L->soffcol = malloc(W * nb * sizeof *L->soffcol);
+            L->offval = malloc(6 * W * nb * sizeof *L->offval);
+            L->uval = malloc(6 * W * ns * sizeof *L->uval);
+            L->dinv = malloc(6 * W * ns * sizeof *L->dinv);
+            L->cu = malloc(9 * W * ns * sizeof *L->cu);
+            L->work = malloc(3 * W * ns * sizeof *L->work);
+            if (!L->soff || !L->soffcol || !L->offval || !L->uval || !L->dinv || !L->cu || !L->work) return false;
         }
     }
     return true;
@@ -341,16 +407,7 @@ spn__lines *spn__lines_build(const spn__eq *e, const spn__bsr *a0)
     free(partner);
     partner = NULL;
     if (!colour_lines(L, a0)) goto fail;
-    uint32_t total = L->start[L->count];
-    L->upos = malloc((total ? total : 1) * sizeof *L->upos);
-    L->uval = malloc(6 * (size_t)(total ? total : 1) * sizeof *L->uval);
-    L->dinv = malloc(6 * (size_t)(total ? total : 1) * sizeof *L->dinv);
-    L->cu = malloc(9 * (size_t)(total ? total : 1) * sizeof *L->cu);
-    L->work = malloc(3 * (size_t)(total ? total : 1) * sizeof *L->work);
-    if (!L->upos || !L->uval || !L->dinv || !L->cu || !L->work) goto fail;
-    for (uint32_t l = 0; l < L->count; l++)
-        for (uint32_t k = L->start[l]; k + 1 < L->start[l + 1]; k++) L->upos[k] = find_entry(a0, L->node[k], L->node[k + 1]);
-    if (!off_entries(L, a0)) goto fail;
+    if (!lay_out(L, a0)) goto fail;
     return L;
 fail:
     free(partner);
@@ -359,214 +416,174 @@ fail:
 }
 
 
-/* The pivot after step k - 1: out = D - U^T M U with M = Dinv_{k-1} (6),
- * U = U_{k-1} and D = D_k (9 each); w = M U, the factor the back
- * substitution needs. Level-0 blocks are symmetric (sums of H_s or -H_s), so
- * U^T M U = U w is too and only its six distinct entries are formed. */
-static void schur(const double *d, const double *m, const double *u, double *w, double *out)
+/* The six distinct entries of a symmetric 3x3 block, as floats at stride W
+ * (zeros for NONE): 0 1 2 the diagonal, 3 4 5 the entries (0,1) (0,2) (1,2). */
+static void to_float6(const spn__bsr *a0, uint32_t entry, float *f)
 {
-    double mm[9] = {m[0], m[3], m[4], m[3], m[1], m[5], m[4], m[5], m[2]};
-    memset(w, 0, 9 * sizeof *w);
-    spn__blk_mul_add(mm, u, w);
-    static const int R[6] = {0, 1, 2, 0, 0, 1}, C[6] = {0, 1, 2, 1, 2, 2};
-    for (int q = 0; q < 6; q++) {
-        const double *ur = u + 3 * R[q];
-        out[q] = d[3 * R[q] + C[q]] - (ur[0] * w[C[q]] + ur[1] * w[3 + C[q]] + ur[2] * w[6 + C[q]]);
-    }
+    static const int src[6] = {0, 4, 8, 1, 2, 5};
+    const double *v = entry == NONE ? NULL : a0->val + 9 * (size_t)entry;
+    for (int q = 0; q < 6; q++) f[W * q] = v ? (float)v[src[q]] : 0.0f;
 }
 
-static void to_float6(const double *v, float *f)
+/* Block Thomas factorisation of group g's lines, all eight lanes at once:
+ * each lane's pivots P_0 = D_0, P_s = D_s - U^T P_{s-1}^-1 U (U = U_{s-1})
+ * in float64, each lane in the order of the line-by-line factorisation this
+ * replaced and of spn__sym_inverse, so the bits are the same. A padded lane (past its line's
+ * end) factors an identity pivot and stores zeros. False if a pivot is not
+ * positive definite. */
+SPN__KERNEL static bool factor_group(spn__lines *L, const spn__bsr *a0, uint32_t g)
 {
-    f[0] = (float)v[0], f[1] = (float)v[4], f[2] = (float)v[8];
-    f[3] = (float)v[1], f[4] = (float)v[2], f[5] = (float)v[5];
+    static const double ident[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, zero[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+    static const int R[6] = {0, 1, 2, 0, 0, 1}, C[6] = {0, 1, 2, 1, 2, 2};
+    double prev[6][W]; /* the last pivot's inverse */
+    bool ok = true;
+    for (size_t s = L->group_step[g]; s < L->group_step[g + 1]; s++) {
+        const bool first = s == L->group_step[g];
+        double d[9][W], u[9][W], w[9][W], piv[6][W];
+        bool on[W];
+        for (uint32_t q = 0; q < W; q++) {
+            const uint32_t i = L->snode[W * s + q], up = first ? NONE : L->supos[W * (s - 1) + q];
+            on[q] = i != NONE;
+            const double *dd = on[q] ? a0->val + 9 * (size_t)a0->start[i] : ident;
+            const double *uu = up == NONE ? zero : a0->val + 9 * (size_t)up;
+            for (int f = 0; f < 9; f++) d[f][q] = dd[f], u[f][q] = uu[f];
+        }
+        if (first) {
+            for (uint32_t q = 0; q < W; q++) {
+                piv[0][q] = d[0][q], piv[1][q] = d[4][q], piv[2][q] = d[8][q];
+                piv[3][q] = d[1][q], piv[4][q] = d[2][q], piv[5][q] = d[5][q];
+            }
+        } else { /* w = P^-1 U, then D - U^T w: level-0 blocks are symmetric (sums of H_s or
+                  * -H_s), so U^T P^-1 U is too and only its six distinct entries are formed */
+            static const int M[9] = {0, 3, 4, 3, 1, 5, 4, 5, 2};
+            for (int r = 0; r < 3; r++)
+                for (int c = 0; c < 3; c++)
+                    for (uint32_t q = 0; q < W; q++) {
+                        double v = 0;
+                        v += prev[M[3 * r]][q] * u[c][q];
+                        v += prev[M[3 * r + 1]][q] * u[3 + c][q];
+                        v += prev[M[3 * r + 2]][q] * u[6 + c][q];
+                        w[3 * r + c][q] = v;
+                    }
+            for (int k = 0; k < 6; k++)
+                for (uint32_t q = 0; q < W; q++)
+                    piv[k][q] = d[3 * R[k] + C[k]][q] - ((u[3 * R[k]][q] * w[C[k]][q] + u[3 * R[k] + 1][q] * w[3 + C[k]][q]) +
+                                                         u[3 * R[k] + 2][q] * w[6 + C[k]][q]);
+            float *cu = L->cu + 9 * W * (s - 1); /* Dinv_{s-1} U_{s-1}, by columns */
+            for (int f = 0; f < 9; f++)
+                for (uint32_t q = 0; q < W; q++) cu[W * (3 * (f % 3) + f / 3) + q] = (float)w[f][q];
+        }
+        /* spn__sym_inverse, lane by lane */
+        float *dinv = L->dinv + 6 * W * s;
+        for (uint32_t q = 0; q < W; q++) {
+            const double a = piv[0][q], b = piv[1][q], c = piv[2][q], dd = piv[3][q], e = piv[4][q], f = piv[5][q];
+            const double c00 = b * c - f * f, c01 = e * f - dd * c, c02 = dd * f - b * e;
+            const double det = a * c00 + dd * c01 + e * c02;
+            ok &= a > 0 && det > 1e-300 && det < HUGE_VAL;
+            const double id = 1 / det;
+            prev[0][q] = c00 * id, prev[1][q] = (a * c - e * e) * id, prev[2][q] = (a * b - dd * dd) * id;
+            prev[3][q] = c01 * id, prev[4][q] = c02 * id, prev[5][q] = (dd * e - a * f) * id;
+            for (int k = 0; k < 6; k++) dinv[W * k + q] = on[q] ? (float)prev[k][q] : 0.0f;
+        }
+    }
+    float *last = L->cu + 9 * W * (size_t)(L->group_step[g + 1] - 1);
+    if (L->group_step[g + 1] > L->group_step[g])
+        for (uint32_t f = 0; f < 9 * W; f++) last[f] = 0;
+    return ok;
 }
 
 bool spn__lines_factor(spn__lines *L, const spn__bsr *a0)
 {
     /* float copies of the blocks the sweep reads, in the order it reads them
      * (level-0 blocks are symmetric: sums of -H_s or of H_s) */
-    const uint32_t noff = L->off_start[L->start[L->count]];
-    for (uint32_t q = 0; q < noff; q++) to_float6(a0->val + 9 * (size_t)L->off[q], L->offval + 6 * (size_t)q);
-    for (uint32_t l = 0; l < L->count; l++)
-        for (uint32_t k = L->start[l]; k + 1 < L->start[l + 1]; k++)
-            to_float6(a0->val + 9 * (size_t)L->upos[k], L->uval + 6 * (size_t)k);
-    for (uint32_t l = 0; l < L->count; l++) {
-        double prev[6] = {0, 0, 0, 0, 0, 0}; /* the last pivot's inverse, in float64 */
-        for (uint32_t k = L->start[l]; k < L->start[l + 1]; k++) {
-            const double *d = a0->val + 9 * (size_t)a0->start[L->node[k]];
-            double piv[6], inv[6], w[9];
-            if (k == L->start[l]) { /* the plain diagonal */
-                piv[0] = d[0], piv[1] = d[4], piv[2] = d[8], piv[3] = d[1], piv[4] = d[2], piv[5] = d[5];
-            } else {
-                schur(d, prev, a0->val + 9 * (size_t)L->upos[k - 1], w, piv);
-                for (int q = 0; q < 9; q++) /* Dinv_{k-1} U_{k-1}, by columns */
-                    L->cu[9 * (size_t)(k - 1) + 3 * (q % 3) + q / 3] = (float)w[q];
+    const size_t S = L->steps;
+    for (size_t j = 0; j < L->off_step[S]; j++)
+        for (uint32_t q = 0; q < W; q++) to_float6(a0, L->soff[W * j + q], L->offval + 6 * W * j + q);
+    for (size_t s = 0; s < S; s++)
+        for (uint32_t q = 0; q < W; q++) to_float6(a0, L->supos[W * s + q], L->uval + 6 * W * s + q);
+    bool ok = true;
+    for (uint32_t g = 0; g < L->groups; g++) ok &= factor_group(L, a0, g);
+    return ok;
+}
+
+/* o -= h v on the W lanes, h a symmetric float block at stride W (entries
+ * as to_float6), v and o three rows of W. Each lane's sums go in the order
+ * (h0 v0 + h3 v1) + h4 v2 and so on, whatever the vector width. */
+#define SYM_SUB(h, v0, v1, v2, o0, o1, o2, q)                                                                         \
+    do {                                                                                                            \
+        const double h0 = (h)[(q)], h1 = (h)[W + (q)], h2 = (h)[2 * W + (q)];                                        \
+        const double h3 = (h)[3 * W + (q)], h4 = (h)[4 * W + (q)], h5 = (h)[5 * W + (q)];                            \
+        (o0)[q] -= (h0 * (v0) + h3 * (v1)) + h4 * (v2);                                                              \
+        (o1)[q] -= (h3 * (v0) + h1 * (v1)) + h5 * (v2);                                                              \
+        (o2)[q] -= (h4 * (v0) + h5 * (v1)) + h2 * (v2);                                                              \
+    } while (0)
+
+/* The lines of group g solved with the current x off them: forward
+ * elimination into work, then back substitution into work and x. */
+SPN__KERNEL static void solve_group(const spn__lines *L, uint32_t g, const double *restrict b, double *restrict x)
+{
+    const size_t s0 = L->group_step[g], s1 = L->group_step[g + 1];
+    for (size_t s = s0; s < s1; s++) {
+        const uint32_t *nd = L->snode + W * s;
+        double r0[W], r1[W], r2[W];
+        for (uint32_t q = 0; q < W; q++) {
+            const double *bi = b + 3 * (size_t)(nd[q] == NONE ? 0 : nd[q]);
+            r0[q] = bi[0], r1[q] = bi[1], r2[q] = bi[2];
+        }
+        for (size_t j = L->off_step[s]; j < L->off_step[s + 1]; j++) {
+            const uint32_t *col = L->soffcol + W * j;
+            const float *h = L->offval + 6 * W * j;
+            double v0[W], v1[W], v2[W]; /* gathered first, so that the product below vectorises */
+            for (uint32_t q = 0; q < W; q++) {
+                const double *v = x + 3 * (size_t)col[q];
+                v0[q] = v[0], v1[q] = v[1], v2[q] = v[2];
             }
-            if (!spn__sym_inverse(piv, inv)) return false;
-            for (int q = 0; q < 6; q++) L->dinv[6 * (size_t)k + q] = (float)inv[q];
-            memcpy(prev, inv, sizeof prev);
+            for (uint32_t q = 0; q < W; q++) SYM_SUB(h, v0[q], v1[q], v2[q], r0, r1, r2, q);
+        }
+        if (s > s0) { /* r -= U_{s-1}^T g_{s-1}; U is symmetric */
+            const double *gp = L->work + 3 * W * (s - 1);
+            const float *u = L->uval + 6 * W * (s - 1);
+            for (uint32_t q = 0; q < W; q++) SYM_SUB(u, gp[q], gp[W + q], gp[2 * W + q], r0, r1, r2, q);
+        }
+        double *o = L->work + 3 * W * s;
+        const float *m = L->dinv + 6 * W * s;
+        for (uint32_t q = 0; q < W; q++) {
+            const double h0 = m[q], h1 = m[W + q], h2 = m[2 * W + q], h3 = m[3 * W + q], h4 = m[4 * W + q],
+                         h5 = m[5 * W + q];
+            o[q] = (h0 * r0[q] + h3 * r1[q]) + h4 * r2[q];
+            o[W + q] = (h3 * r0[q] + h1 * r1[q]) + h5 * r2[q];
+            o[2 * W + q] = (h4 * r0[q] + h5 * r1[q]) + h2 * r2[q];
         }
     }
-    return true;
-}
-
-/* Symmetric float block times a double vector, in double. */
-static inline void fsym_mul(const float *h, double v0, double v1, double v2, double *o)
-{
-    o[0] = (double)h[0] * v0 + (double)h[3] * v1 + (double)h[4] * v2;
-    o[1] = (double)h[3] * v0 + (double)h[1] * v1 + (double)h[5] * v2;
-    o[2] = (double)h[4] * v0 + (double)h[5] * v1 + (double)h[2] * v2;
-}
-
-/* Step t of line l forward: the right-hand side of its particle t, b minus
- * the couplings off the line (with the current x), minus the eliminated part
- * of step t - 1, times the inverted pivot, into g_t. */
-static inline void forward_step(const spn__lines *L, uint32_t l, uint32_t t, const double *b, const double *x)
-{
-    uint32_t k = L->start[l] + t, i = L->node[k];
-    double r0 = b[3 * i], r1 = b[3 * i + 1], r2 = b[3 * i + 2];
-    for (uint32_t q = L->off_start[k]; q < L->off_start[k + 1]; q++) {
-        const float *m = L->offval + 6 * (size_t)q;
-        const double *v = x + 3 * (size_t)L->offcol[q];
-        double o[3];
-        fsym_mul(m, v[0], v[1], v[2], o);
-        r0 -= o[0], r1 -= o[1], r2 -= o[2];
+    for (size_t s = s1; s-- > s0;) { /* x_s = g_s - (Dinv_s U_s) x_{s+1} */
+        double *gs = L->work + 3 * W * s;
+        if (s + 1 < s1) {
+            const double *n = gs + 3 * W;
+            const float *m = L->cu + 9 * W * s; /* by columns */
+            for (uint32_t q = 0; q < W; q++) {
+                const double n0 = n[q], n1 = n[W + q], n2 = n[2 * W + q];
+                gs[q] -= ((double)m[q] * n0 + (double)m[3 * W + q] * n1) + (double)m[6 * W + q] * n2;
+                gs[W + q] -= ((double)m[W + q] * n0 + (double)m[4 * W + q] * n1) + (double)m[7 * W + q] * n2;
+                gs[2 * W + q] -= ((double)m[2 * W + q] * n0 + (double)m[5 * W + q] * n1) + (double)m[8 * W + q] * n2;
+            }
+        }
+        const uint32_t *nd = L->snode + W * s;
+        for (uint32_t q = 0; q < W; q++)
+            if (nd[q] != NONE) {
+                double *xi = x + 3 * (size_t)nd[q];
+                xi[0] = gs[q], xi[1] = gs[W + q], xi[2] = gs[2 * W + q];
+            }
     }
-    if (t > 0) { /* r -= U_{t-1}^T g_{t-1}; U is symmetric */
-        const double *gp = L->work + 3 * (size_t)(k - 1);
-        double o[3];
-        fsym_mul(L->uval + 6 * (size_t)(k - 1), gp[0], gp[1], gp[2], o);
-        r0 -= o[0], r1 -= o[1], r2 -= o[2];
-    }
-    fsym_mul(L->dinv + 6 * (size_t)k, r0, r1, r2, L->work + 3 * (size_t)k);
-}
-
-/* Step t of line l backward: x_t = g_t - (Dinv_t U_t) x_{t+1}. */
-static inline void backward_step(const spn__lines *L, uint32_t l, uint32_t t, double *x)
-{
-    uint32_t k = L->start[l] + t;
-    double *g = L->work + 3 * (size_t)k;
-    if (k + 1 < L->start[l + 1]) {
-        const float *m = L->cu + 9 * (size_t)k; /* by columns */
-        const double *n = g + 3;
-        g[0] -= (double)m[0] * n[0] + (double)m[3] * n[1] + (double)m[6] * n[2];
-        g[1] -= (double)m[1] * n[0] + (double)m[4] * n[1] + (double)m[7] * n[2];
-        g[2] -= (double)m[2] * n[0] + (double)m[5] * n[1] + (double)m[8] * n[2];
-    }
-    double *xi = x + 3 * (size_t)L->node[k];
-    xi[0] = g[0], xi[1] = g[1], xi[2] = g[2];
-}
-
-#if SPN__AVX
-/* fsym_mul on 256-bit vectors: o = (c0 v0 + c1 v1) + c2 v2 by lanes, c_j
- * the block's columns (three lanes and a spare), which is fsym_mul's order
- * in each lane: the same bits. The six floats are read as h[0..3] and
- * h[2..5] and the columns shuffled out of them. */
-__attribute__((target("avx"))) static inline __m256d fsym_avx(const float *h, __m256d v0, __m256d v1, __m256d v2)
-{
-    __m128 a = _mm_loadu_ps(h), b = _mm_loadu_ps(h + 2);
-    __m256d c0 = _mm256_cvtps_pd(_mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 2, 3, 0))); /* h0 h3 h4 */
-    __m256d c1 = _mm256_cvtps_pd(_mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 3, 1, 3))); /* h3 h1 h5 */
-    __m256d c2 = _mm256_cvtps_pd(_mm_shuffle_ps(b, a, _MM_SHUFFLE(0, 2, 3, 2))); /* h4 h5 h2 */
-    return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(c0, v0), _mm256_mul_pd(c1, v1)), _mm256_mul_pd(c2, v2));
-}
-
-/* forward_step with fsym_avx for the couplings and U; the pivot's inverse
- * stays scalar (the right-hand side's lanes would need moving across). */
-__attribute__((target("avx"))) static inline void forward_step_avx(const spn__lines *L, uint32_t l, uint32_t t,
-                                                                    const double *b, const double *x)
-{
-    uint32_t k = L->start[l] + t, i = L->node[k];
-    __m256d r = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(b + 3 * (size_t)i)),
-                                     _mm_load_sd(b + 3 * (size_t)i + 2), 1);
-    for (uint32_t q = L->off_start[k]; q < L->off_start[k + 1]; q++) {
-        const double *v = x + 3 * (size_t)L->offcol[q];
-        r = _mm256_sub_pd(r, fsym_avx(L->offval + 6 * (size_t)q, _mm256_broadcast_sd(v), _mm256_broadcast_sd(v + 1),
-                                      _mm256_broadcast_sd(v + 2)));
-    }
-    if (t > 0) { /* r -= U_{t-1}^T g_{t-1}; U is symmetric */
-        const double *gp = L->work + 3 * (size_t)(k - 1);
-        r = _mm256_sub_pd(r, fsym_avx(L->uval + 6 * (size_t)(k - 1), _mm256_broadcast_sd(gp),
-                                      _mm256_broadcast_sd(gp + 1), _mm256_broadcast_sd(gp + 2)));
-    }
-    double rr[4];
-    _mm256_storeu_pd(rr, r);
-    fsym_mul(L->dinv + 6 * (size_t)k, rr[0], rr[1], rr[2], L->work + 3 * (size_t)k);
-}
-
-/* backward_step on 256-bit vectors: g -= (c0 n0 + c1 n1) + c2 n2 by lanes,
- * c_j the columns of Dinv U (stored by columns): backward_step's order. */
-__attribute__((target("avx"))) static inline void backward_step_avx(const spn__lines *L, uint32_t l, uint32_t t,
-                                                                     double *x)
-{
-    uint32_t k = L->start[l] + t;
-    double *g = L->work + 3 * (size_t)k, *xi = x + 3 * (size_t)L->node[k];
-    if (k + 1 < L->start[l + 1]) {
-        const float *m = L->cu + 9 * (size_t)k;
-        const double *n = g + 3;
-        __m128 c = _mm_loadu_ps(m + 5);
-        __m256d c0 = _mm256_cvtps_pd(_mm_loadu_ps(m)), c1 = _mm256_cvtps_pd(_mm_loadu_ps(m + 3));
-        __m256d c2 = _mm256_cvtps_pd(_mm_shuffle_ps(c, c, _MM_SHUFFLE(3, 3, 2, 1)));
-        __m256d o = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(c0, _mm256_broadcast_sd(n)),
-                                                _mm256_mul_pd(c1, _mm256_broadcast_sd(n + 1))),
-                                  _mm256_mul_pd(c2, _mm256_broadcast_sd(n + 2)));
-        __m256d gv = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(g)), _mm_load_sd(g + 2), 1);
-        gv = _mm256_sub_pd(gv, o);
-        _mm_storeu_pd(g, _mm256_castpd256_pd128(gv));
-        _mm_store_sd(g + 2, _mm256_extractf128_pd(gv, 1));
-    }
-    xi[0] = g[0], xi[1] = g[1], xi[2] = g[2];
-}
-
-/* solve_group with forward_step_avx and backward_step_avx. */
-__attribute__((target("avx"))) static void solve_group_avx(const spn__lines *L, uint32_t l0, uint32_t l1,
-                                                           const double *b, double *x)
-{
-    uint32_t longest = 0;
-    for (uint32_t l = l0; l < l1; l++)
-        if (L->start[l + 1] - L->start[l] > longest) longest = L->start[l + 1] - L->start[l];
-    for (uint32_t t = 0; t < longest; t++)
-        for (uint32_t l = l0; l < l1; l++)
-            if (t < L->start[l + 1] - L->start[l]) forward_step_avx(L, l, t, b, x);
-    for (uint32_t t = longest; t-- > 0;)
-        for (uint32_t l = l0; l < l1; l++)
-            if (t < L->start[l + 1] - L->start[l]) backward_step_avx(L, l, t, x);
-}
-#endif
-
-/* Lines [l0, l1) of one colour, stepped together. */
-static void solve_group(const spn__lines *L, uint32_t l0, uint32_t l1, const double *b, double *x)
-{
-    uint32_t longest = 0;
-    for (uint32_t l = l0; l < l1; l++)
-        if (L->start[l + 1] - L->start[l] > longest) longest = L->start[l + 1] - L->start[l];
-    for (uint32_t t = 0; t < longest; t++)
-        for (uint32_t l = l0; l < l1; l++)
-            if (t < L->start[l + 1] - L->start[l]) forward_step(L, l, t, b, x);
-    for (uint32_t t = longest; t-- > 0;)
-        for (uint32_t l = l0; l < l1; l++)
-            if (t < L->start[l + 1] - L->start[l]) backward_step(L, l, t, x);
 }
 
 void spn__lines_sweep(const spn__lines *L, const double *b, double *x, bool forward, int threads)
 {
-    const bool avx = spn__have_avx();
-    (void)avx;
     for (uint32_t k = 0; k < L->colours; k++) {
         uint32_t c = forward ? k : L->colours - 1 - k;
-        uint32_t l0 = L->colour_start[c], l1 = L->colour_start[c + 1], groups = (l1 - l0 + GROUP - 1) / GROUP;
-        int team = L->start[l1] - L->start[l0] < PAR_MIN ? 1 : threads;
+        uint32_t g0 = L->colour_group[c], g1 = L->colour_group[c + 1];
+        int team = L->start[L->colour_start[c + 1]] - L->start[L->colour_start[c]] < PAR_MIN ? 1 : threads;
         (void)team;
 #pragma omp parallel for schedule(static) num_threads(team)
-        for (uint32_t g = 0; g < groups; g++) {
-            uint32_t g0 = l0 + g * GROUP, g1 = l0 + (g + 1) * GROUP < l1 ? l0 + (g + 1) * GROUP : l1;
-#if SPN__AVX
-            if (avx) {
-                solve_group_avx(L, g0, g1, b, x);
-                continue;
-            }
-#endif
-            solve_group(L, g0, g1, b, x);
-        }
+        for (uint32_t g = g0; g < g1; g++) solve_group(L, g, b, x);
     }
 }

@@ -391,10 +391,22 @@ static spn_status build(spn__mg *mg, const spn__eq *e, const double *inv0)
         if ((uint64_t)mg->lv[l + 1].A.rows * 10 > (uint64_t)mg->lv[l].A.rows * 9) break; /* stalled */
     }
     size_t N = 3 * (size_t)mg->lv[mg->nlevels - 1].A.rows;
-    if (mg->nlevels == 1 || N > 3 * DENSE_MAX) return SPN_OK;
-    mg->dense = malloc((N ? N * N : 1) * sizeof *mg->dense);
-    if (!mg->dense) return SPN_ERR_NOMEM;
-    return dense_factor(mg) ? SPN_OK : SPN_ERR_UNSTABLE;
+    if (mg->nlevels > 1 && N <= 3 * DENSE_MAX) {
+        mg->dense = malloc((N ? N * N : 1) * sizeof *mg->dense);
+        if (!mg->dense) return SPN_ERR_NOMEM;
+        if (!dense_factor(mg)) return SPN_ERR_UNSTABLE;
+    }
+    /* Built: from here the coarse levels and the transfers are only
+     * multiplied by vectors (the finest level's values are refreshed each
+     * Newton step and stay float64): float32 copies halve the bytes those
+     * products read. */
+    for (int l = 0; l < mg->nlevels; l++) {
+        mg_level *L = &mg->lv[l];
+        bool ok = (l == 0 || spn__bsr_round(&L->A)) && (!L->P.val || spn__bsr_round(&L->P)) &&
+                  (!L->R.val || spn__bsr_round(&L->R));
+        if (!ok) return SPN_ERR_NOMEM;
+    }
+    return SPN_OK;
 }
 
 spn_status spn__mg_setup(spn__mg **out, const spn__eq *e, const double *inv0)
