@@ -127,6 +127,25 @@ static void test_bands_and_threads(void **state)
     }
 }
 
+/* Advance one (1 thread) and two (2 threads) by `steps` in one call each,
+ * `blocked` of them in passes, and check them bit for bit against ref (which
+ * the caller has stepped the same way without passes): state, energy books,
+ * and that the web moved. */
+static void assert_passes_match(spn_world *one, spn_world *two, const spn_world *ref, double dt, int steps,
+                                int blocked)
+{
+    assert_int_equal(spn_world_advance(one, dt, steps), SPN_OK);
+    assert_int_equal(spn_world_last_step(one).blocked, blocked);
+    assert_int_equal(spn_world_advance(two, dt, steps), SPN_OK);
+    assert_int_equal(spn_world_last_step(two).blocked, blocked);
+    assert_same_state(one, ref);
+    assert_same_state(two, ref);
+    spn_energy e1 = spn_world_energy(one), e2 = spn_world_energy(two), er = spn_world_energy(ref);
+    assert_memory_equal(&e1.dissipated, &er.dissipated, sizeof(double));
+    assert_memory_equal(&e2.dissipated, &er.dissipated, sizeof(double));
+    assert_true(fastest(one) > 0.01);
+}
+
 /* Steps several to a pass over memory (spn_world_advance on a web of at
  * least def.parallel_min particles, lattice_block.c: four explicit steps or
  * the four stages of an RK4 step to a pass): the same bits as single steps, in the state and in the energy books, on 1 and 2 threads, and a
@@ -142,17 +161,8 @@ static void test_blocked_passes(void **state)
         spn_world *one = disturbed_orb(integs[k], 40, 50, 1, 256, true);
         spn_world *two = disturbed_orb(integs[k], 40, 50, 2, 256, true);
         spn_world *ref = disturbed_orb(integs[k], 40, 50, 1, 256, true);
-        assert_int_equal(spn_world_advance(one, dt, 29), SPN_OK);
-        assert_int_equal(spn_world_last_step(one).blocked, blocked);
-        assert_int_equal(spn_world_advance(two, dt, 29), SPN_OK);
-        assert_int_equal(spn_world_last_step(two).blocked, blocked);
         for (int i = 0; i < 29; i++) assert_int_equal(spn_world_step(ref, dt), SPN_OK);
-        assert_same_state(one, ref);
-        assert_same_state(two, ref);
-        spn_energy e1 = spn_world_energy(one), e2 = spn_world_energy(two), er = spn_world_energy(ref);
-        assert_memory_equal(&e1.dissipated, &er.dissipated, sizeof(double));
-        assert_memory_equal(&e2.dissipated, &er.dissipated, sizeof(double));
-        assert_true(fastest(one) > 0.01);
+        assert_passes_match(one, two, ref, dt, 29, blocked);
         /* a spring changed between calls reaches the blocked passes */
         change_springs(one, ref, 1234);
         assert_int_equal(spn_world_advance(one, dt, 8), SPN_OK);
@@ -212,18 +222,9 @@ static void test_blocked_passes_float32(void **state)
         spn_world *one = disturbed_orb32(integs[k], 1, 256);
         spn_world *two = disturbed_orb32(integs[k], 2, 256);
         spn_world *ref = disturbed_orb32(integs[k], 1, 8192);
-        assert_int_equal(spn_world_advance(one, dt, 69), SPN_OK);
-        assert_int_equal(spn_world_last_step(one).blocked, blocked);
-        assert_int_equal(spn_world_advance(two, dt, 69), SPN_OK);
-        assert_int_equal(spn_world_last_step(two).blocked, blocked);
         assert_int_equal(spn_world_advance(ref, dt, 69), SPN_OK);
         assert_int_equal(spn_world_last_step(ref).blocked, 0);
-        assert_same_state(one, ref);
-        assert_same_state(two, ref);
-        spn_energy e1 = spn_world_energy(one), e2 = spn_world_energy(two), er = spn_world_energy(ref);
-        assert_memory_equal(&e1.dissipated, &er.dissipated, sizeof(double));
-        assert_memory_equal(&e2.dissipated, &er.dissipated, sizeof(double));
-        assert_true(fastest(one) > 0.01);
+        assert_passes_match(one, two, ref, dt, 69, blocked);
         /* a spring changed between calls reaches the float32 passes */
         change_springs(one, ref, 1234);
         assert_int_equal(spn_world_advance(one, dt, 8), SPN_OK);
