@@ -75,7 +75,12 @@ double spn__eq_energy_delta(spn__eq *e, const double *p, double alpha);
 /* The largest step along p (<= 1) that shortens no taut tension-only spring,
  * to first order, by more than cap times its stretch. */
 double spn__eq_slack_limit(const spn__eq *e, const double *p, double cap);
-/* y = A p over free particles; the _dot form also returns p . y. */
+/* The product's lane copy of diag and offd (equilibrium_product.c): its
+ * layout, made once; row i's blocks copied in after each assembly. */
+spn_status spn__eq_build_lanes(spn__eq *e);
+void spn__eq_lanes_store(spn__eq *e, uint32_t i);
+/* y = A p over free particles; the _dot form also returns p . y
+ * (equilibrium_product.c). */
 void spn__eq_matvec(const spn__eq *e, const double *p, double *y);
 double spn__eq_matvec_dot(const spn__eq *e, const double *p, double *y);
 /* p += alpha d, r -= alpha q; returns r . r and sets *rmax2 to the largest

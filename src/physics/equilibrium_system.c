@@ -218,51 +218,6 @@ static void isolated_forces(spn__eq *e, const spn_world *w, const spn_equilibriu
     }
 }
 
-/* The lane layout of the product (see matvec_lanes): slot t of group g holds
- * entry t of each of its rows; a row with fewer entries is padded with a
- * zero block on its own column. */
-static spn_status build_lanes(spn__eq *e)
-{
-    const uint32_t n = e->n, W = SPN__EQ_LANES, groups = (n + W - 1) / W;
-    e->lane_start = malloc(((size_t)groups + 1) * sizeof *e->lane_start);
-    e->lane_by_row = malloc(groups ? groups : 1);
-    if (!e->lane_start || !e->lane_by_row) return SPN_ERR_NOMEM;
-    e->lane_start[0] = 0;
-    for (uint32_t g = 0; g < groups; g++) {
-        uint32_t longest = 0;
-        for (uint32_t i = W * g; i < W * g + W && i < n; i++)
-            if (e->adj_start[i + 1] - e->adj_start[i] > longest) longest = e->adj_start[i + 1] - e->adj_start[i];
-        e->lane_by_row[g] = longest > SPN__EQ_LANE_SLOTS;
-        e->lane_start[g + 1] = e->lane_start[g] + (e->lane_by_row[g] ? 0 : longest);
-    }
-    const size_t slots = e->lane_start[groups] ? e->lane_start[groups] : 1;
-    e->lane_col = malloc(W * slots * sizeof *e->lane_col);
-    e->lane_val = calloc(6 * W * slots, sizeof *e->lane_val);
-    e->lane_diag = calloc(6 * W * (size_t)(groups ? groups : 1), sizeof *e->lane_diag);
-    if (!e->lane_col || !e->lane_val || !e->lane_diag) return SPN_ERR_NOMEM;
-    for (uint32_t g = 0; g < groups; g++)
-        for (uint32_t q = 0; q < W; q++) {
-            const uint32_t i = W * g + q;
-            for (uint32_t t = 0; t < e->lane_start[g + 1] - e->lane_start[g]; t++) {
-                const uint32_t j = i < n ? e->adj_start[i] + t : 0;
-                const bool on = i < n && j < e->adj_start[i + 1];
-                e->lane_col[W * (size_t)(e->lane_start[g] + t) + q] = on ? e->adj_col[j] : (int32_t)(i < n ? i : 0);
-            }
-        }
-    return SPN_OK;
-}
-
-/* Row i's diagonal and off-diagonal blocks into the lane layout. */
-static void lanes_store(spn__eq *e, uint32_t i)
-{
-    const uint32_t W = SPN__EQ_LANES, g = i / W, q = i % W, slot0 = e->lane_start[g];
-    if (e->lane_by_row[g]) return;
-    for (int f = 0; f < 6; f++) e->lane_diag[(6 * (size_t)g + f) * W + q] = e->diag[6 * (size_t)i + f];
-    for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++)
-        for (int f = 0; f < 6; f++)
-            e->lane_val[(6 * (size_t)(slot0 + j - e->adj_start[i]) + f) * W + q] = e->offd[6 * (size_t)j + f];
-}
-
 spn_status spn__eq_init(spn__eq *e, const spn_world *w, const spn_equilibrium_def *def)
 {
     memset(e, 0, sizeof *e);
@@ -282,7 +237,7 @@ spn_status spn__eq_init(spn__eq *e, const spn_world *w, const spn_equilibrium_de
     free(touched);
     free(rec);
     if (st == SPN_OK) st = build_adjacency(e);
-    if (st == SPN_OK) st = build_lanes(e);
+    if (st == SPN_OK) st = spn__eq_build_lanes(e);
     if (st == SPN_OK) {
         size_t n = e->n ? e->n : 1, m = e->m ? e->m : 1;
         e->fext = malloc(3 * n * sizeof *e->fext);
@@ -383,7 +338,7 @@ double spn__eq_assemble(spn__eq *e, double lambda, uint32_t *worst)
         uint32_t arg = 0;
         for (uint32_t i = c * SPN__EQ_CHUNK; i < end; i++) {
             gather_particle(e, i, lambda);
-            lanes_store(e, i);
+            spn__eq_lanes_store(e, i);
             const double *f = e->f + 3 * (size_t)i;
             double f2 = f[0] * f[0] + f[1] * f[1] + f[2] * f[2];
             if (f2 > best) {
@@ -463,101 +418,6 @@ double spn__eq_energy_delta(spn__eq *e, const double *p, double alpha)
     return de - alpha * spn__eq_dot(e, e->fext, p);
 }
 
-/* Row i of A p: the diagonal block, then the row's off-diagonal blocks
- * stored in adjacency order (a fixed neighbour's entry is zero and points at
- * the row itself, so the loop has no branch). */
-static inline void matvec_row(const double *restrict diag, const uint32_t *restrict start,
-                              const int32_t *restrict col, const double *restrict offd, uint32_t i,
-                              const double *restrict p, double *restrict y)
-{
-    const double *d = diag + 6 * (size_t)i, *pi = p + 3 * (size_t)i;
-    /* scalars, not an array: a copy out of a stack array stalls on store forwarding */
-    double a0 = d[0] * pi[0] + d[3] * pi[1] + d[4] * pi[2];
-    double a1 = d[3] * pi[0] + d[1] * pi[1] + d[5] * pi[2];
-    double a2 = d[4] * pi[0] + d[5] * pi[1] + d[2] * pi[2];
-    for (uint32_t j = start[i]; j < start[i + 1]; j++) {
-        const double *h = offd + 6 * (size_t)j, *v = p + 3 * (size_t)col[j];
-        a0 += h[0] * v[0] + h[3] * v[1] + h[4] * v[2];
-        a1 += h[3] * v[0] + h[1] * v[1] + h[5] * v[2];
-        a2 += h[4] * v[0] + h[5] * v[1] + h[2] * v[2];
-    }
-    y[3 * (size_t)i] = a0;
-    y[3 * (size_t)i + 1] = a1;
-    y[3 * (size_t)i + 2] = a2;
-}
-
-/* Rows [8 g, 8 g + 8) of A p, side by side: each row's sums in matvec_row's
- * order (the padding adds zeros), on all eight at once as plain loops over
- * the lanes, which the compiler turns into vector instructions. */
-SPN__KERNEL static void matvec_lanes(const spn__eq *e, uint32_t g, const double *restrict p, double *restrict y)
-{
-    enum { W = SPN__EQ_LANES };
-    const uint32_t i0 = W * g;
-    const double *d = e->lane_diag + 6 * W * (size_t)g;
-    double a0[W], a1[W], a2[W], v0[W], v1[W], v2[W];
-    for (uint32_t q = 0; q < W; q++) {
-        const double *v = p + 3 * (size_t)(i0 + q < e->n ? i0 + q : 0);
-        v0[q] = v[0], v1[q] = v[1], v2[q] = v[2];
-    }
-    for (uint32_t q = 0; q < W; q++) {
-        a0[q] = (d[q] * v0[q] + d[3 * W + q] * v1[q]) + d[4 * W + q] * v2[q];
-        a1[q] = (d[3 * W + q] * v0[q] + d[W + q] * v1[q]) + d[5 * W + q] * v2[q];
-        a2[q] = (d[4 * W + q] * v0[q] + d[5 * W + q] * v1[q]) + d[2 * W + q] * v2[q];
-    }
-    for (uint32_t t = e->lane_start[g]; t < e->lane_start[g + 1]; t++) {
-        const int32_t *col = e->lane_col + W * (size_t)t;
-        const double *h = e->lane_val + 6 * W * (size_t)t;
-        for (uint32_t q = 0; q < W; q++) {
-            const double *v = p + 3 * (size_t)col[q];
-            v0[q] = v[0], v1[q] = v[1], v2[q] = v[2];
-        }
-        for (uint32_t q = 0; q < W; q++) {
-            a0[q] += (h[q] * v0[q] + h[3 * W + q] * v1[q]) + h[4 * W + q] * v2[q];
-            a1[q] += (h[3 * W + q] * v0[q] + h[W + q] * v1[q]) + h[5 * W + q] * v2[q];
-            a2[q] += (h[4 * W + q] * v0[q] + h[5 * W + q] * v1[q]) + h[2 * W + q] * v2[q];
-        }
-    }
-    for (uint32_t q = 0; q < W && i0 + q < e->n; q++) {
-        double *o = y + 3 * (size_t)(i0 + q);
-        o[0] = a0[q], o[1] = a1[q], o[2] = a2[q];
-    }
-}
-
-/* y = A p row by row (each row's own sums, so any thread count gives the
- * same bits), eight rows at a time where the rows are short. Measured
- * against the spring-by-spring product this replaced below 32,768 free
- * particles (which read each spring's block once but scattered, so it ran on
- * one thread) and the scalar row product above: see
- * docs/physics-equilibrium.md. */
-double spn__eq_matvec_dot(const spn__eq *e, const double *p, double *y)
-{
-    const uint32_t n = e->n, nchunks = e->nchunks, W = SPN__EQ_LANES;
-#pragma omp parallel for schedule(static) num_threads(team(e, n))
-    for (uint32_t c = 0; c < nchunks; c++) {
-        uint32_t begin = c * SPN__EQ_CHUNK, end = (c + 1) * SPN__EQ_CHUNK < n ? (c + 1) * SPN__EQ_CHUNK : n;
-        for (uint32_t g = begin / W; g * W < end; g++) {
-            if (!e->lane_by_row[g]) {
-                matvec_lanes(e, g, p, y);
-                continue;
-            }
-            for (uint32_t i = g * W; i < g * W + W && i < n; i++)
-                matvec_row(e->diag, e->adj_start, e->adj_col, e->offd, i, p, y);
-        }
-        double s0 = 0, s1 = 0, s2 = 0;
-        for (uint32_t i = begin; i < end; i++) {
-            const double *pi = p + 3 * (size_t)i, *yi = y + 3 * (size_t)i;
-            s0 += yi[0] * pi[0];
-            s1 += yi[1] * pi[1];
-            s2 += yi[2] * pi[2];
-        }
-        e->partial[c] = s0 + s1 + s2;
-    }
-    double sum = 0;
-    for (uint32_t c = 0; c < nchunks; c++) sum += e->partial[c];
-    return sum;
-}
-
-void spn__eq_matvec(const spn__eq *e, const double *p, double *y) { (void)spn__eq_matvec_dot(e, p, y); }
 
 /* Sum of a[i] * b[i] over [lo, hi), four running sums so the additions
  * overlap instead of waiting on each other; fixed order all the same. */
