@@ -23,7 +23,7 @@ typedef struct chunk {
     double lx[SPN_CHUNK], ly[SPN_CHUNK], lz[SPN_CHUNK];
     double ux[SPN_CHUNK], uy[SPN_CHUNK], uz[SPN_CHUNK];
     double k[SPN_CHUNK], kd[SPN_CHUNK], rest[SPN_CHUNK], tonly[SPN_CHUNK];
-    double s[SPN_CHUNK], e[SPN_CHUNK], p[SPN_CHUNK], g[SPN_CHUNK];
+    double s[SPN_CHUNK], e[SPN_CHUNK], p[SPN_CHUNK];
 } chunk;
 
 /* Springs hs[0..n) into the chunk. A spring whose end b is at or past
@@ -44,7 +44,7 @@ static inline void chunk_load(chunk *restrict c, const spn__spring *restrict hs,
 }
 
 /* Force on end a of each spring of the chunk, into fs; the elastic energy,
- * damping power and force magnitude of each into c->e, c->p, c->g. */
+ * and damping power of each into c->e, c->p. */
 static inline void chunk_forces(chunk *restrict c, uint32_t n, spn_vec3 *restrict fs)
 {
     for (uint32_t j = 0; j < n; j++) {
@@ -63,7 +63,6 @@ static inline void chunk_forces(chunk *restrict c, uint32_t n, spn_vec3 *restric
         c->s[j] = -mag * inv;
         c->e[j] = 0.5 * k * stretch * stretch;
         c->p[j] = kd * rate * rate;
-        c->g[j] = fabs(mag);
     }
     for (uint32_t j = 0; j < n; j++) {
         const double sj = c->s[j];
@@ -71,21 +70,19 @@ static inline void chunk_forces(chunk *restrict c, uint32_t n, spn_vec3 *restric
     }
 }
 
-/* Adds the chunk's sums to out[0..2], four independent partial sums each
+/* Adds the chunk's sums to out[0..1], four independent partial sums each
  * (a fixed order, whatever the vector width of the loop above). */
 static inline void chunk_sums(const chunk *restrict c, uint32_t n, double *out)
 {
-    double e0 = 0, e1 = 0, e2 = 0, e3 = 0, p0 = 0, p1 = 0, p2 = 0, p3 = 0, g0 = 0, g1 = 0, g2 = 0, g3 = 0;
+    double e0 = 0, e1 = 0, e2 = 0, e3 = 0, p0 = 0, p1 = 0, p2 = 0, p3 = 0;
     uint32_t j = 0;
     for (; j + 4 <= n; j += 4) {
         e0 += c->e[j], e1 += c->e[j + 1], e2 += c->e[j + 2], e3 += c->e[j + 3];
         p0 += c->p[j], p1 += c->p[j + 1], p2 += c->p[j + 2], p3 += c->p[j + 3];
-        g0 += c->g[j], g1 += c->g[j + 1], g2 += c->g[j + 2], g3 += c->g[j + 3];
     }
-    for (; j < n; j++) e0 += c->e[j], p0 += c->p[j], g0 += c->g[j];
+    for (; j < n; j++) e0 += c->e[j], p0 += c->p[j];
     out[0] += (e0 + e1) + (e2 + e3);
     out[1] += (p0 + p1) + (p2 + p3);
-    out[2] += (g0 + g1) + (g2 + g3);
 }
 
 

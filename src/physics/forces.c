@@ -132,24 +132,21 @@ void spn__spring_pass(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, ns))
     for (uint32_t blk = 0; blk < nb; blk++) {
         const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < ns ? lo + SPN_BLOCK : ns;
-        double sums[3] = {0, 0, 0};
+        double sums[2] = {0, 0};
         spring_range(hs, lo, hi, x, v, fs, sums);
-        const double energy = sums[0], power = sums[1], gross = sums[2];
+        const double energy = sums[0], power = sums[1];
         if (air)
             for (uint32_t s = lo; s < hi; s++) w->fair[s] = air_force(w, s, x, v, &w->cair[s]);
         partial[(size_t)blk * SPN_NSUMS + 0] = energy;
         partial[(size_t)blk * SPN_NSUMS + 1] = power;
-        partial[(size_t)blk * SPN_NSUMS + 2] = gross;
     }
-    double elastic = 0, damp = 0, gross = 0;
+    double elastic = 0, damp = 0;
     for (uint32_t blk = 0; blk < nb; blk++) {
         elastic += partial[(size_t)blk * SPN_NSUMS + 0];
         damp += partial[(size_t)blk * SPN_NSUMS + 1];
-        gross += partial[(size_t)blk * SPN_NSUMS + 2];
     }
     e->elastic = elastic;
     e->damp_power = damp;
-    e->gross = gross + w->free_mass * spn_v3_len(w->def.gravity);
     e->kinetic = 0;
     e->ext_power = 0;
 }

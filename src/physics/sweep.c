@@ -28,7 +28,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { W_ELASTIC, W_DAMP, W_GROSS, W_MV2, W_GAIN, W_MVN2 };
+enum { W_ELASTIC, W_DAMP, W_MV2, W_GAIN, W_MVN2 };
 
 void spn__sweep_free(spn_world *w)
 {
@@ -86,7 +86,7 @@ SPN__KERNEL static void crossing_forces(const spn_world *w, uint32_t blk, double
 {
     chunk c;
     spn_vec3 buf[SPN_CHUNK];
-    double sums[3] = {0, 0, 0};
+    double sums[2] = {0, 0};
     const uint32_t lo = w->xout_start[blk], hi = w->xout_start[blk + 1];
     for (uint32_t s0 = lo; s0 < hi; s0 += SPN_CHUNK) {
         const uint32_t n = hi - s0 < SPN_CHUNK ? hi - s0 : SPN_CHUNK;
@@ -95,7 +95,8 @@ SPN__KERNEL static void crossing_forces(const spn_world *w, uint32_t blk, double
         chunk_sums(&c, n, sums);
         for (uint32_t j = 0; j < n; j++) w->fs[w->xout[s0 + j]] = buf[j];
     }
-    p[W_ELASTIC] = sums[0], p[W_DAMP] = sums[1], p[W_GROSS] = sums[2];
+    for (int k = 0; k < SPN_NSUMS; k++) p[k] = 0; /* spn__sum_partials adds every slot */
+    p[W_ELASTIC] = sums[0], p[W_DAMP] = sums[1];
 }
 
 typedef struct sweep_args {
@@ -143,7 +144,7 @@ SPN__KERNEL static void sweep_block(const spn_world *w, const sweep_args *s, uin
     }
     chunk c;
     spn_vec3 buf[SPN_CHUNK];
-    double sums[3] = {p[W_ELASTIC], p[W_DAMP], p[W_GROSS]};
+    double sums[2] = {p[W_ELASTIC], p[W_DAMP]};
     double ps[SPN_NSUMS] = {0};
     uint32_t i = lo;
     const uint32_t s_lo = s->a_start[lo], s_hi = s->a_start[hi];
@@ -176,7 +177,7 @@ SPN__KERNEL static void sweep_block(const spn_world *w, const sweep_args *s, uin
         i = end;
     }
     move(s, i, hi, ps);
-    p[W_ELASTIC] = sums[0], p[W_DAMP] = sums[1], p[W_GROSS] = sums[2];
+    p[W_ELASTIC] = sums[0], p[W_DAMP] = sums[1];
     p[W_MV2] = ps[W_MV2], p[W_GAIN] = ps[W_GAIN], p[W_MVN2] = ps[W_MVN2];
 }
 

@@ -83,7 +83,6 @@ typedef struct spn__eval {
     double kinetic;     /* sum 1/2 m v^2 over free particles */
     double damp_power;  /* power removed by spring damping and viscous drag [W] */
     double ext_power;   /* power of external forces (callback + air), sum fext . v */
-    double gross;       /* sum of |spring force| plus m |g|: the scale of round-off in forces */
 } spn__eval;
 
 /* Implicit Euler's per-spring Jacobian data (see implicit.c). */
