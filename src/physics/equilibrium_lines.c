@@ -492,18 +492,25 @@ SPN__KERNEL static bool factor_group(spn__lines *L, const spn__bsr *a0, uint32_t
     return ok;
 }
 
-bool spn__lines_factor(spn__lines *L, const spn__bsr *a0)
+bool spn__lines_factor(spn__lines *L, const spn__bsr *a0, int threads)
 {
     /* float copies of the blocks the sweep reads, in the order it reads them
-     * (level-0 blocks are symmetric: sums of -H_s or of H_s) */
+     * (level-0 blocks are symmetric: sums of -H_s or of H_s); each group's
+     * own entries, so any thread count gives the same bits */
     const size_t S = L->steps;
-    for (size_t j = 0; j < L->off_step[S]; j++)
-        for (uint32_t q = 0; q < W; q++) to_float6(a0, L->soff[W * j + q], L->offval + 6 * W * j + q);
-    for (size_t s = 0; s < S; s++)
-        for (uint32_t q = 0; q < W; q++) to_float6(a0, L->supos[W * s + q], L->uval + 6 * W * s + q);
-    bool ok = true;
-    for (uint32_t g = 0; g < L->groups; g++) ok &= factor_group(L, a0, g);
-    return ok;
+    const int team = S * W < PAR_MIN ? 1 : threads;
+    (void)team;
+    int bad = 0;
+#pragma omp parallel for schedule(static) num_threads(team) reduction(+ : bad)
+    for (uint32_t g = 0; g < L->groups; g++) {
+        for (size_t s = L->group_step[g]; s < L->group_step[g + 1]; s++) {
+            for (size_t j = L->off_step[s]; j < L->off_step[s + 1]; j++)
+                for (uint32_t q = 0; q < W; q++) to_float6(a0, L->soff[W * j + q], L->offval + 6 * W * j + q);
+            for (uint32_t q = 0; q < W; q++) to_float6(a0, L->supos[W * s + q], L->uval + 6 * W * s + q);
+        }
+        bad += !factor_group(L, a0, g);
+    }
+    return bad == 0;
 }
 
 /* o -= h v on the W lanes, h a symmetric float block at stride W (entries
