@@ -27,7 +27,7 @@ typedef enum spn_precond {
     SPN_PRECOND_BLOCK_JACOBI, ///< each particle's 3x3 diagonal block, inverted
     SPN_PRECOND_MULTIGRID,   ///< smoothed-aggregation multigrid V-cycle over the spring graph, thread-line smoothing
     SPN_PRECOND_SGS,         ///< symmetric block Gauss-Seidel (sequential)
-    SPN_PRECOND_AUTO,        ///< block Jacobi below 4,000 free particles, multigrid above (measured)
+    SPN_PRECOND_AUTO,        ///< block Jacobi below 1,000 free particles, multigrid above (measured)
     SPN_PRECOND_COUNT
 } spn_precond;
 

@@ -26,7 +26,7 @@
 #define LAMBDA_FIRST 1e-6 /* first shift when the plain Newton system fails */
 #define LAMBDA_MAX 1e8
 #define ARMIJO 1e-4
-#define AUTO_MULTIGRID 4000u /* free particles from which multigrid beats block Jacobi (measured, 1 thread: 2.5k 10.7 vs 11.6 ms, 5k 31 vs 27 ms) */
+#define AUTO_MULTIGRID 1000u /* free particles from which multigrid is the faster (docs/physics-equilibrium.md: the standard web ties at 1k, the species webs 1.5-7x faster from 1.8k) */
 #define SLACK_CAP 1.0   /* a step may take a taut silk thread (to first order) at most to slack */
 #define SLACK_FLOOR 0.01 /* ... but is never cut below this fraction */
 #define ETA0 0.1         /* the first solve's CG tolerance: a rough first step went slack wholesale */
