@@ -449,7 +449,6 @@ fail:
     return NULL;
 }
 
-
 /* The six distinct entries of a symmetric 3x3 block, as floats at stride W
  * (0 1 2 the diagonal, 3 4 5 the entries (0,1) (0,2) (1,2)); a NONE entry,
  * a padded lane, keeps the zeros it was allocated with. (On the species webs
@@ -466,8 +465,8 @@ static void to_float6(const spn__bsr *a0, uint32_t entry, float *f)
 /* Block Thomas factorisation of group g's lines, all eight lanes at once:
  * each lane's pivots P_0 = D_0, P_s = D_s - U^T P_{s-1}^-1 U (U = U_{s-1})
  * in float64, each lane in the order of the line-by-line factorisation this
- * replaced and of spn__sym_inverse, so the bits are the same. A padded lane (past its line's
- * end) factors an identity pivot and stores zeros. False if a pivot is not
+ * replaced and of spn__sym_inverse, so the bits are the same. A padded
+ * lane (past its line's end) factors an identity pivot and stores zeros. False if a pivot is not
  * positive definite. */
 SPN__KERNEL static bool factor_group(spn__lines *L, const spn__bsr *a0, uint32_t g)
 {
