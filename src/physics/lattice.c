@@ -62,6 +62,8 @@ static void lattice_free(spn__lattice *L)
     spn__lat32_free(L->f32);
     for (int t = 0; t < L->nws; t++) free(L->ws[t]);
     free(L->ws);
+    for (int t = 0; t < L->ncols; t++) free(L->cols[t]);
+    free(L->cols);
     free(L);
 }
 
@@ -174,7 +176,7 @@ static bool prepare(spn_world *w, int threads)
             if (!L->ws[L->nws]) return false;
         }
     }
-    return true;
+    return spn__lattice_cols_alloc(L, threads);
 }
 
 /* ---- the sweep ---- */
@@ -186,8 +188,8 @@ LAT_INLINE void eval_rows(const lat_args *a, size_t p0, double **X, double **V)
 }
 
 /* Particles p0 .. p0+n-1 of an RK4 stage, their force F (3 arrays) known. */
-LAT_INLINE void rk4_update(const lat_args *a, size_t p0, uint32_t n, double *const *F, double *const *t,
-                           double (*acc)[LANES])
+LAT_INLINE void rk4_update(const lat_args *a, size_t p0, uint32_t n, double *const *F,
+                           const lat_cols *cs)
 {
     const spn__lattice *L = a->L;
     rk4_rows64 R;
@@ -197,63 +199,62 @@ LAT_INLINE void rk4_update(const lat_args *a, size_t p0, uint32_t n, double *con
         R.ax[c] = L->ax[c] + p0, R.av[c] = L->av[c] + p0;
     }
     rk4_update64(n, a->mode == MODE_RK4_LAST, a->first, a->h, a->weight, a->drag, a->g, a->mass + p0,
-                 a->inv_mass + p0, &R, F, t, acc);
+                 a->inv_mass + p0, &R, F, cs);
 }
 
 /* Row p0 complete (radial in, ring, radial out or NULL): its update. */
 LAT_INLINE void finish(const lat_args *a, size_t p0, uint32_t n, double *const *ri, double *const *rg,
-                       double *const *ro, double *const *t, double *const *Fw, double (*acc)[LANES])
+                       double *const *ro, double *const *Fw, const lat_cols *cs)
 {
     const spn__lattice *L = a->L;
     if (a->mode == MODE_RK4_STAGE || a->mode == MODE_RK4_LAST) {
         for (int c = 0; c < 3; c++)
             assemble64(n, a->g[c], a->drag, a->mass + p0, a->ev[c] + p0, ri[c], rg[c], ro ? ro[c] : NULL, Fw[c]);
-        rk4_update(a, p0, n, Fw, t, acc);
+        rk4_update(a, p0, n, Fw, cs);
         return;
     }
     double *X[3], *V[3];
     for (int c = 0; c < 3; c++) X[c] = L->x[c] + p0, V[c] = L->v[c] + p0;
     row_move64(n, a->mode == MODE_SYMPLECTIC, a->dt, a->g, a->drag, a->mass + p0, a->inv_mass + p0, X, V, ri, rg,
-               ro, t, acc);
+               ro, cs);
 }
 
 /* The hub: its radial forces in radial order, then its update. */
-static void hub(const lat_args *a, double *const *rad, double *const *t, double (*acc)[LANES])
+static void hub(const lat_args *a, double *const *rad, const lat_cols *cs)
 {
     const spn__lattice *L = a->L;
     if (a->mode != MODE_RK4_STAGE && a->mode != MODE_RK4_LAST) {
         hub_move64(L->radials, a->mode == MODE_SYMPLECTIC, a->dt, a->g, a->drag, a->mass[0], a->inv_mass[0], L->x,
-                   L->v, rad, acc);
+                   L->v, rad, cs);
         return;
     }
     const double v[3] = {a->ev[0][0], a->ev[1][0], a->ev[2][0]};
     double f[3];
     hub_force64(L->radials, a->mass[0], a->drag, a->g, v, rad, f);
     double *Fp[3] = {f, f + 1, f + 2};
-    rk4_update(a, 0, 1, Fp, t, acc);
+    rk4_update(a, 0, 1, Fp, cs);
 }
 
 /* The sweep (lattice_sweep_t.h) on the float64 state. */
 LAT_INLINE void radials64(const lat_args *a, double *const *Xa, double *const *Va, double *const *Xb,
-                          double *const *Vb, uint32_t j, double *const *f, double *e, double *p, double *acc_e,
-                          double *acc_p)
+                          double *const *Vb, uint32_t j, double *const *f, const lat_cols *cs)
 {
     const spn__lattice *L = a->L;
     const size_t s0 = (size_t)j * L->radials;
     springs_rows(L->radials, (const double *const *)Xa, (const double *const *)Va, (const double *const *)Xb,
-                 (const double *const *)Vb, 0, 0, L->rk + s0, L->rkd + s0, L->rrest + s0, f, 0, e, p, acc_e, acc_p);
+                 (const double *const *)Vb, 0, 0, L->rk + s0, L->rkd + s0, L->rrest + s0, f, 0, cs);
 }
 
 LAT_INLINE void rings64(const lat_args *a, double *const *X, double *const *V, uint32_t j, double *const *f,
-                        double *e, double *p, double *acc_e, double *acc_p)
+                        const lat_cols *cs)
 {
     const spn__lattice *L = a->L;
     const uint32_t n = L->radials;
     const size_t s0 = (size_t)j * n;
     const double *const *cX = (const double *const *)X, *const *cV = (const double *const *)V;
-    springs_rows(n - 1, cX, cV, cX, cV, 0, 1, L->gk + s0, L->gkd + s0, L->grest + s0, f, 0, e, p, acc_e, acc_p);
+    springs_rows(n - 1, cX, cV, cX, cV, 0, 1, L->gk + s0, L->gkd + s0, L->grest + s0, f, 0, cs);
     springs_rows(1, cX, cV, cX, cV, 0, n - 1, L->gk + s0 + n - 1, L->gkd + s0 + n - 1, L->grest + s0 + n - 1, f,
-                 n - 1, e, p, acc_e, acc_p);
+                 n - 1, cs);
 }
 
 LAT_INLINE void hub_state64(const lat_args *a, double *x, double *v)

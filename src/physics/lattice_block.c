@@ -40,6 +40,18 @@ bool spn__lattice_block_alloc(spn__lattice *L, int threads, size_t bytes)
     return true;
 }
 
+bool spn__lattice_cols_alloc(spn__lattice *L, int threads)
+{
+    if (L->ncols >= threads) return true;
+    double **cols = realloc(L->cols, (size_t)threads * sizeof *cols);
+    if (!cols) return false;
+    L->cols = cols;
+    L->col_stride = ((size_t)L->radials + 7) & ~(size_t)7;
+    for (; L->ncols < threads; L->ncols++)
+        if (!(L->cols[L->ncols] = calloc(COL_COUNT * L->col_stride, sizeof **L->cols))) return false;
+    return true;
+}
+
 void spn__lattice_block_sums(const spn__lattice *L, uint32_t K, double sums[][L_NSUMS])
 {
     const uint32_t nb = L->nbands;

@@ -46,14 +46,15 @@
 #error "define LK_T, LK(name) and LK_ARGS before including lattice_block_t.h"
 #endif
 
-/* Per level: the two latest rows' radial and ring forces, the lane sums of
- * two bands (the band whose springs and the band whose particles are being
- * summed differ at a band's first row) and of the current band's cut. */
+/* Per level: the two latest rows' radial and ring forces, the sum columns
+ * of two bands (the band whose springs and the band whose particles are
+ * being summed differ at a band's first row) and the sums of their cuts. */
 typedef struct LK(level) {
     LK_T *rad[2][3], *ring[2][3];
     LK_T **rad_prev;
     int cur;
-    double acc_e[2][LANES], acc_p[2][LANES], cut_e[2][LANES], cut_p[2][LANES], acc[2][L_NSUMS][LANES];
+    lat_cols band[2];
+    double cut_e[2], cut_p[2];
 } LK(level);
 
 typedef struct LK(block) {
@@ -64,13 +65,13 @@ typedef struct LK(block) {
     LK_T *X[3], *V[3];        /* the state */
     const LK_T *mass, *inv_mass;
     LK_T *ghost[2 * LAT_LEVELS][6];
-    LK_T *hub[6], *e, *p, *t[3], *F[3];
+    LK_T *hub[6], *F[3];
     /* RK4: the trial state of levels 1-3 by row mod 4 and the weighted sums
      * ax, av by row mod 8 (a row's live for at most 2 and 5 fronts), and
      * the hub's */
     LK_T *trial[LAT_LEVELS - 1][4][6], *sums[8][6];
     LK_T hub_trial[LAT_LEVELS - 1][6], hub_sums[6];
-    double dummy[L_NSUMS + 4][LANES];
+    lat_cols dummy, cut; /* the ghost rows' sums (never read), a cut's before it is summed */
     LK(level) lv[LAT_LEVELS];
 } LK(block);
 
@@ -117,17 +118,14 @@ static void LK(store_level)(LK(block) *B, double *partial, uint32_t s, uint32_t 
     const int q = (int)(b & 1);
     const spn__lattice *L = B->L;
     double *out = partial + ((size_t)(s - 1) * L->nbands + b) * L_NSUMS;
-    if (b) out[L_ELASTIC] = lane_total(lv->cut_e[q]), out[L_DAMP] = lane_total(lv->cut_p[q]);
-    store_band_sums(out, b == 0, lv->acc_e[q], lv->acc_p[q], lv->acc[q]);
-    memset(lv->acc_e[q], 0, sizeof lv->acc_e[q]), memset(lv->acc_p[q], 0, sizeof lv->acc_p[q]);
-    memset(lv->cut_e[q], 0, sizeof lv->cut_e[q]), memset(lv->cut_p[q], 0, sizeof lv->cut_p[q]);
-    memset(lv->acc[q], 0, sizeof lv->acc[q]);
+    if (b) out[L_ELASTIC] = lv->cut_e[q], out[L_DAMP] = lv->cut_p[q];
+    store_band_sums(out, b == 0, &lv->band[q], L->radials);
 }
 
-/* The hub at level s: its radial springs into ring 0 (forces into rad, sums
- * into ae, ap), then its update (sum terms into acc). */
+/* The hub at level s: its radial springs into ring 0 (forces into rad),
+ * then its update; sums into the columns cs. */
 LAT_INLINE void LK(block_hub)(LK(block) *B, uint32_t s, LK_T *const *X, LK_T *const *V, LK_T *const *rad,
-                              double *ae, double *ap, double (*acc)[LANES])
+                              const lat_cols *cs)
 {
     const LK_ARGS *a = &B->la[s - 1];
     const uint32_t n = B->L->radials;
@@ -138,10 +136,10 @@ LAT_INLINE void LK(block_hub)(LK(block) *B, uint32_t s, LK_T *const *X, LK_T *co
         hv[c] = base ? B->V[c][0] : B->hub_trial[s - 2][3 + c];
         for (uint32_t i = 0; i < n; i++) B->hub[c][i] = hx[c], B->hub[3 + c][i] = hv[c];
     }
-    LK(radials)(a, B->hub, B->hub + 3, X, V, 0, rad, B->e, B->p, ae, ap);
+    LK(radials)(a, B->hub, B->hub + 3, X, V, 0, rad, cs);
     if (!B->rk4) {
         LK(hub_move)(n, a->mode == MODE_SYMPLECTIC, a->dt, a->g, a->drag, B->mass[0], B->inv_mass[0], B->X, B->V,
-                     rad, acc);
+                     rad, cs);
         return;
     }
     LK_T f[3], *Fp[3] = {f, f + 1, f + 2};
@@ -154,13 +152,13 @@ LAT_INLINE void LK(block_hub)(LK(block) *B, uint32_t s, LK_T *const *X, LK_T *co
         R.ax[c] = &B->hub_sums[c], R.av[c] = &B->hub_sums[3 + c];
     }
     LK(rk4_update)(1, a->mode == MODE_RK4_LAST, a->first, a->h, a->weight, a->drag, a->g, B->mass, B->inv_mass, &R,
-                   Fp, B->t, acc);
+                   Fp, cs);
 }
 
 /* Row r (particles from p0) moved to level s, its forces complete (radial
- * in ri, ring rg, radial out ro or NULL); sum terms into acc. */
+ * in ri, ring rg, radial out ro or NULL); sum terms into the columns cs. */
 LAT_INLINE void LK(block_move)(LK(block) *B, uint32_t s, uint32_t r, LK_T *const *ri, LK_T *const *rg,
-                               LK_T *const *ro, double (*acc)[LANES])
+                               LK_T *const *ro, const lat_cols *cs)
 {
     const LK_ARGS *a = &B->la[s - 1];
     const uint32_t n = B->L->radials;
@@ -169,7 +167,7 @@ LAT_INLINE void LK(block_move)(LK(block) *B, uint32_t s, uint32_t r, LK_T *const
     LK(row_ptrs)(B, r, X, V);
     if (!B->rk4) {
         LK(row_move)(n, a->mode == MODE_SYMPLECTIC, a->dt, a->g, a->drag, B->mass + p0, B->inv_mass + p0, X, V, ri,
-                     rg, ro, B->t, acc);
+                     rg, ro, cs);
         return;
     }
     LK_T *EX[3], *EV[3];
@@ -183,7 +181,7 @@ LAT_INLINE void LK(block_move)(LK(block) *B, uint32_t s, uint32_t r, LK_T *const
         R.ax[c] = B->sums[r % 8][c], R.av[c] = B->sums[r % 8][3 + c];
     }
     LK(rk4_update)(n, a->mode == MODE_RK4_LAST, a->first, a->h, a->weight, a->drag, a->g, B->mass + p0,
-                   B->inv_mass + p0, &R, B->F, B->t, acc);
+                   B->inv_mass + p0, &R, B->F, cs);
 }
 
 /* op(s, j): see the file comment. (Inlined into run_block, so that each
@@ -201,25 +199,25 @@ LAT_INLINE void LK(op)(LK(block) *B, double *partial, uint32_t s, uint32_t j)
         const bool mine = LK(own)(B, j) && j < hi;
         const int q = (int)((j / L->band_rows) & 1);
         const bool cut = j > 0 && j % L->band_rows == 0;
-        double *ae = mine ? (cut ? lv->cut_e[q] : lv->acc_e[q]) : B->dummy[0];
-        double *ap = mine ? (cut ? lv->cut_p[q] : lv->acc_p[q]) : B->dummy[1];
+        const lat_cols *own = mine ? &lv->band[q] : &B->dummy;
         if (j == 0) {
-            LK(block_hub)(B, s, X, V, lv->rad[cur], ae, ap, lv->acc[q]);
+            LK(block_hub)(B, s, X, V, lv->rad[cur], own);
         } else {
             LK_T *Xp[3], *Vp[3];
             LK(eval_ptrs)(B, s, j - 1, Xp, Vp);
-            LK(radials)(a, Xp, Vp, X, V, j, lv->rad[cur], B->e, B->p, ae, ap);
+            LK(radials)(a, Xp, Vp, X, V, j, lv->rad[cur], mine && cut ? &B->cut : own);
+            if (mine && cut) {
+                lv->cut_e[q] = col_take(B->cut.c[L_ELASTIC], L->radials);
+                lv->cut_p[q] = col_take(B->cut.c[L_DAMP], L->radials);
+            }
         }
-        if (j < hi) {
-            double *re = mine ? lv->acc_e[q] : B->dummy[0], *rp = mine ? lv->acc_p[q] : B->dummy[1];
-            LK(rings)(a, X, V, j, lv->ring[cur], B->e, B->p, re, rp);
-        }
+        if (j < hi) LK(rings)(a, X, V, j, lv->ring[cur], own);
     }
     if (j > LK(low)(B, s)) {
         const uint32_t r = j - 1, b = r / L->band_rows;
         const bool mine = LK(own)(B, r);
         LK(block_move)(B, s, r, lv->rad_prev, lv->ring[cur ^ 1], j < rings ? lv->rad[cur] : NULL,
-                       mine ? lv->acc[b & 1] : B->dummy + 2);
+                       mine ? &lv->band[b & 1] : &B->dummy);
         const uint32_t band_end = (b + 1) * L->band_rows < rings ? (b + 1) * L->band_rows : rings;
         if (mine && r + 1 == band_end) LK(store_level)(B, partial, s, b);
     }
@@ -231,11 +229,11 @@ LAT_INLINE void LK(op)(LK(block) *B, double *partial, uint32_t s, uint32_t j)
 static size_t LK(block_numbers)(size_t stride)
 {
     const size_t levels = 12 * LAT_LEVELS, ghosts = 12 * LAT_LEVELS, rk4 = 6 * 4 * (LAT_LEVELS - 1) + 6 * 8;
-    return (levels + ghosts + rk4 + 14) * stride;
+    return (levels + ghosts + rk4 + 9) * stride;
 }
 
-static void LK(block_init)(LK(block) *B, const LK_ARGS *la, bool rk4, LK_T *ws, uint32_t R0, uint32_t R1,
-                           uint32_t K)
+static void LK(block_init)(LK(block) *B, const LK_ARGS *la, bool rk4, LK_T *ws, double *cols, uint32_t R0,
+                           uint32_t R1, uint32_t K)
 {
     const size_t st = LK(stride)(la);
     memset(B, 0, sizeof *B);
@@ -254,8 +252,11 @@ static void LK(block_init)(LK(block) *B, const LK_ARGS *la, bool rk4, LK_T *ws, 
     for (int r = 0; r < 8; r++)
         for (int c = 0; c < 6; c++) B->sums[r][c] = q, q += st;
     for (int c = 0; c < 6; c++) B->hub[c] = q, q += st;
-    B->e = q, q += st, B->p = q, q += st;
-    for (int c = 0; c < 3; c++) B->t[c] = q, q += st, B->F[c] = q, q += st;
+    for (int c = 0; c < 3; c++) B->F[c] = q, q += st;
+    const size_t cst = B->L->col_stride;
+    B->dummy = col_set(cols, cst, COL_SETS - 1), B->cut = col_set(cols, cst, -1);
+    for (uint32_t s = 0; s < LAT_LEVELS; s++)
+        for (int r = 0; r < 2; r++) B->lv[s].band[r] = col_set(cols, cst, 2 * (int)s + r);
 }
 
 /* Level 0 of the ghost rows, from the state before anyone moves it. */
@@ -292,7 +293,9 @@ SPN__KERNEL static void LK(run_block)(LK(block) *B, double *partial)
 static bool LK(block_pass)(spn__lattice *L, const LK_ARGS *la, bool rk4, int threads, uint32_t K,
                            double sums[][L_NSUMS])
 {
-    if (!spn__lattice_block_alloc(L, threads, LK(block_numbers)(LK(stride)(la)) * sizeof(LK_T))) return false;
+    if (!spn__lattice_block_alloc(L, threads, LK(block_numbers)(LK(stride)(la)) * sizeof(LK_T)) ||
+        !spn__lattice_cols_alloc(L, threads))
+        return false;
     const uint32_t nb = L->nbands;
 #pragma omp parallel num_threads(threads)
     {
@@ -301,7 +304,7 @@ static bool LK(block_pass)(spn__lattice *L, const LK_ARGS *la, bool rk4, int thr
         const uint32_t b1 = (uint32_t)((uint64_t)nb * (uint32_t)(t + 1) / (uint32_t)threads);
         const uint32_t R0 = b0 * L->band_rows, R1 = b1 * L->band_rows < L->rings ? b1 * L->band_rows : L->rings;
         LK(block) B;
-        LK(block_init)(&B, la, rk4, (LK_T *)L->bws[t], R0, R1, K);
+        LK(block_init)(&B, la, rk4, (LK_T *)L->bws[t], L->cols[t], R0, R1, K);
         LK(copy_ghosts)(&B);
 #pragma omp barrier
         LK(run_block)(&B, L->partial_k);

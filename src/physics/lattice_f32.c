@@ -94,8 +94,8 @@ LAT_INLINE void eval_rows(const a32 *a, size_t p0, float **D, float **U)
 }
 
 /* Particles p0 .. p0+n-1 of an RK4 stage, their force F (3 arrays) known. */
-LAT_INLINE void rk4_update(const a32 *a, size_t p0, uint32_t n, float *const *F, float *const *t,
-                           double (*acc)[LANES])
+LAT_INLINE void rk4_update(const a32 *a, size_t p0, uint32_t n, float *const *F,
+                           const lat_cols *cs)
 {
     const spn__lat32 *S = a->F;
     rk4_rows32 R;
@@ -105,62 +105,61 @@ LAT_INLINE void rk4_update(const a32 *a, size_t p0, uint32_t n, float *const *F,
         R.ax[c] = S->ax[c] + p0, R.av[c] = S->av[c] + p0;
     }
     rk4_update32(n, a->mode == MODE_RK4_LAST, a->first, a->h, a->weight, a->drag, a->g, S->mass + p0,
-                 S->inv_mass + p0, &R, F, t, acc);
+                 S->inv_mass + p0, &R, F, cs);
 }
 
 LAT_INLINE void finish32(const a32 *a, size_t p0, uint32_t n, float *const *ri, float *const *rg,
-                         float *const *ro, float *const *t, float *const *Fw, double (*acc)[LANES])
+                         float *const *ro, float *const *Fw, const lat_cols *cs)
 {
     const spn__lat32 *F = a->F;
     if (a->mode == MODE_RK4_STAGE || a->mode == MODE_RK4_LAST) {
         for (int c = 0; c < 3; c++)
             assemble32(n, a->g[c], a->drag, F->mass + p0, a->eu[c] + p0, ri[c], rg[c], ro ? ro[c] : NULL, Fw[c]);
-        rk4_update(a, p0, n, Fw, t, acc);
+        rk4_update(a, p0, n, Fw, cs);
         return;
     }
     float *D[3], *U[3];
     for (int c = 0; c < 3; c++) D[c] = F->d[c] + p0, U[c] = F->u[c] + p0;
     row_move32(n, a->mode == MODE_SYMPLECTIC, a->dt, a->g, a->drag, F->mass + p0, F->inv_mass + p0, D, U, ri, rg,
-               ro, t, acc);
+               ro, cs);
 }
 
 /* The hub: its radial forces in radial order, then its update. */
-static void hub32(const a32 *a, float *const *rad, float *const *t, double (*acc)[LANES])
+static void hub32(const a32 *a, float *const *rad, const lat_cols *cs)
 {
     spn__lat32 *F = a->F;
     const uint32_t n = a->L->radials;
     if (a->mode != MODE_RK4_STAGE && a->mode != MODE_RK4_LAST) {
         hub_move32(n, a->mode == MODE_SYMPLECTIC, a->dt, a->g, a->drag, F->mass[0], F->inv_mass[0], F->d, F->u, rad,
-                   acc);
+                   cs);
         return;
     }
     const float v[3] = {a->eu[0][0], a->eu[1][0], a->eu[2][0]};
     float f[3], *Fp[3] = {f, f + 1, f + 2};
     hub_force32(n, F->mass[0], a->drag, a->g, v, rad, f);
-    rk4_update(a, 0, 1, Fp, t, acc);
+    rk4_update(a, 0, 1, Fp, cs);
 }
 
 /* The sweep (lattice_sweep_t.h) on the float32 state: a spring's
  * difference is its slot's reference difference plus the displacements'. */
 LAT_INLINE void radials32(const a32 *a, float *const *Da, float *const *Ua, float *const *Db, float *const *Ub,
-                          uint32_t j, float *const *f, float *e, float *p, double *acc_e, double *acc_p)
+                          uint32_t j, float *const *f, const lat_cols *cs)
 {
     const spn__lat32 *F = a->F;
     spring_rows(a->L->radials, Da, Ua, Db, Ub, (float *const *)F->rl, (size_t)j * a->L->radials, F->rk, F->rkd,
-                F->rr, f, 0, e, p, acc_e, acc_p);
+                F->rr, f, 0, cs);
 }
 
-LAT_INLINE void rings32(const a32 *a, float *const *D, float *const *U, uint32_t j, float *const *f, float *e,
-                        float *p, double *acc_e, double *acc_p)
+LAT_INLINE void rings32(const a32 *a, float *const *D, float *const *U, uint32_t j, float *const *f,
+                        const lat_cols *cs)
 {
     const spn__lat32 *F = a->F;
     const uint32_t n = a->L->radials;
     const size_t s0 = (size_t)j * n;
     float *D1[3], *U1[3], *Dl[3], *Ul[3]; /* the row from its second and its last particle */
     for (int c = 0; c < 3; c++) D1[c] = D[c] + 1, U1[c] = U[c] + 1, Dl[c] = D[c] + n - 1, Ul[c] = U[c] + n - 1;
-    spring_rows(n - 1, D, U, D1, U1, (float *const *)F->gl, s0, F->gk, F->gkd, F->gr, f, 0, e, p, acc_e, acc_p);
-    spring_rows(1, D, U, Dl, Ul, (float *const *)F->gl, s0 + n - 1, F->gk, F->gkd, F->gr, f, n - 1, e, p, acc_e,
-                acc_p);
+    spring_rows(n - 1, D, U, D1, U1, (float *const *)F->gl, s0, F->gk, F->gkd, F->gr, f, 0, cs);
+    spring_rows(1, D, U, Dl, Ul, (float *const *)F->gl, s0 + n - 1, F->gk, F->gkd, F->gr, f, n - 1, cs);
 }
 
 LAT_INLINE void hub_state32(const a32 *a, float *x, float *v)
@@ -298,7 +297,7 @@ static bool prepare32(spn__lattice *L, int threads)
         for (; F->nws < threads; F->nws++)
             if (!(F->ws[F->nws] = malloc(WS_COUNT * F->stride * sizeof **F->ws))) return false;
     }
-    return true;
+    return spn__lattice_cols_alloc(L, threads);
 }
 
 /* The float32 state ready for a step (loaded unless a call already holds

@@ -22,17 +22,31 @@ enum { L_ELASTIC, L_DAMP, L_MV2, L_GAIN, L_MVN2, L_NSUMS };
 #define LAT_LEVELS SPN__LAT_BLOCK_MAX
 #define LAT_INLINE static inline __attribute__((always_inline))
 
-/* Arrays of one thread's workspace, `stride` doubles each. */
+/* Arrays of one thread's workspace, `stride` numbers each. */
 enum {
     WS_RAD = 0,   /* 2 rows x 3: radial force on the inner end */
     WS_RING = 6,  /* 2 rows x 3: ring force on the lower end */
     WS_HUB = 12,  /* 6: the hub's x and v, replicated along a row */
-    WS_E = 18,    /* per-spring elastic energy (scratch) */
-    WS_P = 19,    /* per-spring damping power (scratch) */
-    WS_T = 20,    /* 3: per-particle sum terms (scratch) */
-    WS_F = 23,    /* 3: RK4: the assembled force on the row being moved */
-    WS_COUNT = 26
+    WS_F = 18,    /* 3: RK4: the assembled force on the row being moved */
+    WS_COUNT = 21
 };
+
+/* Sum columns. A band's energy sums are kept per radial i: the terms of its
+ * rows add into column i (c[i] += term) in the loop that makes them, and
+ * the columns are reduced once, at the band's end (col_take). (Until
+ * 2026-11-22 each loop stored its terms and a second loop added them into
+ * eight lanes: a chain of dependent additions after every loop, about a
+ * ninth of the 5k web's step.) One set per quantity of L_NSUMS (NULL where
+ * a kernel does not sum it). */
+typedef struct lat_cols {
+    double *c[L_NSUMS];
+} lat_cols;
+/* Per thread: COL_SETS sets, then the cut's two columns. A sweep uses set
+ * 0; a blocked pass two per level (sets 2 s and 2 s + 1) and the last for
+ * the ghost rows' sums, which are never read (that set alone is not kept
+ * zero). */
+#define COL_SETS (2 * SPN__LAT_BLOCK_MAX + 1)
+#define COL_COUNT (COL_SETS * L_NSUMS + 2)
 
 /* The float32 step's state and arrays (lattice_f32.c). */
 typedef struct spn__lat32 spn__lat32;
@@ -72,6 +86,9 @@ struct spn__lattice {
     double *partial_k; /* per level and band: L_NSUMS */
     uint32_t npartial_k;
     spn__lat32 *f32; /* the float32 step (on first use) */
+    double **cols;   /* per thread: COL_COUNT sum columns of col_stride doubles, zero between uses */
+    int ncols;
+    size_t col_stride;
 };
 
 /* What a sweep does with a row once its forces are complete. */
@@ -98,19 +115,44 @@ LAT_INLINE double lane_total(const double *acc)
     return ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
 }
 
-/* A band's sums into out (its L_NSUMS partials): the spring energy terms
- * add up over the band's sweeps from the first band's reset, the particle
- * terms are the last sweep's. */
-LAT_INLINE void store_band_sums(double *out, bool first, const double *acc_e, const double *acc_p,
-                                double acc[L_NSUMS][LANES])
+/* Column set `set` of a thread's columns, or (set < 0) the cut's two. */
+LAT_INLINE lat_cols col_set(double *cols, size_t stride, int set)
+{
+    lat_cols cs = {{NULL}};
+    if (set < 0) {
+        cs.c[L_ELASTIC] = cols + (size_t)COL_SETS * L_NSUMS * stride;
+        cs.c[L_DAMP] = cs.c[L_ELASTIC] + stride;
+        return cs;
+    }
+    for (int k = 0; k < L_NSUMS; k++) cs.c[k] = cols + ((size_t)set * L_NSUMS + k) * stride;
+    return cs;
+}
+
+/* The sum of column c[0 .. n) (in eight lanes, i mod 8, then lane_total),
+ * the column zeroed for its next use. */
+LAT_INLINE double col_take(double *restrict c, uint32_t n)
+{
+    double acc[LANES] = {0};
+    uint32_t i = 0;
+    for (; i + LANES <= n; i += LANES)
+        for (int l = 0; l < LANES; l++) acc[l] += c[i + l];
+    for (; i < n; i++) acc[i % LANES] += c[i];
+    memset(c, 0, n * sizeof *c);
+    return lane_total(acc);
+}
+
+/* A band's sums into out (its L_NSUMS partials), from its columns (n
+ * wide): the spring energy terms add to what the band's cut put there (the
+ * first band has none), the particle terms are the band's own. */
+LAT_INLINE void store_band_sums(double *out, bool first, const lat_cols *cs, uint32_t n)
 {
     if (first) out[L_ELASTIC] = out[L_DAMP] = 0;
-    out[L_ELASTIC] += lane_total(acc_e), out[L_DAMP] += lane_total(acc_p);
-    out[L_MV2] = lane_total(acc[L_MV2]), out[L_GAIN] = lane_total(acc[L_GAIN]), out[L_MVN2] = lane_total(acc[L_MVN2]);
+    out[L_ELASTIC] += col_take(cs->c[L_ELASTIC], n), out[L_DAMP] += col_take(cs->c[L_DAMP], n);
+    for (int k = L_MV2; k <= L_MVN2; k++) out[k] = col_take(cs->c[k], n);
 }
 
 /* Springs j = 0..n-1 from (a[j]) to (b[j]), SoA: force on end a into f, the
- * elastic energy and damping power into e, p. The arithmetic of chunk_forces
+ * elastic energy and damping power added into the sum columns ce, cp. The arithmetic of chunk_forces
  * (same bits): a spring is off (no force) at zero length or when slack and
  * tension-only, and then 1/len is replaced by 0 and k by 0, which is what
  * chunk_forces' 0/1 factors give, with selects instead of products. */
@@ -120,7 +162,7 @@ LAT_INLINE void springs(uint32_t n, const double *restrict axp, const double *re
                         const double *restrict avz, const double *restrict bvx, const double *restrict bvy,
                         const double *restrict bvz, const double *restrict kk, const double *restrict kkd,
                         const double *restrict rr, double *restrict fx, double *restrict fy, double *restrict fz,
-                        double *restrict e, double *restrict p)
+                        double *restrict ce, double *restrict cp)
 {
     for (uint32_t j = 0; j < n; j++) {
         const double lx = axp[j] - bxp[j], ly = ayp[j] - byp[j], lz = azp[j] - bzp[j];
@@ -135,26 +177,23 @@ LAT_INLINE void springs(uint32_t n, const double *restrict axp, const double *re
         const double k = on ? kk[j] : 0, kd = kkd[j];
         const double mag = k * stretch + kd * rate;
         const double s = -mag * inv;
-        e[j] = 0.5 * k * stretch * stretch;
-        p[j] = kd * rate * rate;
+        ce[j] += 0.5 * k * stretch * stretch;
+        cp[j] += kd * rate * rate;
         fx[j] = s * lx, fy[j] = s * ly, fz[j] = s * lz;
     }
 }
 
 /* Springs from rows a to b of a state (3 arrays each, offsets off_a,
- * off_b) with parameters k, kd, rest, forces into f; sums into acc. */
+ * off_b) with parameters k, kd, rest, forces into f and sums into the
+ * columns cs, both at off_f. */
 LAT_INLINE void springs_rows(uint32_t n, const double *const *ax, const double *const *av, const double *const *bx,
                              const double *const *bv, size_t off_a, size_t off_b, const double *k, const double *kd,
-                             const double *rest, double *const *f, size_t off_f, double *e, double *p,
-                             double *acc_e, double *acc_p)
+                             const double *rest, double *const *f, size_t off_f, const lat_cols *cs)
 {
     springs(n, ax[0] + off_a, ax[1] + off_a, ax[2] + off_a, bx[0] + off_b, bx[1] + off_b, bx[2] + off_b,
             av[0] + off_a, av[1] + off_a, av[2] + off_a, bv[0] + off_b, bv[1] + off_b, bv[2] + off_b, k, kd, rest,
-            f[0] + off_f, f[1] + off_f, f[2] + off_f, e, p);
-    lane_add64(acc_e, e, n);
-    lane_add64(acc_p, p, n);
+            f[0] + off_f, f[1] + off_f, f[2] + off_f, cs->c[L_ELASTIC] + off_f, cs->c[L_DAMP] + off_f);
 }
-
 
 /* An Euler or symplectic step's results from its sweep's sums. */
 static inline void lat_explicit_result(const double *sum, double dt, double drag, spn__step_result *r)
@@ -190,6 +229,9 @@ bool spn__lattice_block_ready(const spn__lattice *L, int threads, uint32_t K);
 /* Per-thread workspaces of `bytes` each and the per-level band partials;
  * false when out of memory. */
 bool spn__lattice_block_alloc(spn__lattice *L, int threads, size_t bytes);
+/* Each of `threads` threads' sum columns (zeroed), for rows of L->radials;
+ * false when out of memory. */
+bool spn__lattice_cols_alloc(spn__lattice *L, int threads);
 /* Each level's sums from its band partials, in band order. */
 void spn__lattice_block_sums(const spn__lattice *L, uint32_t K, double sums[][L_NSUMS]);
 /* Up to k float32 Euler or symplectic steps (mode), or one RK4 step, as one

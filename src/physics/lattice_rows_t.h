@@ -7,22 +7,14 @@
  * of both precisions call these. Every kernel updates a row of the state in
  * place (structure of arrays, positions x or float32 displacements d,
  * velocities v) once the row's forces are complete. Fixed particles are selected out, not skipped, so the
- * loops vectorise; the per-particle terms of the energy sums go to t_mv2,
- * t_gain, t_mvn2 and from there, in a fixed order, to lane accumulators.
+ * loops vectorise; the per-particle terms of the energy sums add into the
+ * sum columns (lattice_rows.h) t_mv2, t_gain, t_mvn2, in double.
  * Each expression is the general path's (chunk.h, explicit.c), so the
  * float64 lattice gives its bits. Plain loops for GCC 12 to vectorise; where
  * it would not, the comment says what was changed. */
 #if !defined(LK_T) || !defined(LK)
 #error "define LK_T and LK(name) before including lattice_rows_t.h"
 #endif
-
-LAT_INLINE void LK(lane_add)(double *restrict acc, const LK_T *restrict e, uint32_t n)
-{
-    uint32_t i = 0;
-    for (; i + LANES <= n; i += LANES)
-        for (int l = 0; l < LANES; l++) acc[l] += (double)e[i + l];
-    for (; i < n; i++) acc[i % LANES] += (double)e[i];
-}
 
 typedef struct LK(moved) {
     LK_T x[3], v[3], mv2, gain, mvn2;
@@ -57,8 +49,8 @@ LAT_INLINE void LK(row)(uint32_t n, bool sym, LK_T dt, const LK_T *g, LK_T drag,
                         LK_T *restrict vx, LK_T *restrict vy, LK_T *restrict vz, const LK_T *restrict ix,
                         const LK_T *restrict iy, const LK_T *restrict iz, const LK_T *restrict rx,
                         const LK_T *restrict ry, const LK_T *restrict rz, const LK_T *restrict ox,
-                        const LK_T *restrict oy, const LK_T *restrict oz, LK_T *restrict t_mv2,
-                        LK_T *restrict t_gain, LK_T *restrict t_mvn2)
+                        const LK_T *restrict oy, const LK_T *restrict oz, double *restrict t_mv2,
+                        double *restrict t_gain, double *restrict t_mvn2)
 {
     const uint32_t l = n - 1;
     LK_T e0[3], el[3];
@@ -73,7 +65,7 @@ LAT_INLINE void LK(row)(uint32_t n, bool sym, LK_T dt, const LK_T *g, LK_T drag,
     do {                                                                                                        \
         xx[i] = (o).x[0], xy[i] = (o).x[1], xz[i] = (o).x[2];                                                   \
         vx[i] = (o).v[0], vy[i] = (o).v[1], vz[i] = (o).v[2];                                                   \
-        t_mv2[i] = (o).mv2, t_gain[i] = (o).gain, t_mvn2[i] = (o).mvn2;                                         \
+        t_mv2[i] += (o).mv2, t_gain[i] += (o).gain, t_mvn2[i] += (o).mvn2;                                         \
     } while (0)
     if (ox)
         for (uint32_t i = 1; i < l; i++) {
@@ -131,10 +123,10 @@ LAT_INLINE void LK(assemble)(uint32_t n, LK_T gc, LK_T drag, const LK_T *restric
  * gain and new-energy terms are zero, so they are not summed at all). */
 LAT_INLINE void LK(rk4_kin)(uint32_t n, const LK_T *restrict mass, const LK_T *restrict inv_mass,
                             const LK_T *restrict Vx, const LK_T *restrict Vy, const LK_T *restrict Vz,
-                            LK_T *restrict t_mv2)
+                            double *restrict t_mv2)
 {
     for (uint32_t i = 0; i < n; i++)
-        t_mv2[i] = (inv_mass[i] != 0 ? mass[i] : (LK_T)0) * (Vx[i] * Vx[i] + Vy[i] * Vy[i] + Vz[i] * Vz[i]);
+        t_mv2[i] += (inv_mass[i] != 0 ? mass[i] : (LK_T)0) * (Vx[i] * Vx[i] + Vy[i] * Vy[i] + Vz[i] * Vz[i]);
 }
 
 /* One component of a stage but the last: the weighted sums ax, av and the
@@ -167,8 +159,8 @@ LAT_INLINE void LK(rk4_sums)(uint32_t n, LK_T h6, const LK_T *g, const LK_T *res
                              const LK_T *restrict Fz, const LK_T *restrict axx, const LK_T *restrict axy,
                              const LK_T *restrict axz, const LK_T *restrict avx, const LK_T *restrict avy,
                              const LK_T *restrict avz, const LK_T *restrict ux, const LK_T *restrict uy,
-                             const LK_T *restrict uz, LK_T *restrict t_mv2, LK_T *restrict t_gain,
-                             LK_T *restrict t_mvn2)
+                             const LK_T *restrict uz, double *restrict t_mv2, double *restrict t_gain,
+                             double *restrict t_mvn2)
 {
     for (uint32_t i = 0; i < n; i++) {
         const LK_T im = inv_mass[i], s = h6 * im;
@@ -176,9 +168,9 @@ LAT_INLINE void LK(rk4_sums)(uint32_t n, LK_T h6, const LK_T *g, const LK_T *res
         const LK_T vx = Vx[i], vy = Vy[i], vz = Vz[i], wx = ux[i], wy = uy[i], wz = uz[i];
         const LK_T ex = (axx[i] + vx) * h6, ey = (axy[i] + vy) * h6, ez = (axz[i] + vz) * h6;
         const LK_T nx = wx + (avx[i] + Fx[i]) * s, ny = wy + (avy[i] + Fy[i]) * s, nz = wz + (avz[i] + Fz[i]) * s;
-        t_mv2[i] = mf * (vx * vx + vy * vy + vz * vz);
-        t_mvn2[i] = mf * (nx * nx + ny * ny + nz * nz);
-        t_gain[i] = mf * ((LK_T)0.5 * ((nx - wx) * (nx + wx) + (ny - wy) * (ny + wy) + (nz - wz) * (nz + wz)) -
+        t_mv2[i] += mf * (vx * vx + vy * vy + vz * vz);
+        t_mvn2[i] += mf * (nx * nx + ny * ny + nz * nz);
+        t_gain[i] += mf * ((LK_T)0.5 * ((nx - wx) * (nx + wx) + (ny - wy) * (ny + wy) + (nz - wz) * (nz + wz)) -
                           (g[0] * ex + g[1] * ey + g[2] * ez));
     }
 }
@@ -214,36 +206,35 @@ LAT_INLINE void LK(hub_force)(uint32_t n, LK_T m, LK_T drag, const LK_T *g, cons
 }
 
 /* The explicit hub (particle 0 of the state X, V; mass m, inverse im): its
- * force from its n radials, then moved in place; its sum terms into acc. */
+ * force from its n radials, then moved in place; its sum terms into column
+ * 0 of cs. */
 LAT_INLINE void LK(hub_move)(uint32_t n, bool sym, LK_T dt, const LK_T *g, LK_T drag, LK_T m, LK_T im,
-                             LK_T *const *X, LK_T *const *V, LK_T *const *rad, double (*acc)[LANES])
+                             LK_T *const *X, LK_T *const *V, LK_T *const *rad, const lat_cols *cs)
 {
     const LK_T v[3] = {V[0][0], V[1][0], V[2][0]};
     LK_T f[3];
     LK(hub_force)(n, m, drag, g, v, rad, f);
     const LK(moved) o = LK(one)(f[0], f[1], f[2], im, m, X[0][0], X[1][0], X[2][0], v[0], v[1], v[2], sym, dt, g);
     for (int c = 0; c < 3; c++) X[c][0] = o.x[c], V[c][0] = o.v[c];
-    acc[L_MV2][0] += o.mv2, acc[L_GAIN][0] += o.gain, acc[L_MVN2][0] += o.mvn2;
+    cs->c[L_MV2][0] += o.mv2, cs->c[L_GAIN][0] += o.gain, cs->c[L_MVN2][0] += o.mvn2;
 }
 
 /* An explicit row (n particles, state rows X, V, masses from mass and
  * inv_mass) with its forces complete (radial in, ring, radial out or NULL),
- * moved in place; its sum terms through t into acc. */
+ * moved in place; its sum terms into the columns cs. */
 LAT_INLINE void LK(row_move)(uint32_t n, bool sym, LK_T dt, const LK_T *g, LK_T drag, const LK_T *mass,
                              const LK_T *inv_mass, LK_T *const *X, LK_T *const *V, LK_T *const *ri,
-                             LK_T *const *rg, LK_T *const *ro, LK_T *const *t, double (*acc)[LANES])
+                             LK_T *const *rg, LK_T *const *ro, const lat_cols *cs)
 {
     /* (sym a constant in each call: GCC 12 does not vectorise a select on a
      * run-time bool) */
 #define LK_ROW(sym)                                                                                             \
     LK(row)(n, sym, dt, g, drag, mass, inv_mass, X[0], X[1], X[2], V[0], V[1], V[2], ri[0], ri[1], ri[2], rg[0], \
-            rg[1], rg[2], ro ? ro[0] : NULL, ro ? ro[1] : NULL, ro ? ro[2] : NULL, t[0], t[1], t[2])
+            rg[1], rg[2], ro ? ro[0] : NULL, ro ? ro[1] : NULL, ro ? ro[2] : NULL, cs->c[L_MV2], cs->c[L_GAIN],  \
+            cs->c[L_MVN2])
     if (sym) LK_ROW(true);
     else LK_ROW(false);
 #undef LK_ROW
-    LK(lane_add)(acc[L_MV2], t[0], n);
-    LK(lane_add)(acc[L_GAIN], t[1], n);
-    LK(lane_add)(acc[L_MVN2], t[2], n);
 }
 
 /* The rows an RK4 stage reads and writes (3 arrays each, at the row): the
@@ -256,19 +247,16 @@ typedef struct LK(rk4_rows) {
 
 /* n particles of an RK4 stage (the last one when `last`; weighted `wgt`,
  * step fraction h, or h = dt / 6 at the last), their force F known and
- * masses from mass and inv_mass; sum terms through t into acc. */
+ * masses from mass and inv_mass; sum terms into the columns cs. */
 LAT_INLINE void LK(rk4_update)(uint32_t n, bool last, bool first, LK_T h, LK_T wgt, LK_T drag, const LK_T *g,
                                const LK_T *mass, const LK_T *inv_mass, const LK(rk4_rows) *R, LK_T *const *F,
-                               LK_T *const *t, double (*acc)[LANES])
+                               const lat_cols *cs)
 {
     if (!last) {
         /* m v^2 at a stage's state serves the drag's loss (and, at the first
          * stage, the energy before the step); without drag the later stages
          * skip it, as drag * m v^2 would add exactly zero */
-        if (first || drag != 0) {
-            LK(rk4_kin)(n, mass, inv_mass, R->V[0], R->V[1], R->V[2], t[0]);
-            LK(lane_add)(acc[L_MV2], t[0], n);
-        }
+        if (first || drag != 0) LK(rk4_kin)(n, mass, inv_mass, R->V[0], R->V[1], R->V[2], cs->c[L_MV2]);
         /* (three calls, not a loop: GCC 12 does not vectorise an inlined
          * function with restrict parameters inside a loop) */
         LK(rk4_stage)(n, first, h, wgt, inv_mass, R->V[0], F[0], R->xb[0], R->vb[0], R->xt[0], R->vt[0], R->ax[0],
@@ -280,11 +268,9 @@ LAT_INLINE void LK(rk4_update)(uint32_t n, bool last, bool first, LK_T h, LK_T w
         return;
     }
     LK(rk4_sums)(n, h, g, mass, inv_mass, R->V[0], R->V[1], R->V[2], F[0], F[1], F[2], R->ax[0], R->ax[1],
-                 R->ax[2], R->av[0], R->av[1], R->av[2], R->vb[0], R->vb[1], R->vb[2], t[0], t[1], t[2]);
+                 R->ax[2], R->av[0], R->av[1], R->av[2], R->vb[0], R->vb[1], R->vb[2], cs->c[L_MV2], cs->c[L_GAIN],
+                 cs->c[L_MVN2]);
     LK(rk4_last)(n, h, inv_mass, R->V[0], F[0], R->ax[0], R->av[0], R->xb[0], R->vb[0]);
     LK(rk4_last)(n, h, inv_mass, R->V[1], F[1], R->ax[1], R->av[1], R->xb[1], R->vb[1]);
     LK(rk4_last)(n, h, inv_mass, R->V[2], F[2], R->ax[2], R->av[2], R->xb[2], R->vb[2]);
-    LK(lane_add)(acc[L_MV2], t[0], n);
-    LK(lane_add)(acc[L_GAIN], t[1], n);
-    LK(lane_add)(acc[L_MVN2], t[2], n);
 }

@@ -5,59 +5,58 @@
  * The including file defines LK(name), LK_ARGS (its step arguments, with a
  * member L, the spn__lattice) and, for its precision:
  *   LK(eval)(a, p0, X, V)        row p0 of the evaluated state (3 + 3 arrays)
- *   LK(radials)(a, Xa, Va, Xb, Vb, j, f, e, p, acc_e, acc_p)
+ *   LK(radials)(a, Xa, Va, Xb, Vb, j, f, cs)
  *                                the radial springs from row a into row j
- *                                (b), forces on the inner end into f
- *   LK(rings)(a, X, V, j, f, e, p, acc_e, acc_p)
- *                                row j's ring springs, wrap included
+ *                                (b), forces on the inner end into f, sums
+ *                                into the columns cs (lattice_rows.h)
+ *   LK(rings)(a, X, V, j, f, cs) row j's ring springs, wrap included
  *   LK(hub_state)(a, x, v)       the hub's evaluated state (3 each)
- *   LK(hub)(a, rad, t, acc)      the hub's force from its radials, and its update
- *   LK(finish)(a, p0, n, ri, rg, ro, t, F, acc)
+ *   LK(hub)(a, rad, cs)          the hub's force from its radials, and its update
+ *   LK(finish)(a, p0, n, ri, rg, ro, F, cs)
  *                                a row whose forces are complete, moved
  *   LK(cut)(a)                   the radial forces into each band's first row
  *   LK(ws)(a, thread), LK(stride)(a)
  *                                the per-thread workspaces (WS_* arrays)
- * Sums go to the band partials in L->partial, added in band order. */
+ * Sums go to each thread's sum columns (L->cols), a band's reduced at its
+ * end into its partial in L->partial; those are added in band order. */
 #if !defined(LK_T) || !defined(LK) || !defined(LK_ARGS)
 #error "define LK_T, LK(name) and LK_ARGS before including lattice_sweep_t.h"
 #endif
 
 /* Radial springs into band b's first row, from the state before the step;
  * their sums start the band's partial. */
-SPN__KERNEL static void LK(cut_pass)(const LK_ARGS *a, LK_T *ws, uint32_t b)
+SPN__KERNEL static void LK(cut_pass)(const LK_ARGS *a, double *cols, uint32_t b)
 {
     const spn__lattice *L = a->L;
     const uint32_t n = L->radials, j = b * L->band_rows;
-    const size_t st = LK(stride)(a);
     LK_T *Xa[3], *Va[3], *Xb[3], *Vb[3], *f[3];
     LK(eval)(a, 1 + (size_t)(j - 1) * n, Xa, Va);
     LK(eval)(a, 1 + (size_t)j * n, Xb, Vb);
     for (int c = 0; c < 3; c++) f[c] = LK(cut)(a) + ((size_t)b * 3 + c) * n;
-    double acc_e[LANES] = {0}, acc_p[LANES] = {0};
-    LK(radials)(a, Xa, Va, Xb, Vb, j, f, ws + (size_t)WS_E * st, ws + (size_t)WS_P * st, acc_e, acc_p);
+    const lat_cols cs = col_set(cols, L->col_stride, -1);
+    LK(radials)(a, Xa, Va, Xb, Vb, j, f, &cs);
     double *p = L->partial + (size_t)b * L_NSUMS;
-    p[L_ELASTIC] = lane_total(acc_e), p[L_DAMP] = lane_total(acc_p);
+    p[L_ELASTIC] = col_take(cs.c[L_ELASTIC], n), p[L_DAMP] = col_take(cs.c[L_DAMP], n);
 }
 
 /* Sweep band b: rows read straight from the state arrays, each moved in
  * place once every spring that reads it is done. */
-SPN__KERNEL static void LK(band_pass)(const LK_ARGS *a, LK_T *ws, uint32_t b)
+SPN__KERNEL static void LK(band_pass)(const LK_ARGS *a, LK_T *ws, double *cols, uint32_t b)
 {
     const spn__lattice *L = a->L;
     const uint32_t n = L->radials, lo = b * L->band_rows;
     const uint32_t hi = lo + L->band_rows < L->rings ? lo + L->band_rows : L->rings;
     const size_t st = LK(stride)(a);
-    LK_T *RAD[2][3], *RING[2][3], *H[6], *t[3], *Fw[3], *cut[3], *next_cut[3];
+    LK_T *RAD[2][3], *RING[2][3], *H[6], *Fw[3], *cut[3], *next_cut[3];
     for (int c = 0; c < 3; c++) {
         RAD[0][c] = ws + (WS_RAD + c) * st, RAD[1][c] = ws + (WS_RAD + 3 + c) * st;
         RING[0][c] = ws + (WS_RING + c) * st, RING[1][c] = ws + (WS_RING + 3 + c) * st;
-        t[c] = ws + (WS_T + c) * st, Fw[c] = ws + (WS_F + c) * st;
+        Fw[c] = ws + (WS_F + c) * st;
         cut[c] = LK(cut)(a) + ((size_t)b * 3 + c) * n;
         next_cut[c] = LK(cut)(a) + ((size_t)(b + 1) * 3 + c) * n;
     }
     for (int c = 0; c < 6; c++) H[c] = ws + (WS_HUB + c) * st;
-    LK_T *e = ws + WS_E * st, *p = ws + WS_P * st;
-    double acc_e[LANES] = {0}, acc_p[LANES] = {0}, acc[L_NSUMS][LANES] = {{0}};
+    const lat_cols cs = col_set(cols, L->col_stride, 0);
     int cur = 0;
     LK_T **rad_cur = NULL, **rad_prev = NULL;
     for (uint32_t j = lo; j < hi; j++, cur ^= 1) {
@@ -71,21 +70,21 @@ SPN__KERNEL static void LK(band_pass)(const LK_ARGS *a, LK_T *ws, uint32_t b)
             LK(hub_state)(a, hx, hv);
             for (int c = 0; c < 3; c++)
                 for (uint32_t i = 0; i < n; i++) H[c][i] = hx[c], H[3 + c][i] = hv[c];
-            LK(radials)(a, H, H + 3, X, V, 0, RAD[cur], e, p, acc_e, acc_p);
+            LK(radials)(a, H, H + 3, X, V, 0, RAD[cur], &cs);
             rad_cur = RAD[cur];
-            LK(hub)(a, rad_cur, t, acc);
+            LK(hub)(a, rad_cur, &cs);
         } else {
             LK_T *Xp[3], *Vp[3];
             LK(eval)(a, p0 - n, Xp, Vp);
-            LK(radials)(a, Xp, Vp, X, V, j, RAD[cur], e, p, acc_e, acc_p);
+            LK(radials)(a, Xp, Vp, X, V, j, RAD[cur], &cs);
             rad_cur = RAD[cur];
         }
-        LK(rings)(a, X, V, j, RING[cur], e, p, acc_e, acc_p);
-        if (j > lo) LK(finish)(a, p0 - n, n, rad_prev, RING[cur ^ 1], rad_cur, t, Fw, acc);
+        LK(rings)(a, X, V, j, RING[cur], &cs);
+        if (j > lo) LK(finish)(a, p0 - n, n, rad_prev, RING[cur ^ 1], rad_cur, Fw, &cs);
         rad_prev = rad_cur;
     }
-    LK(finish)(a, 1 + (size_t)(hi - 1) * n, n, rad_prev, RING[cur ^ 1], hi < L->rings ? next_cut : NULL, t, Fw, acc);
-    store_band_sums(L->partial + (size_t)b * L_NSUMS, b == 0, acc_e, acc_p, acc);
+    LK(finish)(a, 1 + (size_t)(hi - 1) * n, n, rad_prev, RING[cur ^ 1], hi < L->rings ? next_cut : NULL, Fw, &cs);
+    store_band_sums(L->partial + (size_t)b * L_NSUMS, b == 0, &cs, n);
 }
 
 /* One force evaluation and update over the whole lattice; sums into sum[]. */
@@ -95,11 +94,13 @@ static void LK(sweep)(const LK_ARGS *a, int threads, double *sum)
     const uint32_t nb = L->nbands;
 #pragma omp parallel num_threads(threads)
     {
-        LK_T *ws = LK(ws)(a, spn__thread_num());
+        const int t = spn__thread_num();
+        LK_T *ws = LK(ws)(a, t);
+        double *cols = L->cols[t];
 #pragma omp for schedule(static)
-        for (uint32_t b = 1; b < nb; b++) LK(cut_pass)(a, ws, b);
+        for (uint32_t b = 1; b < nb; b++) LK(cut_pass)(a, cols, b);
 #pragma omp for schedule(static)
-        for (uint32_t b = 0; b < nb; b++) LK(band_pass)(a, ws, b);
+        for (uint32_t b = 0; b < nb; b++) LK(band_pass)(a, ws, cols, b);
     }
     for (int k = 0; k < L_NSUMS; k++) sum[k] = 0;
     for (uint32_t b = 0; b < nb; b++)
