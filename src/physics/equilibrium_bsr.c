@@ -433,14 +433,69 @@ static double dot4(const double *a, const double *b, size_t n)
     return (s0 + s1) + (s2 + s3);
 }
 
+/* Four numbers on one vector (GCC vector extension: SSE2 pairs, AVX, ...;
+ * elementwise IEEE operations, so the same bits as the scalar code). */
+typedef double spn__v4 __attribute__((vector_size(4 * sizeof(double))));
+
+/* (a macro, not a function: a vector returned by value would depend on the
+ * clone's instruction set, -Wpsabi) */
+#define LOAD4(v, p) memcpy(&(v), (p), sizeof(v))
+
+/* Row i's entries in columns k0 .. k0 + 3 (k0 a multiple of 4, those
+ * columns' diagonal in d), from the four columns' running sums over the
+ * row's first k0 numbers (s, lane l: the products of q = l mod 4): dot4's
+ * sum, its remainder being the entries just found. */
+static void panel_finish(double *row, const double *const *b, size_t k0, const spn__v4 *s, const double *d)
+{
+    for (size_t r = 0; r < 4; r++) {
+        double t = s[r][0];
+        for (size_t q = k0; q < k0 + r; q++) t += row[q] * b[r][q];
+        const double dot = (t + s[r][1]) + (s[r][2] + s[r][3]);
+        row[k0 + r] = (row[k0 + r] - dot) / d[r];
+    }
+}
+
+/* Rows i and j (below the panel of columns k0 .. k0 + 3; j = i for one row
+ * alone): the four
+ * columns of each share the loop over [0, k0), keeping dot4's four running
+ * sums (so dot4's bits), and the panel's rows are read once for two rows,
+ * each row once for four columns, instead of eight times. */
+SPN__KERNEL static void panel_rows(double *f, size_t n, size_t i, size_t j, size_t k0, const double *d)
+{
+    const double *a = f + i * n, *c = f + j * n, *b[4] = {f + k0 * n, f + (k0 + 1) * n, f + (k0 + 2) * n, f + (k0 + 3) * n};
+    spn__v4 s[4] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}}, t[4];
+    memcpy(t, s, sizeof t);
+    for (size_t q = 0; q < k0; q += 4) {
+        spn__v4 u, v, w0, w1, w2, w3;
+        LOAD4(u, a + q), LOAD4(v, c + q), LOAD4(w0, b[0] + q), LOAD4(w1, b[1] + q), LOAD4(w2, b[2] + q),
+            LOAD4(w3, b[3] + q);
+        s[0] += u * w0, s[1] += u * w1, s[2] += u * w2, s[3] += u * w3;
+        t[0] += v * w0, t[1] += v * w1, t[2] += v * w2, t[3] += v * w3;
+    }
+    panel_finish(f + i * n, b, k0, s, d);
+    if (j != i) panel_finish(f + j * n, b, k0, t, d);
+}
+
+/* Cholesky L L^T of the dense symmetric n x n matrix f (row-major; L into
+ * its lower triangle), column by column in panels of four: a panel's own
+ * rows first, then every row below it four columns at a time
+ * (panel_row). The same bits as one column at a time with dot4 (the
+ * matrix of thread slides: 1,999 rows on the 1M web, once a Newton step).
+ * False if f is not positive definite. */
 bool spn__dense_cholesky(double *f, size_t n)
 {
-    for (size_t k = 0; k < n; k++) {
-        double d = f[k * n + k] - dot4(f + k * n, f + k * n, k);
-        if (!(d > 0)) return false;
-        d = sqrt(d);
-        f[k * n + k] = d;
-        for (size_t i = k + 1; i < n; i++) f[i * n + k] = (f[i * n + k] - dot4(f + i * n, f + k * n, k)) / d;
+    for (size_t k0 = 0; k0 < n; k0 += 4) {
+        const size_t k1 = k0 + 4 <= n ? k0 + 4 : n;
+        double d[4];
+        for (size_t k = k0; k < k1; k++) {
+            double dk = f[k * n + k] - dot4(f + k * n, f + k * n, k);
+            if (!(dk > 0)) return false;
+            dk = sqrt(dk);
+            f[k * n + k] = d[k - k0] = dk;
+            for (size_t i = k + 1; i < k1; i++) f[i * n + k] = (f[i * n + k] - dot4(f + i * n, f + k * n, k)) / dk;
+        }
+        if (k1 - k0 < 4) break; /* the last, narrower panel has no rows below it */
+        for (size_t i = k1; i < n; i += 2) panel_rows(f, n, i, i + 1 < n ? i + 1 : i, k0, d);
     }
     return true;
 }
