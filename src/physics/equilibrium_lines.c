@@ -61,6 +61,7 @@
  * bytes: the 100k web's solve went from 4.2 to 3.3 s CPU. (Since the sweep
  * computes a line's new values rather than a correction, the rounding of the
  * factors touches the whole value; the counts stayed the same: 12 and 24.)*/
+#include "core/big_alloc.h"
 #include "equilibrium_bsr.h"
 #include "equilibrium_internal.h"
 #include "world_internal.h"
@@ -223,9 +224,9 @@ static bool find_lines(spn__lines *L, const spn__eq *e, const uint32_t *partner)
 {
     uint32_t nadj = e->adj_start[e->n];
     walker w = {e, partner, NULL, NULL, NULL, L, 0};
-    uint32_t *end_entry = malloc(2 * (size_t)(e->m ? e->m : 1) * sizeof *end_entry);
-    w.used = calloc(e->m ? e->m : 1, 1);
-    w.seen = calloc(e->n ? e->n : 1, sizeof *w.seen);
+    uint32_t *end_entry = spn__big_alloc(2 * (size_t)(e->m ? e->m : 1) * sizeof *end_entry);
+    w.used = spn__big_calloc(e->m ? e->m : 1, 1);
+    w.seen = spn__big_calloc(e->n ? e->n : 1, sizeof *w.seen);
     if (!end_entry || !w.used || !w.seen) {
         free(end_entry), free(w.used), free(w.seen);
         return false;
@@ -262,7 +263,7 @@ static int by_key(const void *x, const void *y)
  * The standard web's lines of a colour are all alike, so its order stays. */
 static bool by_length(const spn__lines *L, uint32_t *order)
 {
-    uint64_t *key = malloc((L->count ? L->count : 1) * sizeof *key);
+    uint64_t *key = spn__big_alloc((L->count ? L->count : 1) * sizeof *key);
     if (!key) return false;
     for (uint32_t c = 0; c < L->colours; c++) {
         const uint32_t a = L->colour_start[c], b = L->colour_start[c + 1];
@@ -283,9 +284,9 @@ static bool by_length(const spn__lines *L, uint32_t *order)
 static bool colour_lines(spn__lines *L, const spn__bsr *a)
 {
     uint32_t n = a->rows, total = L->start[L->count];
-    uint32_t *ns = calloc((size_t)n + 1, sizeof *ns), *nl = malloc((total ? total : 1) * sizeof *nl);
-    uint32_t *colour = malloc((L->count ? L->count : 1) * sizeof *colour);
-    uint32_t *stamp = malloc(((size_t)L->count + 1) * sizeof *stamp), *fill = calloc((n > L->count ? n : L->count) + 1, sizeof *fill);
+    uint32_t *ns = spn__big_calloc((size_t)n + 1, sizeof *ns), *nl = spn__big_alloc((total ? total : 1) * sizeof *nl);
+    uint32_t *colour = spn__big_alloc((L->count ? L->count : 1) * sizeof *colour);
+    uint32_t *stamp = spn__big_alloc(((size_t)L->count + 1) * sizeof *stamp), *fill = spn__big_calloc((n > L->count ? n : L->count) + 1, sizeof *fill);
     bool ok = ns && nl && colour && stamp && fill;
     if (ok) { /* particle -> the lines through it */
         for (uint32_t k = 0; k < total; k++) ns[L->node[k] + 1]++;
@@ -307,9 +308,9 @@ static bool colour_lines(spn__lines *L, const spn__bsr *a)
     }
     uint32_t *start = NULL, *node = NULL;
     if (ok) {
-        L->colour_start = calloc((size_t)L->colours + 1, sizeof *L->colour_start);
-        start = malloc(((size_t)L->count + 1) * sizeof *start);
-        node = malloc((total ? total : 1) * sizeof *node);
+        L->colour_start = spn__big_calloc((size_t)L->colours + 1, sizeof *L->colour_start);
+        start = spn__big_alloc(((size_t)L->count + 1) * sizeof *start);
+        node = spn__big_alloc((total ? total : 1) * sizeof *node);
         ok = L->colour_start && start && node;
     }
     if (ok) {
@@ -368,13 +369,13 @@ static uint32_t lane_line(const spn__lines *L, uint32_t c, uint32_t g, uint32_t 
  * has), then the particles and BSR entries of each lane. */
 static bool lay_out(spn__lines *L, const spn__bsr *a0)
 {
-    L->colour_group = malloc(((size_t)L->colours + 1) * sizeof *L->colour_group);
+    L->colour_group = spn__big_alloc(((size_t)L->colours + 1) * sizeof *L->colour_group);
     if (!L->colour_group) return false;
     L->colour_group[0] = 0;
     for (uint32_t c = 0; c < L->colours; c++)
         L->colour_group[c + 1] = L->colour_group[c] + (L->colour_start[c + 1] - L->colour_start[c] + W - 1) / W;
     L->groups = L->colour_group[L->colours];
-    L->group_step = malloc(((size_t)L->groups + 1) * sizeof *L->group_step);
+    L->group_step = spn__big_alloc(((size_t)L->groups + 1) * sizeof *L->group_step);
     if (!L->group_step) return false;
     L->group_step[0] = 0;
     for (uint32_t c = 0; c < L->colours; c++)
@@ -385,9 +386,9 @@ static bool lay_out(spn__lines *L, const spn__bsr *a0)
             L->group_step[g + 1] = L->group_step[g] + longest;
         }
     const size_t S = L->steps = L->group_step[L->groups];
-    L->off_step = calloc(S + 1, sizeof *L->off_step);
-    L->snode = malloc(W * (S ? S : 1) * sizeof *L->snode);
-    L->supos = malloc(W * (S ? S : 1) * sizeof *L->supos);
+    L->off_step = spn__big_calloc(S + 1, sizeof *L->off_step);
+    L->snode = spn__big_alloc(W * (S ? S : 1) * sizeof *L->snode);
+    L->supos = spn__big_alloc(W * (S ? S : 1) * sizeof *L->supos);
     if (!L->off_step || !L->snode || !L->supos) return false;
     for (int pass = 0; pass < 2; pass++) {
         for (uint32_t c = 0; c < L->colours; c++)
@@ -413,14 +414,14 @@ static bool lay_out(spn__lines *L, const spn__bsr *a0)
         if (pass == 0) {
             for (size_t s = 0; s < S; s++) L->off_step[s + 1] += L->off_step[s];
             const size_t nb = L->off_step[S] ? L->off_step[S] : 1, ns = S ? S : 1;
-            L->soff = malloc(W * nb * sizeof *L->soff);
-            L->soffcol = malloc(W * nb * sizeof *L->soffcol);
+            L->soff = spn__big_alloc(W * nb * sizeof *L->soff);
+            L->soffcol = spn__big_alloc(W * nb * sizeof *L->soffcol);
             /* zero: a padded lane's blocks stay zero (spn__lines_factor writes the real ones) */
-            L->offval = calloc(6 * W * nb, sizeof *L->offval);
-            L->uval = calloc(6 * W * ns, sizeof *L->uval);
-            L->dinv = malloc(6 * W * ns * sizeof *L->dinv);
-            L->cu = malloc(9 * W * ns * sizeof *L->cu);
-            L->work = malloc(3 * W * ns * sizeof *L->work);
+            L->offval = spn__big_calloc(6 * W * nb, sizeof *L->offval);
+            L->uval = spn__big_calloc(6 * W * ns, sizeof *L->uval);
+            L->dinv = spn__big_alloc(6 * W * ns * sizeof *L->dinv);
+            L->cu = spn__big_alloc(9 * W * ns * sizeof *L->cu);
+            L->work = spn__big_alloc(3 * W * ns * sizeof *L->work);
             if (!L->soff || !L->soffcol || !L->offval || !L->uval || !L->dinv || !L->cu || !L->work) return false;
         }
     }
@@ -429,14 +430,14 @@ static bool lay_out(spn__lines *L, const spn__bsr *a0)
 
 spn__lines *spn__lines_build(const spn__eq *e, const spn__bsr *a0)
 {
-    spn__lines *L = calloc(1, sizeof *L);
+    spn__lines *L = spn__big_calloc(1, sizeof *L);
     uint32_t nadj = e->adj_start[e->n];
     /* every line has one more particle than springs: at most m + n particles on at most m + n lines */
     size_t cap = (size_t)e->m + e->n + 1;
-    uint32_t *partner = malloc((nadj ? nadj : 1) * sizeof *partner);
+    uint32_t *partner = spn__big_alloc((nadj ? nadj : 1) * sizeof *partner);
     if (!L || !partner) goto fail;
-    L->start = malloc((cap + 1) * sizeof *L->start);
-    L->node = malloc(cap * sizeof *L->node);
+    L->start = spn__big_alloc((cap + 1) * sizeof *L->start);
+    L->node = spn__big_alloc(cap * sizeof *L->node);
     if (!L->start || !L->node || !pair_springs(e, partner) || !find_lines(L, e, partner)) goto fail;
     free(partner);
     partner = NULL;
