@@ -53,12 +53,18 @@ void *spn__big_calloc(size_t count, size_t size)
 {
     if (size && count > PTRDIFF_MAX / size) return NULL;
     size_t bytes = count * size;
+    if (!bytes) return calloc(1, 1);
+    /* calloc, not huge_alloc and memset: fresh pages from the kernel are
+     * zero already, and calloc knows when it has them, so pages the caller
+     * never writes are never touched (a memset made 130 MB more resident on
+     * the 1M web). The advice covers the 2 MiB-aligned middle of the block. */
+    unsigned char *p = calloc(count, size);
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
-    if (bytes >= SPN__BIG_MIN) {
-        void *p = huge_alloc(bytes);
-        if (p) memset(p, 0, bytes); /* posix_memalign does not zero */
-        return p;
+    if (p && bytes >= SPN__BIG_MIN) {
+        uintptr_t lo = ((uintptr_t)p + HUGE_PAGE - 1) & ~(uintptr_t)(HUGE_PAGE - 1);
+        uintptr_t hi = ((uintptr_t)p + bytes) & ~(uintptr_t)(HUGE_PAGE - 1);
+        if (hi > lo) (void)madvise((void *)lo, hi - lo, MADV_HUGEPAGE);
     }
 #endif
-    return calloc(bytes ? count : 1, bytes ? size : 1);
+    return p;
 }
