@@ -189,16 +189,23 @@ static void mirror_lower(spn__bsr *c, int threads)
         }
 }
 
-static bool mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, bool upper, int threads)
+/* lasting: C outlives the setup (huge pages: spn__big_alloc); otherwise
+ * it is a temporary read once (A P), on plain malloc, since in a VM
+ * that hands huge pages out fresh from the host their first touch costs
+ * 4x that of small pages (docs/physics-equilibrium.md). */
+static bool mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, bool upper, bool lasting,
+                int threads)
 {
+    void *(*alloc)(size_t) = lasting ? spn__big_alloc : malloc;
     memset(c, 0, sizeof *c);
     c->rows = a->rows;
     c->cols = b->cols;
     int nt = team(a->rows, threads);
     size_t per = b->cols ? b->cols : 1;
     bool avx = spn__have_avx();
-    c->start = spn__big_calloc((size_t)a->rows + 1, sizeof *c->start);
-    uint32_t *marks = spn__big_alloc(2 * (size_t)nt * per * sizeof *marks);
+    c->start = lasting ? spn__big_calloc((size_t)a->rows + 1, sizeof *c->start)
+                       : calloc((size_t)a->rows + 1, sizeof *c->start);
+    uint32_t *marks = malloc(2 * (size_t)nt * per * sizeof *marks);
     if (!c->start || !marks) goto fail;
     for (size_t t = 0; t < (size_t)nt * per; t++) marks[t] = UINT32_MAX;
 #pragma omp parallel for schedule(static) num_threads(nt)
@@ -206,8 +213,8 @@ static bool mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_fir
         c->start[i + 1] = row_count(a, b, i, diag_first, marks + (size_t)spn__thread_num() * per);
     for (uint32_t i = 0; i < a->rows; i++) c->start[i + 1] += c->start[i];
     size_t nnz = c->start[a->rows];
-    c->col = spn__big_alloc((nnz ? nnz : 1) * sizeof *c->col);
-    c->val = spn__big_alloc(9 * (nnz ? nnz : 1) * sizeof *c->val);
+    c->col = alloc((nnz ? nnz : 1) * sizeof *c->col);
+    c->val = alloc(9 * (nnz ? nnz : 1) * sizeof *c->val);
     if (!c->col || !c->val) goto fail;
     for (size_t t = 0; t < (size_t)nt * per; t++) marks[t] = UINT32_MAX;
 #pragma omp parallel for schedule(static) num_threads(nt)
@@ -226,12 +233,12 @@ fail:
 
 bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, int threads)
 {
-    return mul(a, b, c, diag_first, false, threads);
+    return mul(a, b, c, diag_first, false, false, threads);
 }
 
 bool spn__bsr_galerkin(const spn__bsr *r, const spn__bsr *ap, spn__bsr *c, int threads)
 {
-    return mul(r, ap, c, true, true, threads);
+    return mul(r, ap, c, true, true, true, threads);
 }
 
 bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm_out)
@@ -243,7 +250,7 @@ bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm_out)
     t->start = spn__big_calloc((size_t)t->rows + 1, sizeof *t->start);
     t->col = spn__big_alloc((nnz ? nnz : 1) * sizeof *t->col);
     t->val = spn__big_alloc(9 * (nnz ? nnz : 1) * sizeof *t->val);
-    uint32_t *perm = spn__big_alloc((nnz ? nnz : 1) * sizeof *perm), *fill = spn__big_calloc(t->rows ? t->rows : 1, sizeof *fill);
+    uint32_t *perm = malloc((nnz ? nnz : 1) * sizeof *perm), *fill = calloc(t->rows ? t->rows : 1, sizeof *fill);
     if (!t->start || !t->col || !t->val || !perm || !fill) {
         free(perm);
         free(fill);

@@ -36,7 +36,7 @@ typedef struct spn__bsr {
 
 void spn__bsr_free(spn__bsr *a);
 /* Pattern and values of C = A B (C's square-matrix diagonal first when
- * diag_first). false on out of memory. */
+ * diag_first), a temporary (plain malloc). false on out of memory. */
 bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, int threads);
 /* The Galerkin product C = R (A P), R = P^T, A symmetric: diagonal first,
  * the blocks above the diagonal computed and those below mirrored from them

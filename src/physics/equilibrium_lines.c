@@ -224,9 +224,9 @@ static bool find_lines(spn__lines *L, const spn__eq *e, const uint32_t *partner)
 {
     uint32_t nadj = e->adj_start[e->n];
     walker w = {e, partner, NULL, NULL, NULL, L, 0};
-    uint32_t *end_entry = spn__big_alloc(2 * (size_t)(e->m ? e->m : 1) * sizeof *end_entry);
-    w.used = spn__big_calloc(e->m ? e->m : 1, 1);
-    w.seen = spn__big_calloc(e->n ? e->n : 1, sizeof *w.seen);
+    uint32_t *end_entry = malloc(2 * (size_t)(e->m ? e->m : 1) * sizeof *end_entry);
+    w.used = calloc(e->m ? e->m : 1, 1);
+    w.seen = calloc(e->n ? e->n : 1, sizeof *w.seen);
     if (!end_entry || !w.used || !w.seen) {
         free(end_entry), free(w.used), free(w.seen);
         return false;
@@ -263,7 +263,7 @@ static int by_key(const void *x, const void *y)
  * The standard web's lines of a colour are all alike, so its order stays. */
 static bool by_length(const spn__lines *L, uint32_t *order)
 {
-    uint64_t *key = spn__big_alloc((L->count ? L->count : 1) * sizeof *key);
+    uint64_t *key = malloc((L->count ? L->count : 1) * sizeof *key);
     if (!key) return false;
     for (uint32_t c = 0; c < L->colours; c++) {
         const uint32_t a = L->colour_start[c], b = L->colour_start[c + 1];
@@ -284,9 +284,9 @@ static bool by_length(const spn__lines *L, uint32_t *order)
 static bool colour_lines(spn__lines *L, const spn__bsr *a)
 {
     uint32_t n = a->rows, total = L->start[L->count];
-    uint32_t *ns = spn__big_calloc((size_t)n + 1, sizeof *ns), *nl = spn__big_alloc((total ? total : 1) * sizeof *nl);
-    uint32_t *colour = spn__big_alloc((L->count ? L->count : 1) * sizeof *colour);
-    uint32_t *stamp = spn__big_alloc(((size_t)L->count + 1) * sizeof *stamp), *fill = spn__big_calloc((n > L->count ? n : L->count) + 1, sizeof *fill);
+    uint32_t *ns = calloc((size_t)n + 1, sizeof *ns), *nl = malloc((total ? total : 1) * sizeof *nl);
+    uint32_t *colour = malloc((L->count ? L->count : 1) * sizeof *colour);
+    uint32_t *stamp = malloc(((size_t)L->count + 1) * sizeof *stamp), *fill = calloc((n > L->count ? n : L->count) + 1, sizeof *fill);
     bool ok = ns && nl && colour && stamp && fill;
     if (ok) { /* particle -> the lines through it */
         for (uint32_t k = 0; k < total; k++) ns[L->node[k] + 1]++;
@@ -430,14 +430,14 @@ static bool lay_out(spn__lines *L, const spn__bsr *a0)
 
 spn__lines *spn__lines_build(const spn__eq *e, const spn__bsr *a0)
 {
-    spn__lines *L = spn__big_calloc(1, sizeof *L);
+    spn__lines *L = calloc(1, sizeof *L);
     uint32_t nadj = e->adj_start[e->n];
     /* every line has one more particle than springs: at most m + n particles on at most m + n lines */
     size_t cap = (size_t)e->m + e->n + 1;
-    uint32_t *partner = spn__big_alloc((nadj ? nadj : 1) * sizeof *partner);
+    uint32_t *partner = malloc((nadj ? nadj : 1) * sizeof *partner);
     if (!L || !partner) goto fail;
-    L->start = spn__big_alloc((cap + 1) * sizeof *L->start);
-    L->node = spn__big_alloc(cap * sizeof *L->node);
+    L->start = malloc((cap + 1) * sizeof *L->start);
+    L->node = malloc(cap * sizeof *L->node);
     if (!L->start || !L->node || !pair_springs(e, partner) || !find_lines(L, e, partner)) goto fail;
     free(partner);
     partner = NULL;

@@ -156,8 +156,8 @@ static bool strong(const spn__bsr *a, const double *dn, uint32_t i, uint32_t p, 
 static uint32_t aggregate(const spn__bsr *a, uint32_t *agg, double theta)
 {
     const uint32_t n = a->rows, NONE = UINT32_MAX;
-    double *dn = spn__big_alloc((n ? n : 1) * sizeof *dn);
-    uint32_t *join = spn__big_alloc((n ? n : 1) * sizeof *join), na = 0;
+    double *dn = malloc((n ? n : 1) * sizeof *dn);
+    uint32_t *join = malloc((n ? n : 1) * sizeof *join), na = 0;
     if (!dn || !join) {
         free(dn), free(join);
         return 0;
@@ -247,7 +247,7 @@ static double spectral_radius(const mg_level *L, int threads)
 static bool smoothed_prolongator(mg_level *L, uint32_t nc)
 {
     const spn__bsr *A = &L->A;
-    uint32_t n = A->rows, *mark = spn__big_alloc(2 * (size_t)(nc ? nc : 1) * sizeof *mark), *pos = mark + (nc ? nc : 1);
+    uint32_t n = A->rows, *mark = malloc(2 * (size_t)(nc ? nc : 1) * sizeof *mark), *pos = mark + (nc ? nc : 1);
     spn__bsr *P = &L->P;
     P->rows = n, P->cols = nc;
     P->start = spn__big_alloc(((size_t)n + 1) * sizeof *P->start);
@@ -414,7 +414,7 @@ spn_status spn__mg_setup(spn__mg **out, const spn__eq *e, const double *inv0)
 {
     spn__mg *mg = *out;
     if (!mg) {
-        mg = spn__big_calloc(1, sizeof *mg);
+        mg = calloc(1, sizeof *mg);
         spn_status st = mg ? build(mg, e, inv0) : SPN_ERR_NOMEM;
         if (st != SPN_OK) { /* built again from the next (shifted) system */
             spn__mg_free(mg);

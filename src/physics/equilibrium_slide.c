@@ -69,12 +69,12 @@ spn__slide *spn__slide_build(const spn__eq *e, const spn__lines *L)
     const uint32_t *start, *node;
     spn__lines_nodes(L, &count, &start, &node);
     total = start[count];
-    spn__slide *S = spn__big_calloc(1, sizeof *S);
+    spn__slide *S = calloc(1, sizeof *S);
     if (!S) return NULL;
     S->pstart = spn__big_calloc((size_t)e->n + 1, sizeof *S->pstart);
     S->pcol = spn__big_alloc((total ? total : 1) * sizeof *S->pcol);
     S->ptan = spn__big_alloc(3 * (size_t)(total ? total : 1) * sizeof *S->ptan);
-    uint32_t *fill = spn__big_calloc(e->n ? e->n : 1, sizeof *fill);
+    uint32_t *fill = calloc(e->n ? e->n : 1, sizeof *fill);
     if (!S->pstart || !S->pcol || !S->ptan || !fill) {
         free(fill);
         spn__slide_free(S);

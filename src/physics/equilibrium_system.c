@@ -157,7 +157,7 @@ static spn_status build_adjacency(spn__eq *e)
     e->adj_col = spn__big_alloc(2 * (size_t)(e->m ? e->m : 1) * sizeof *e->adj_col);
     e->offd = spn__big_alloc(12 * (size_t)(e->m ? e->m : 1) * sizeof *e->offd);
     e->kscale = spn__big_calloc(n ? n : 1, sizeof *e->kscale);
-    uint32_t *fill = spn__big_calloc(n ? n : 1, sizeof *fill);
+    uint32_t *fill = calloc(n ? n : 1, sizeof *fill);
     if (!e->adj_start || !e->adj || !e->adj_other || !e->adj_col || !e->offd || !e->kscale || !fill) {
         free(fill);
         return SPN_ERR_NOMEM;
@@ -223,9 +223,9 @@ spn_status spn__eq_init(spn__eq *e, const spn_world *w, const spn_equilibrium_de
 {
     memset(e, 0, sizeof *e);
     uint32_t np = spn_world_particle_count(w), ns = spn_world_spring_count(w), live = 0;
-    int32_t *local = spn__big_alloc((np ? np : 1) * sizeof *local);
-    uint8_t *touched = spn__big_calloc(np ? np : 1, 1);
-    spring_rec *rec = spn__big_alloc((ns ? ns : 1) * sizeof *rec);
+    int32_t *local = malloc((np ? np : 1) * sizeof *local);
+    uint8_t *touched = calloc(np ? np : 1, 1);
+    spring_rec *rec = malloc((ns ? ns : 1) * sizeof *rec);
     spn_status st = local && touched && rec ? SPN_OK : SPN_ERR_NOMEM;
     if (st == SPN_OK) {
         for (uint32_t i = 0; i < np; i++) local[i] = -1;
