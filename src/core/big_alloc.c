@@ -1,13 +1,13 @@
 /* Large arrays on transparent huge pages.
  *
- * Why: the equilibrium solve of a 1M-particle web allocates about 4 GB in
- * ~100 arrays of 10-400 MB. Each first touch of a 4 KiB page is a page
- * fault that clears the page; in a virtual machine the host backs the page
- * too. Measured on a 2-core KVM guest: 1.06 million faults in one solve,
- * 14% of its 28.5 s in the kernel's page clearing and ~2% more in fault
- * handling (docs/physics-equilibrium.md). A 2 MiB huge page is one fault
- * instead of 512, and one TLB entry instead of 512 for the sparse
- * products' scattered reads.
+ * Why: the equilibrium solve of a 1M-particle web keeps about 2.5 GB in
+ * arrays of 10-400 MB that every CG iteration reads again, in gathers
+ * through index arrays. On 4 KiB pages that was 1.06 million page faults
+ * per solve and a TLB miss (a two-level page walk in a virtual machine)
+ * wherever a gather leaves its page. A 2 MiB huge page is one fault
+ * instead of 512 and one TLB entry instead of 512: the level-0 product
+ * of the 1M solve ran in 3.3 s instead of 4.0-4.1 s
+ * (docs/physics-equilibrium.md, "Memory").
  *
  * How: on Linux a request of at least SPN__BIG_MIN bytes is allocated
  * 2 MiB-aligned (so the whole range can be huge pages) and advised
@@ -15,7 +15,12 @@
  * setting ("madvise"); under "never" the advice is ignored and the memory is
  * ordinary. Elsewhere, and for smaller requests, plain malloc. The memory
  * comes from the C library's allocator either way, so free() releases it.
- * The advice only changes how pages are backed, never their contents. */
+ * The advice only changes how pages are backed, never their contents.
+ *
+ * For arrays that are read again and again, not for scratch written once:
+ * where free memory is handed back to the host (a VM with page reporting,
+ * as the one measured), a huge page comes back fresh from the host and
+ * its first touch costs about four times that of small pages. */
 #define _DEFAULT_SOURCE /* madvise and MADV_HUGEPAGE under -std=c11 */
 #include "core/big_alloc.h"
 

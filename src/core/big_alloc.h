@@ -1,6 +1,7 @@
-/* Allocation of large arrays (the equilibrium solver's matrices and vectors
- * on webs of 100k-1M particles): see big_alloc.c for why. Internal to the
- * library; memory from either function is released with plain free(). */
+/* Allocation of large arrays that a computation reads many times (the
+ * equilibrium solver's matrices and vectors on webs of 100k-1M particles;
+ * scratch written once stays on malloc): see big_alloc.c for why. Internal
+ * to the library; memory from either function is released with free(). */
 #ifndef SPN_BIG_ALLOC_H
 #define SPN_BIG_ALLOC_H
 
