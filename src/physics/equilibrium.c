@@ -17,6 +17,7 @@
  *    whose change is within the rounding estimate is accepted, and the force
  *    residual (not the energy) decides convergence.
  * Invariant: the world is written only at the end and only with finite values. */
+#include "core/big_alloc.h"
 #include "equilibrium_internal.h"
 
 #include <math.h>
@@ -309,8 +310,8 @@ spn_status spn_world_equilibrium(spn_world *w, const spn_equilibrium_def *def, s
         nt.pc.kind = nt.e.n < AUTO_MULTIGRID ? SPN_PRECOND_BLOCK_JACOBI : SPN_PRECOND_MULTIGRID;
     nt.rep.preconditioner = nt.pc.kind;
     size_t n3 = 3 * (size_t)(nt.e.n ? nt.e.n : 1);
-    nt.p = malloc(n3 * sizeof *nt.p);
-    nt.work = malloc(4 * n3 * sizeof *nt.work);
+    nt.p = spn__big_alloc(n3 * sizeof *nt.p);
+    nt.work = spn__big_alloc(4 * n3 * sizeof *nt.work);
     if (!nt.p || !nt.work) {
         st = spn_error(SPN_ERR_NOMEM, "equilibrium: out of memory");
     } else {

@@ -7,6 +7,7 @@
  * thread count. The Galerkin product computes only the blocks on and above
  * the diagonal and mirrors the rest (C = P^T A P is symmetric): half the
  * block arithmetic of the setup's largest product. */
+#include "core/big_alloc.h"
 #include "equilibrium_bsr.h"
 #include "equilibrium_internal.h"
 #include "world_internal.h"
@@ -29,17 +30,29 @@ void spn__bsr_free(spn__bsr *a)
     memset(a, 0, sizeof *a);
 }
 
-bool spn__bsr_round(spn__bsr *a)
+/* In place: float k goes to bytes [4k, 4k + 4), which only doubles already
+ * read (those below k / 2 + 1) occupy, so the values need no second buffer;
+ * the tail is then given back. A new float array beside the doubles, as
+ * before, added 430 MB of fresh pages to the 1M web's setup (page faults:
+ * docs/physics-equilibrium.md). The floats pass through a small buffer and
+ * memcpy, which may write over memory the doubles were read from. */
+void spn__bsr_round(spn__bsr *a)
 {
+    enum { BATCH = 512 };
     const size_t n = 9 * (size_t)a->start[a->rows];
-    float *f = malloc((n + 1) * sizeof *f); /* + 1: a block's last row is read four floats wide */
-    if (!f) return false;
-    for (size_t k = 0; k < n; k++) f[k] = (float)a->val[k];
-    f[n] = 0;
-    free(a->val);
+    unsigned char *bytes = (unsigned char *)a->val;
+    float batch[BATCH];
+    for (size_t k = 0; k < n; k += BATCH) {
+        size_t m = n - k < BATCH ? n - k : BATCH;
+        for (size_t j = 0; j < m; j++) batch[j] = (float)a->val[k + j];
+        memcpy(bytes + k * sizeof(float), batch, m * sizeof(float));
+    }
+    /* + 1: a block's last row is read four floats wide (9 n doubles hold 18 n floats) */
+    const float zero = 0;
+    memcpy(bytes + n * sizeof(float), &zero, sizeof zero);
+    float *f = realloc(a->val, (n + 1) * sizeof *f); /* shrinks in place */
+    a->fval = f ? f : (float *)(void *)bytes;
     a->val = NULL;
-    a->fval = f;
-    return true;
 }
 
 /* The number of distinct columns of row i of A B (mark: per column, the
@@ -176,15 +189,22 @@ static void mirror_lower(spn__bsr *c, int threads)
         }
 }
 
-static bool mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, bool upper, int threads)
+/* lasting: C outlives the setup (huge pages: spn__big_alloc); otherwise
+ * it is a temporary read once (A P), on plain malloc, since in a VM
+ * that hands huge pages out fresh from the host their first touch costs
+ * 4x that of small pages (docs/physics-equilibrium.md). */
+static bool mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, bool upper, bool lasting,
+                int threads)
 {
+    void *(*alloc)(size_t) = lasting ? spn__big_alloc : malloc;
     memset(c, 0, sizeof *c);
     c->rows = a->rows;
     c->cols = b->cols;
     int nt = team(a->rows, threads);
     size_t per = b->cols ? b->cols : 1;
     bool avx = spn__have_avx();
-    c->start = calloc((size_t)a->rows + 1, sizeof *c->start);
+    c->start = lasting ? spn__big_calloc((size_t)a->rows + 1, sizeof *c->start)
+                       : calloc((size_t)a->rows + 1, sizeof *c->start);
     uint32_t *marks = malloc(2 * (size_t)nt * per * sizeof *marks);
     if (!c->start || !marks) goto fail;
     for (size_t t = 0; t < (size_t)nt * per; t++) marks[t] = UINT32_MAX;
@@ -193,8 +213,8 @@ static bool mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_fir
         c->start[i + 1] = row_count(a, b, i, diag_first, marks + (size_t)spn__thread_num() * per);
     for (uint32_t i = 0; i < a->rows; i++) c->start[i + 1] += c->start[i];
     size_t nnz = c->start[a->rows];
-    c->col = malloc((nnz ? nnz : 1) * sizeof *c->col);
-    c->val = malloc(9 * (nnz ? nnz : 1) * sizeof *c->val);
+    c->col = alloc((nnz ? nnz : 1) * sizeof *c->col);
+    c->val = alloc(9 * (nnz ? nnz : 1) * sizeof *c->val);
     if (!c->col || !c->val) goto fail;
     for (size_t t = 0; t < (size_t)nt * per; t++) marks[t] = UINT32_MAX;
 #pragma omp parallel for schedule(static) num_threads(nt)
@@ -213,12 +233,12 @@ fail:
 
 bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, int threads)
 {
-    return mul(a, b, c, diag_first, false, threads);
+    return mul(a, b, c, diag_first, false, false, threads);
 }
 
 bool spn__bsr_galerkin(const spn__bsr *r, const spn__bsr *ap, spn__bsr *c, int threads)
 {
-    return mul(r, ap, c, true, true, threads);
+    return mul(r, ap, c, true, true, true, threads);
 }
 
 bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm_out)
@@ -227,9 +247,9 @@ bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm_out)
     t->rows = a->cols;
     t->cols = a->rows;
     size_t nnz = a->start[a->rows];
-    t->start = calloc((size_t)t->rows + 1, sizeof *t->start);
-    t->col = malloc((nnz ? nnz : 1) * sizeof *t->col);
-    t->val = malloc(9 * (nnz ? nnz : 1) * sizeof *t->val);
+    t->start = spn__big_calloc((size_t)t->rows + 1, sizeof *t->start);
+    t->col = spn__big_alloc((nnz ? nnz : 1) * sizeof *t->col);
+    t->val = spn__big_alloc(9 * (nnz ? nnz : 1) * sizeof *t->val);
     uint32_t *perm = malloc((nnz ? nnz : 1) * sizeof *perm), *fill = calloc(t->rows ? t->rows : 1, sizeof *fill);
     if (!t->start || !t->col || !t->val || !perm || !fill) {
         free(perm);

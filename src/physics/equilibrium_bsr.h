@@ -36,7 +36,7 @@ typedef struct spn__bsr {
 
 void spn__bsr_free(spn__bsr *a);
 /* Pattern and values of C = A B (C's square-matrix diagonal first when
- * diag_first). false on out of memory. */
+ * diag_first), a temporary (plain malloc). false on out of memory. */
 bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, int threads);
 /* The Galerkin product C = R (A P), R = P^T, A symmetric: diagonal first,
  * the blocks above the diagonal computed and those below mirrored from them
@@ -45,12 +45,12 @@ bool spn__bsr_galerkin(const spn__bsr *r, const spn__bsr *ap, spn__bsr *c, int t
 /* T = A^T, blocks transposed; perm[k]: the entry of A that T's entry k came from. */
 bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm);
 void spn__bsr_transpose_values(const spn__bsr *a, spn__bsr *t, const uint32_t *perm, int threads);
-/* Replace the values by float32 copies (val freed): the multigrid's levels
+/* Replace the values by float32 copies (val becomes fval): the multigrid's levels
  * below the finest, its prolongators and restrictions, once built, are only
  * multiplied by vectors, and a preconditioner does not need them exact (see
  * equilibrium_mg.c). The products below read either; their sums stay float64.
- * false on out of memory (the values are then kept). */
-bool spn__bsr_round(spn__bsr *a);
+ * Done in place: it needs no memory. */
+void spn__bsr_round(spn__bsr *a);
 /* y = A x (add: y += A x). */
 void spn__bsr_apply(const spn__bsr *a, const double *x, double *y, bool add, int threads);
 /* r = b - A x. */

@@ -61,6 +61,7 @@
  * bytes: the 100k web's solve went from 4.2 to 3.3 s CPU. (Since the sweep
  * computes a line's new values rather than a correction, the rounding of the
  * factors touches the whole value; the counts stayed the same: 12 and 24.)*/
+#include "core/big_alloc.h"
 #include "equilibrium_bsr.h"
 #include "equilibrium_internal.h"
 #include "world_internal.h"
@@ -310,9 +311,9 @@ static bool colour_lines(spn__lines *L, const spn__bsr *a)
     }
     uint32_t *start = NULL, *node = NULL;
     if (ok) {
-        L->colour_start = calloc((size_t)L->colours + 1, sizeof *L->colour_start);
-        start = malloc(((size_t)L->count + 1) * sizeof *start);
-        node = malloc((total ? total : 1) * sizeof *node);
+        L->colour_start = spn__big_calloc((size_t)L->colours + 1, sizeof *L->colour_start);
+        start = spn__big_alloc(((size_t)L->count + 1) * sizeof *start);
+        node = spn__big_alloc((total ? total : 1) * sizeof *node);
         ok = L->colour_start && start && node;
     }
     if (ok) {
@@ -371,13 +372,13 @@ static uint32_t lane_line(const spn__lines *L, uint32_t c, uint32_t g, uint32_t 
  * has), then the particles and BSR entries of each lane. */
 static bool lay_out(spn__lines *L, const spn__bsr *a0)
 {
-    L->colour_group = malloc(((size_t)L->colours + 1) * sizeof *L->colour_group);
+    L->colour_group = spn__big_alloc(((size_t)L->colours + 1) * sizeof *L->colour_group);
     if (!L->colour_group) return false;
     L->colour_group[0] = 0;
     for (uint32_t c = 0; c < L->colours; c++)
         L->colour_group[c + 1] = L->colour_group[c] + (L->colour_start[c + 1] - L->colour_start[c] + W - 1) / W;
     L->groups = L->colour_group[L->colours];
-    L->group_step = malloc(((size_t)L->groups + 1) * sizeof *L->group_step);
+    L->group_step = spn__big_alloc(((size_t)L->groups + 1) * sizeof *L->group_step);
     if (!L->group_step) return false;
     L->group_step[0] = 0;
     for (uint32_t c = 0; c < L->colours; c++)
@@ -388,9 +389,9 @@ static bool lay_out(spn__lines *L, const spn__bsr *a0)
             L->group_step[g + 1] = L->group_step[g] + longest;
         }
     const size_t S = L->steps = L->group_step[L->groups];
-    L->off_step = calloc(S + 1, sizeof *L->off_step);
-    L->snode = malloc(W * (S ? S : 1) * sizeof *L->snode);
-    L->supos = malloc(W * (S ? S : 1) * sizeof *L->supos);
+    L->off_step = spn__big_calloc(S + 1, sizeof *L->off_step);
+    L->snode = spn__big_alloc(W * (S ? S : 1) * sizeof *L->snode);
+    L->supos = spn__big_alloc(W * (S ? S : 1) * sizeof *L->supos);
     if (!L->off_step || !L->snode || !L->supos) return false;
     for (int pass = 0; pass < 2; pass++) {
         for (uint32_t c = 0; c < L->colours; c++)
@@ -416,14 +417,14 @@ static bool lay_out(spn__lines *L, const spn__bsr *a0)
         if (pass == 0) {
             for (size_t s = 0; s < S; s++) L->off_step[s + 1] += L->off_step[s];
             const size_t nb = L->off_step[S] ? L->off_step[S] : 1, ns = S ? S : 1;
-            L->soff = malloc(W * nb * sizeof *L->soff);
-            L->soffcol = malloc(W * nb * sizeof *L->soffcol);
+            L->soff = spn__big_alloc(W * nb * sizeof *L->soff);
+            L->soffcol = spn__big_alloc(W * nb * sizeof *L->soffcol);
             /* zero: a padded lane's blocks stay zero (spn__lines_factor writes the real ones) */
-            L->offval = calloc(6 * W * nb, sizeof *L->offval);
-            L->uval = calloc(6 * W * ns, sizeof *L->uval);
-            L->dinv = malloc(6 * W * ns * sizeof *L->dinv);
-            L->cu = malloc(9 * W * ns * sizeof *L->cu);
-            L->work = malloc(3 * W * ns * sizeof *L->work);
+            L->offval = spn__big_calloc(6 * W * nb, sizeof *L->offval);
+            L->uval = spn__big_calloc(6 * W * ns, sizeof *L->uval);
+            L->dinv = spn__big_alloc(6 * W * ns * sizeof *L->dinv);
+            L->cu = spn__big_alloc(9 * W * ns * sizeof *L->cu);
+            L->work = spn__big_alloc(3 * W * ns * sizeof *L->work);
             if (!L->soff || !L->soffcol || !L->offval || !L->uval || !L->dinv || !L->cu || !L->work) return false;
         }
     }

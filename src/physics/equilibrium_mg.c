@@ -46,6 +46,7 @@
  * hierarchy is dropped and built again from the next, shifted, system.
  * Every product writes its own rows in a fixed order: the same bits for any
  * thread count. */
+#include "core/big_alloc.h"
 #include "equilibrium_bsr.h"
 #include "equilibrium_internal.h"
 
@@ -100,9 +101,9 @@ static bool level0_pattern(spn__mg *mg, const spn__eq *e)
     spn__bsr *a = &mg->lv[0].A;
     uint32_t n = e->n, nadj = e->adj_start[n];
     a->rows = a->cols = n;
-    a->start = malloc(((size_t)n + 1) * sizeof *a->start);
-    a->col = malloc(((size_t)n + nadj + 1) * sizeof *a->col);
-    mg->map0 = malloc((nadj ? nadj : 1) * sizeof *mg->map0);
+    a->start = spn__big_alloc(((size_t)n + 1) * sizeof *a->start);
+    a->col = spn__big_alloc(((size_t)n + nadj + 1) * sizeof *a->col);
+    mg->map0 = spn__big_alloc((nadj ? nadj : 1) * sizeof *mg->map0);
     if (!a->start || !a->col || !mg->map0) return false;
     uint32_t nnz = 0;
     a->start[0] = 0;
@@ -118,7 +119,7 @@ static bool level0_pattern(spn__mg *mg, const spn__eq *e)
         }
         a->start[i + 1] = nnz;
     }
-    a->val = malloc(9 * (size_t)(nnz ? nnz : 1) * sizeof *a->val);
+    a->val = spn__big_alloc(9 * (size_t)(nnz ? nnz : 1) * sizeof *a->val);
     return a->val != NULL;
 }
 
@@ -249,7 +250,7 @@ static bool smoothed_prolongator(mg_level *L, uint32_t nc)
     uint32_t n = A->rows, *mark = malloc(2 * (size_t)(nc ? nc : 1) * sizeof *mark), *pos = mark + (nc ? nc : 1);
     spn__bsr *P = &L->P;
     P->rows = n, P->cols = nc;
-    P->start = malloc(((size_t)n + 1) * sizeof *P->start);
+    P->start = spn__big_alloc(((size_t)n + 1) * sizeof *P->start);
     if (!mark || !P->start) {
         free(mark);
         return false;
@@ -265,8 +266,8 @@ static bool smoothed_prolongator(mg_level *L, uint32_t nc)
         P->start[i + 1] = P->start[i] + cnt;
     }
     size_t nnz = P->start[n];
-    P->col = malloc((nnz ? nnz : 1) * sizeof *P->col);
-    P->val = calloc(9 * (nnz ? nnz : 1), sizeof *P->val);
+    P->col = spn__big_alloc((nnz ? nnz : 1) * sizeof *P->col);
+    P->val = spn__big_calloc(9 * (nnz ? nnz : 1), sizeof *P->val);
     if (!P->col || !P->val) {
         free(mark);
         return false;
@@ -297,7 +298,7 @@ static bool add_level(spn__mg *mg, int l)
     uint32_t n = L->A.rows;
     spn__bsr ap = {0};
     uint32_t *rperm = NULL;
-    L->agg = malloc((n ? n : 1) * sizeof *L->agg);
+    L->agg = spn__big_alloc((n ? n : 1) * sizeof *L->agg);
     if (!L->agg) return false;
     uint32_t nc = aggregate(&L->A, L->agg, THETA);
     bool ok = nc > 0;
@@ -310,9 +311,9 @@ static bool add_level(spn__mg *mg, int l)
     } else if (ok) { /* P0: an aggregate's three translations copied to its members */
         spn__bsr *P = &L->P;
         P->rows = n, P->cols = nc;
-        P->start = malloc(((size_t)n + 1) * sizeof *P->start);
-        P->col = malloc((n ? n : 1) * sizeof *P->col);
-        P->val = calloc(9 * (size_t)(n ? n : 1), sizeof *P->val);
+        P->start = spn__big_alloc(((size_t)n + 1) * sizeof *P->start);
+        P->col = spn__big_alloc((n ? n : 1) * sizeof *P->col);
+        P->val = spn__big_calloc(9 * (size_t)(n ? n : 1), sizeof *P->val);
         ok = P->start && P->col && P->val;
         for (uint32_t i = 0; ok && i <= n; i++) P->start[i] = i;
         for (uint32_t i = 0; ok && i < n; i++) {
@@ -326,10 +327,10 @@ static bool add_level(spn__mg *mg, int l)
     free(rperm);
     if (!ok) return false;
     size_t n3 = 3 * (size_t)(nc ? nc : 1);
-    C->dinv = malloc(2 * n3 * sizeof *C->dinv);
-    C->x = malloc(n3 * sizeof *C->x);
-    C->b = malloc(n3 * sizeof *C->b);
-    C->r = malloc(n3 * sizeof *C->r);
+    C->dinv = spn__big_alloc(2 * n3 * sizeof *C->dinv);
+    C->x = spn__big_alloc(n3 * sizeof *C->x);
+    C->b = spn__big_alloc(n3 * sizeof *C->b);
+    C->r = spn__big_alloc(n3 * sizeof *C->r);
     return C->dinv && C->x && C->b && C->r;
 }
 
@@ -375,8 +376,8 @@ static spn_status build(spn__mg *mg, const spn__eq *e, const double *inv0)
     mg->threads = e->threads;
     mg_level *L0 = &mg->lv[0];
     L0->dinv = (double *)inv0;
-    L0->r = malloc(3 * (size_t)(e->n ? e->n : 1) * sizeof *L0->r);
-    L0->x = malloc(3 * (size_t)(e->n ? e->n : 1) * sizeof *L0->x);
+    L0->r = spn__big_alloc(3 * (size_t)(e->n ? e->n : 1) * sizeof *L0->r);
+    L0->x = spn__big_alloc(3 * (size_t)(e->n ? e->n : 1) * sizeof *L0->x);
     if (!L0->r || !L0->x || !level0_pattern(mg, e)) return SPN_ERR_NOMEM;
     level0_values(mg, e);
     if (!(L0->lines = spn__lines_build(e, &L0->A))) return SPN_ERR_NOMEM;
@@ -392,7 +393,7 @@ static spn_status build(spn__mg *mg, const spn__eq *e, const double *inv0)
     }
     size_t N = 3 * (size_t)mg->lv[mg->nlevels - 1].A.rows;
     if (mg->nlevels > 1 && N <= 3 * DENSE_MAX) {
-        mg->dense = malloc((N ? N * N : 1) * sizeof *mg->dense);
+        mg->dense = spn__big_alloc((N ? N * N : 1) * sizeof *mg->dense);
         if (!mg->dense) return SPN_ERR_NOMEM;
         if (!dense_factor(mg)) return SPN_ERR_UNSTABLE;
     }
@@ -402,9 +403,9 @@ static spn_status build(spn__mg *mg, const spn__eq *e, const double *inv0)
      * products read. */
     for (int l = 0; l < mg->nlevels; l++) {
         mg_level *L = &mg->lv[l];
-        bool ok = (l == 0 || spn__bsr_round(&L->A)) && (!L->P.val || spn__bsr_round(&L->P)) &&
-                  (!L->R.val || spn__bsr_round(&L->R));
-        if (!ok) return SPN_ERR_NOMEM;
+        if (l > 0) spn__bsr_round(&L->A);
+        if (L->P.val) spn__bsr_round(&L->P);
+        if (L->R.val) spn__bsr_round(&L->R);
     }
     return SPN_OK;
 }

@@ -7,6 +7,7 @@
  *
  * Every sum is a fixed-order block reduction (spn__eq_dot), so the iterates
  * are the same bits for any thread count. */
+#include "core/big_alloc.h"
 #include "equilibrium_internal.h"
 
 #include <math.h>
@@ -21,7 +22,7 @@ spn_status spn__precond_setup(spn__precond *pc, const spn__eq *e)
 {
     const uint32_t n = e->n;
     if (!pc->inv) {
-        pc->inv = malloc(6 * (size_t)(n ? n : 1) * sizeof *pc->inv);
+        pc->inv = spn__big_alloc(6 * (size_t)(n ? n : 1) * sizeof *pc->inv);
         if (!pc->inv) return spn_error(SPN_ERR_NOMEM, "equilibrium: out of memory");
     }
     int bad = 0;

@@ -14,6 +14,7 @@
  * same bits; below 32,768 particles it replaced a spring-by-spring product
  * (each block read once, but scattering into y, so on one thread only),
  * which on the 1M web was slower still (33.5 s). */
+#include "core/big_alloc.h"
 #include "equilibrium_internal.h"
 #include "world_internal.h"
 
@@ -29,8 +30,8 @@ static inline int team(const spn__eq *e, uint32_t items) { return items < PAR_MI
 spn_status spn__eq_build_lanes(spn__eq *e)
 {
     const uint32_t n = e->n, W = SPN__EQ_LANES, groups = (n + W - 1) / W;
-    e->lane_start = malloc(((size_t)groups + 1) * sizeof *e->lane_start);
-    e->lane_by_row = malloc(groups ? groups : 1);
+    e->lane_start = spn__big_alloc(((size_t)groups + 1) * sizeof *e->lane_start);
+    e->lane_by_row = spn__big_alloc(groups ? groups : 1);
     if (!e->lane_start || !e->lane_by_row) return SPN_ERR_NOMEM;
     e->lane_start[0] = 0;
     for (uint32_t g = 0; g < groups; g++) {
@@ -41,9 +42,9 @@ spn_status spn__eq_build_lanes(spn__eq *e)
         e->lane_start[g + 1] = e->lane_start[g] + (e->lane_by_row[g] ? 0 : longest);
     }
     const size_t slots = e->lane_start[groups] ? e->lane_start[groups] : 1;
-    e->lane_col = malloc(W * slots * sizeof *e->lane_col);
-    e->lane_val = calloc(6 * W * slots, sizeof *e->lane_val);
-    e->lane_diag = calloc(6 * W * (size_t)(groups ? groups : 1), sizeof *e->lane_diag);
+    e->lane_col = spn__big_alloc(W * slots * sizeof *e->lane_col);
+    e->lane_val = spn__big_calloc(6 * W * slots, sizeof *e->lane_val);
+    e->lane_diag = spn__big_calloc(6 * W * (size_t)(groups ? groups : 1), sizeof *e->lane_diag);
     if (!e->lane_col || !e->lane_val || !e->lane_diag) return SPN_ERR_NOMEM;
     for (uint32_t g = 0; g < groups; g++)
         for (uint32_t q = 0; q < W; q++) {

@@ -21,6 +21,7 @@
  * x += Z C^-1 Z^T (b - A x) is applied before and after the aggregation
  * multigrid's coarse correction, so the V-cycle stays symmetric.
  * Sequential and in a fixed order: the same bits for any thread count. */
+#include "core/big_alloc.h"
 #include "equilibrium_bsr.h"
 #include "equilibrium_internal.h"
 
@@ -70,9 +71,9 @@ spn__slide *spn__slide_build(const spn__eq *e, const spn__lines *L)
     total = start[count];
     spn__slide *S = calloc(1, sizeof *S);
     if (!S) return NULL;
-    S->pstart = calloc((size_t)e->n + 1, sizeof *S->pstart);
-    S->pcol = malloc((total ? total : 1) * sizeof *S->pcol);
-    S->ptan = malloc(3 * (size_t)(total ? total : 1) * sizeof *S->ptan);
+    S->pstart = spn__big_calloc((size_t)e->n + 1, sizeof *S->pstart);
+    S->pcol = spn__big_alloc((total ? total : 1) * sizeof *S->pcol);
+    S->ptan = spn__big_alloc(3 * (size_t)(total ? total : 1) * sizeof *S->ptan);
     uint32_t *fill = calloc(e->n ? e->n : 1, sizeof *fill);
     if (!S->pstart || !S->pcol || !S->ptan || !fill) {
         free(fill);
@@ -98,8 +99,8 @@ spn__slide *spn__slide_build(const spn__eq *e, const spn__lines *L)
         spn__slide_free(S);
         return NULL;
     }
-    S->c = malloc((nz ? (size_t)nz * nz : 1) * sizeof *S->c);
-    S->w = malloc((nz ? nz : 1) * sizeof *S->w);
+    S->c = spn__big_alloc((nz ? (size_t)nz * nz : 1) * sizeof *S->c);
+    S->w = spn__big_alloc((nz ? nz : 1) * sizeof *S->w);
     if (!S->c || !S->w) {
         spn__slide_free(S);
         return NULL;

@@ -22,6 +22,7 @@
  * outputs (springs, or particles gathering over their incident springs in
  * spring order) and every sum runs over fixed blocks added in order, so the
  * results are the same bits for any thread count. */
+#include "core/big_alloc.h"
 #include "equilibrium_internal.h"
 #include "world_internal.h"
 
@@ -100,9 +101,9 @@ static spn_status number_particles(spn__eq *e, const spn_world *w, const spring_
         if (touched[i] && spn_world_is_fixed(w, i)) local[i] = (int32_t)nl++;
     e->n = n;
     e->nl = nl;
-    e->world_id = malloc((nl ? nl : 1) * sizeof *e->world_id);
-    e->x = malloc(3 * (size_t)(nl ? nl : 1) * sizeof *e->x);
-    e->xtrial = malloc(3 * (size_t)(nl ? nl : 1) * sizeof *e->xtrial);
+    e->world_id = spn__big_alloc((nl ? nl : 1) * sizeof *e->world_id);
+    e->x = spn__big_alloc(3 * (size_t)(nl ? nl : 1) * sizeof *e->x);
+    e->xtrial = spn__big_alloc(3 * (size_t)(nl ? nl : 1) * sizeof *e->xtrial);
     if (!e->world_id || !e->x || !e->xtrial) return SPN_ERR_NOMEM;
     const spn_vec3 *pos = spn_world_positions(w);
     for (uint32_t i = 0; i < np; i++) {
@@ -120,11 +121,11 @@ static spn_status gather_springs(spn__eq *e, const spring_rec *rec, uint32_t liv
 {
     uint32_t m = 0;
     size_t cap = live ? live : 1;
-    e->sa = malloc(cap * sizeof *e->sa);
-    e->sb = malloc(cap * sizeof *e->sb);
-    e->k = malloc(cap * sizeof *e->k);
-    e->rest = malloc(cap * sizeof *e->rest);
-    e->tonly = malloc(cap);
+    e->sa = spn__big_alloc(cap * sizeof *e->sa);
+    e->sb = spn__big_alloc(cap * sizeof *e->sb);
+    e->k = spn__big_alloc(cap * sizeof *e->k);
+    e->rest = spn__big_alloc(cap * sizeof *e->rest);
+    e->tonly = spn__big_alloc(cap);
     if (!e->sa || !e->sb || !e->k || !e->rest || !e->tonly) return SPN_ERR_NOMEM;
     /* springs between free particles first, then those to a fixed one with
      * the free end as a (the edge-wise product needs no branch on the first) */
@@ -150,12 +151,12 @@ static spn_status gather_springs(spn__eq *e, const spring_rec *rec, uint32_t liv
 static spn_status build_adjacency(spn__eq *e)
 {
     uint32_t n = e->n;
-    e->adj_start = calloc((size_t)n + 1, sizeof *e->adj_start);
-    e->adj = malloc(2 * (size_t)(e->m ? e->m : 1) * sizeof *e->adj);
-    e->adj_other = malloc(2 * (size_t)(e->m ? e->m : 1) * sizeof *e->adj_other);
-    e->adj_col = malloc(2 * (size_t)(e->m ? e->m : 1) * sizeof *e->adj_col);
-    e->offd = malloc(12 * (size_t)(e->m ? e->m : 1) * sizeof *e->offd);
-    e->kscale = calloc(n ? n : 1, sizeof *e->kscale);
+    e->adj_start = spn__big_calloc((size_t)n + 1, sizeof *e->adj_start);
+    e->adj = spn__big_alloc(2 * (size_t)(e->m ? e->m : 1) * sizeof *e->adj);
+    e->adj_other = spn__big_alloc(2 * (size_t)(e->m ? e->m : 1) * sizeof *e->adj_other);
+    e->adj_col = spn__big_alloc(2 * (size_t)(e->m ? e->m : 1) * sizeof *e->adj_col);
+    e->offd = spn__big_alloc(12 * (size_t)(e->m ? e->m : 1) * sizeof *e->offd);
+    e->kscale = spn__big_calloc(n ? n : 1, sizeof *e->kscale);
     uint32_t *fill = calloc(n ? n : 1, sizeof *fill);
     if (!e->adj_start || !e->adj || !e->adj_other || !e->adj_col || !e->offd || !e->kscale || !fill) {
         free(fill);
@@ -240,13 +241,13 @@ spn_status spn__eq_init(spn__eq *e, const spn_world *w, const spn_equilibrium_de
     if (st == SPN_OK) st = spn__eq_build_lanes(e);
     if (st == SPN_OK) {
         size_t n = e->n ? e->n : 1, m = e->m ? e->m : 1;
-        e->fext = malloc(3 * n * sizeof *e->fext);
-        e->f = malloc(3 * n * sizeof *e->f);
-        e->diag = malloc(6 * n * sizeof *e->diag);
-        e->hs = malloc(6 * m * sizeof *e->hs);
-        e->fs = malloc(3 * m * sizeof *e->fs);
+        e->fext = spn__big_alloc(3 * n * sizeof *e->fext);
+        e->f = spn__big_alloc(3 * n * sizeof *e->f);
+        e->diag = spn__big_alloc(6 * n * sizeof *e->diag);
+        e->hs = spn__big_alloc(6 * m * sizeof *e->hs);
+        e->fs = spn__big_alloc(3 * m * sizeof *e->fs);
         size_t chunks = (n > m ? n : m) / SPN__EQ_CHUNK + 1;
-        e->partial = malloc(4 * chunks * sizeof *e->partial);
+        e->partial = spn__big_alloc(4 * chunks * sizeof *e->partial);
         if (!e->fext || !e->f || !e->diag || !e->hs || !e->fs || !e->partial) st = SPN_ERR_NOMEM;
     }
     if (st != SPN_OK) {
