@@ -1,7 +1,8 @@
 /* spn__big_alloc / spn__big_calloc (src/core/big_alloc.c): the memory is
  * usable end to end, the calloc form is zeroed even where freed dirty memory
  * could come back, large blocks are 2 MiB-aligned where huge pages are
- * asked for, and impossible requests give NULL instead of aborting. */
+ * asked for (SPN_HUGE_PAGES=1), and impossible requests give NULL instead
+ * of aborting, with huge pages asked for or not. */
 #define _DEFAULT_SOURCE /* MADV_HUGEPAGE, as big_alloc.c sees it */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -43,6 +44,7 @@ static void fill_and_check(unsigned char *p, size_t n, unsigned seed)
 static void test_usable(void **state)
 {
     (void)state;
+    assert_int_equal(setenv("SPN_HUGE_PAGES", "1", 1), 0);
     const size_t sizes[] = {0, 1, 4096, SPN__BIG_MIN - 1, SPN__BIG_MIN, 3 * SPN__BIG_MIN + 12345};
     for (size_t k = 0; k < sizeof sizes / sizeof *sizes; k++) {
         unsigned char *p = spn__big_alloc(sizes[k]);
@@ -53,6 +55,12 @@ static void test_usable(void **state)
 #endif
         free(p);
     }
+    /* without the variable: plain malloc, usable all the same */
+    assert_int_equal(unsetenv("SPN_HUGE_PAGES"), 0);
+    unsigned char *q = spn__big_alloc(SPN__BIG_MIN + 1);
+    assert_non_null(q);
+    fill_and_check(q, SPN__BIG_MIN + 1, 3);
+    free(q);
 }
 
 static bool all_zero(const unsigned char *p, size_t n)
@@ -65,6 +73,7 @@ static bool all_zero(const unsigned char *p, size_t n)
 static void test_calloc_zeroed(void **state)
 {
     (void)state;
+    assert_int_equal(setenv("SPN_HUGE_PAGES", "1", 1), 0);
     const size_t counts[] = {0, 1, 1000, SPN__BIG_MIN / 8, 5 * SPN__BIG_MIN / 8 + 3};
     for (size_t k = 0; k < sizeof counts / sizeof *counts; k++) {
         size_t bytes = counts[k] * sizeof(double);
@@ -84,6 +93,7 @@ static void test_calloc_zeroed(void **state)
 static void test_impossible_requests_fail_cleanly(void **state)
 {
     (void)state;
+    assert_int_equal(setenv("SPN_HUGE_PAGES", "1", 1), 0);
     assert_null(spn__big_alloc(SIZE_MAX));
     assert_null(spn__big_alloc((size_t)PTRDIFF_MAX + 1));
     assert_null(spn__big_calloc(SIZE_MAX / 2, 4)); /* the product overflows */

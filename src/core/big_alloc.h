@@ -7,8 +7,9 @@
 
 #include <stddef.h>
 
-/* Requests of at least this many bytes are placed on huge pages where the
- * system has them; smaller ones are plain malloc. */
+/* With SPN_HUGE_PAGES=1 in the environment, requests of at least this many
+ * bytes are placed on huge pages where the system has them (big_alloc.c
+ * says why it is opt-in); otherwise, and for smaller ones, plain malloc. */
 #define SPN__BIG_MIN ((size_t)4 << 20)
 
 /* Like malloc (never NULL for 0 bytes: one byte is given). NULL when the
