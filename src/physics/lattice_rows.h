@@ -40,13 +40,17 @@ enum {
  * a kernel does not sum it). */
 typedef struct lat_cols {
     double *c[L_NSUMS];
+    /* float32 scratch, one row per quantity: the float32 kernels store their
+     * terms here, in a loop that stays all float32 (16 lanes wide), and add
+     * them into c after it (col_addf) */
+    float *scr[L_NSUMS];
 } lat_cols;
 /* Per thread: COL_SETS sets, then the cut's two columns. A sweep uses set
  * 0; a blocked pass two per level (sets 2 s and 2 s + 1) and the last for
  * the ghost rows' sums, which are never read (that set alone is not kept
  * zero). */
 #define COL_SETS (2 * SPN__LAT_BLOCK_MAX + 1)
-#define COL_COUNT (COL_SETS * L_NSUMS + 2)
+#define COL_COUNT (COL_SETS * L_NSUMS + 2 + (L_NSUMS + 1) / 2)
 
 /* The float32 step's state and arrays (lattice_f32.c). */
 typedef struct spn__lat32 spn__lat32;
@@ -106,7 +110,9 @@ typedef struct lat_args {
 
 #define LK_T double
 #define LK(name) name##64
+#define LK_SCRATCH 0
 #include "lattice_rows_t.h"
+#undef LK_SCRATCH
 #undef LK
 #undef LK_T
 
@@ -118,7 +124,9 @@ LAT_INLINE double lane_total(const double *acc)
 /* Column set `set` of a thread's columns, or (set < 0) the cut's two. */
 LAT_INLINE lat_cols col_set(double *cols, size_t stride, int set)
 {
-    lat_cols cs = {{NULL}};
+    lat_cols cs = {{NULL}, {NULL}};
+    float *scr = (float *)(cols + ((size_t)COL_SETS * L_NSUMS + 2) * stride); /* after every double column */
+    for (int k = 0; k < L_NSUMS; k++) cs.scr[k] = scr + (size_t)k * stride;
     if (set < 0) {
         cs.c[L_ELASTIC] = cols + (size_t)COL_SETS * L_NSUMS * stride;
         cs.c[L_DAMP] = cs.c[L_ELASTIC] + stride;
@@ -126,6 +134,19 @@ LAT_INLINE lat_cols col_set(double *cols, size_t stride, int set)
     }
     for (int k = 0; k < L_NSUMS; k++) cs.c[k] = cols + ((size_t)set * L_NSUMS + k) * stride;
     return cs;
+}
+
+/* n float32 terms t added into a sum column c: in eight running sums
+ * (term i into sum i mod 8), added into c[0 .. 7] at the end (col_take sums
+ * the whole column, so where in it a term lands does not matter). */
+LAT_INLINE void col_addf(double *restrict c, const float *restrict t, uint32_t n)
+{
+    double acc[LANES] = {0};
+    uint32_t i = 0;
+    for (; i + LANES <= n; i += LANES)
+        for (int l = 0; l < LANES; l++) acc[l] += (double)t[i + l];
+    for (; i < n; i++) acc[i % LANES] += (double)t[i];
+    for (int l = 0; l < LANES; l++) c[l] += acc[l];
 }
 
 /* The sum of column c[0 .. n) (in eight lanes, i mod 8, then lane_total),

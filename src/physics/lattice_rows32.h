@@ -14,13 +14,15 @@
 
 #define LK_T float
 #define LK(name) name##32
+#define LK_SCRATCH 1
 #include "lattice_rows_t.h"
+#undef LK_SCRATCH
 #undef LK
 #undef LK_T
 
 /* Springs j = 0..n-1 from a to b: chunk.h's expression in float32, the
  * difference as L + (d_a - d_b); force on end a into f, energy and damping
- * power (float32, summed in double) added into the sum columns ce, cp. */
+ * power into e, p (float32 scratch). */
 LAT_INLINE void springs32(uint32_t n, const float *restrict dax, const float *restrict day,
                           const float *restrict daz, const float *restrict dbx, const float *restrict dby,
                           const float *restrict dbz, const float *restrict uax, const float *restrict uay,
@@ -28,7 +30,7 @@ LAT_INLINE void springs32(uint32_t n, const float *restrict dax, const float *re
                           const float *restrict ubz, const float *restrict Lx, const float *restrict Ly,
                           const float *restrict Lz, const float *restrict kk, const float *restrict kkd,
                           const float *restrict rr, float *restrict fx, float *restrict fy, float *restrict fz,
-                          double *restrict ce, double *restrict cp)
+                          float *restrict e, float *restrict p)
 {
     for (uint32_t j = 0; j < n; j++) {
         const float lx = Lx[j] + (dax[j] - dbx[j]), ly = Ly[j] + (day[j] - dby[j]), lz = Lz[j] + (daz[j] - dbz[j]);
@@ -41,8 +43,8 @@ LAT_INLINE void springs32(uint32_t n, const float *restrict dax, const float *re
         const float rate = (ux * lx + uy * ly + uz * lz) * inv;
         const float k = on ? kk[j] : 0.0f, kd = kkd[j];
         const float s = -(k * stretch + kd * rate) * inv;
-        ce[j] += (double)(0.5f * k * stretch * stretch);
-        cp[j] += (double)(kd * rate * rate);
+        e[j] = 0.5f * k * stretch * stretch;
+        p[j] = kd * rate * rate;
         fx[j] = s * lx, fy[j] = s * ly, fz[j] = s * lz;
     }
 }
@@ -55,7 +57,9 @@ LAT_INLINE void spring_rows(uint32_t n, float *const *da, float *const *ua, floa
 {
     springs32(n, da[0], da[1], da[2], db[0], db[1], db[2], ua[0], ua[1], ua[2], ub[0], ub[1], ub[2], L[0] + s0,
               L[1] + s0, L[2] + s0, k + s0, kd + s0, rest + s0, f[0] + off_f, f[1] + off_f, f[2] + off_f,
-              cs->c[L_ELASTIC] + off_f, cs->c[L_DAMP] + off_f);
+              cs->scr[L_ELASTIC], cs->scr[L_DAMP]);
+    col_addf(cs->c[L_ELASTIC], cs->scr[L_ELASTIC], n);
+    col_addf(cs->c[L_DAMP], cs->scr[L_DAMP], n);
 }
 
 #endif

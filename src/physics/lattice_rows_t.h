@@ -12,8 +12,25 @@
  * Each expression is the general path's (chunk.h, explicit.c), so the
  * float64 lattice gives its bits. Plain loops for GCC 12 to vectorise; where
  * it would not, the comment says what was changed. */
-#if !defined(LK_T) || !defined(LK)
-#error "define LK_T and LK(name) before including lattice_rows_t.h"
+#if !defined(LK_T) || !defined(LK) || !defined(LK_SCRATCH)
+#error "define LK_T, LK(name) and LK_SCRATCH before including lattice_rows_t.h"
+#endif
+
+/* The per-particle sum terms: float64 adds them straight into the sum
+ * columns (LK_S double, LK_ACC +=); float32 stores them in its float
+ * scratch (lat_cols.scr) and adds them into the columns after the loop
+ * (col_addf), so that the loop stays float32. LK_TERMS: the array a
+ * kernel writes; LK_DONE: that addition. */
+#if LK_SCRATCH
+#define LK_S float
+#define LK_ACC(a, v) ((a) = (v))
+#define LK_TERMS(cs, k) ((cs)->scr[k])
+#define LK_DONE(cs, k, n) col_addf((cs)->c[k], (cs)->scr[k], (n))
+#else
+#define LK_S double
+#define LK_ACC(a, v) ((a) += (v))
+#define LK_TERMS(cs, k) ((cs)->c[k])
+#define LK_DONE(cs, k, n) ((void)0)
 #endif
 
 typedef struct LK(moved) {
@@ -49,8 +66,8 @@ LAT_INLINE void LK(row)(uint32_t n, bool sym, LK_T dt, const LK_T *g, LK_T drag,
                         LK_T *restrict vx, LK_T *restrict vy, LK_T *restrict vz, const LK_T *restrict ix,
                         const LK_T *restrict iy, const LK_T *restrict iz, const LK_T *restrict rx,
                         const LK_T *restrict ry, const LK_T *restrict rz, const LK_T *restrict ox,
-                        const LK_T *restrict oy, const LK_T *restrict oz, double *restrict t_mv2,
-                        double *restrict t_gain, double *restrict t_mvn2)
+                        const LK_T *restrict oy, const LK_T *restrict oz, LK_S *restrict t_mv2,
+                        LK_S *restrict t_gain, LK_S *restrict t_mvn2)
 {
     const uint32_t l = n - 1;
     LK_T e0[3], el[3];
@@ -65,7 +82,7 @@ LAT_INLINE void LK(row)(uint32_t n, bool sym, LK_T dt, const LK_T *g, LK_T drag,
     do {                                                                                                        \
         xx[i] = (o).x[0], xy[i] = (o).x[1], xz[i] = (o).x[2];                                                   \
         vx[i] = (o).v[0], vy[i] = (o).v[1], vz[i] = (o).v[2];                                                   \
-        t_mv2[i] += (o).mv2, t_gain[i] += (o).gain, t_mvn2[i] += (o).mvn2;                                         \
+        LK_ACC(t_mv2[i], (o).mv2), LK_ACC(t_gain[i], (o).gain), LK_ACC(t_mvn2[i], (o).mvn2);                   \
     } while (0)
     if (ox)
         for (uint32_t i = 1; i < l; i++) {
@@ -123,10 +140,10 @@ LAT_INLINE void LK(assemble)(uint32_t n, LK_T gc, LK_T drag, const LK_T *restric
  * gain and new-energy terms are zero, so they are not summed at all). */
 LAT_INLINE void LK(rk4_kin)(uint32_t n, const LK_T *restrict mass, const LK_T *restrict inv_mass,
                             const LK_T *restrict Vx, const LK_T *restrict Vy, const LK_T *restrict Vz,
-                            double *restrict t_mv2)
+                            LK_S *restrict t_mv2)
 {
     for (uint32_t i = 0; i < n; i++)
-        t_mv2[i] += (inv_mass[i] != 0 ? mass[i] : (LK_T)0) * (Vx[i] * Vx[i] + Vy[i] * Vy[i] + Vz[i] * Vz[i]);
+        LK_ACC(t_mv2[i], (inv_mass[i] != 0 ? mass[i] : (LK_T)0) * (Vx[i] * Vx[i] + Vy[i] * Vy[i] + Vz[i] * Vz[i]));
 }
 
 /* One component of a stage but the last: the weighted sums ax, av and the
@@ -159,8 +176,8 @@ LAT_INLINE void LK(rk4_sums)(uint32_t n, LK_T h6, const LK_T *g, const LK_T *res
                              const LK_T *restrict Fz, const LK_T *restrict axx, const LK_T *restrict axy,
                              const LK_T *restrict axz, const LK_T *restrict avx, const LK_T *restrict avy,
                              const LK_T *restrict avz, const LK_T *restrict ux, const LK_T *restrict uy,
-                             const LK_T *restrict uz, double *restrict t_mv2, double *restrict t_gain,
-                             double *restrict t_mvn2)
+                             const LK_T *restrict uz, LK_S *restrict t_mv2, LK_S *restrict t_gain,
+                             LK_S *restrict t_mvn2)
 {
     for (uint32_t i = 0; i < n; i++) {
         const LK_T im = inv_mass[i], s = h6 * im;
@@ -168,10 +185,10 @@ LAT_INLINE void LK(rk4_sums)(uint32_t n, LK_T h6, const LK_T *g, const LK_T *res
         const LK_T vx = Vx[i], vy = Vy[i], vz = Vz[i], wx = ux[i], wy = uy[i], wz = uz[i];
         const LK_T ex = (axx[i] + vx) * h6, ey = (axy[i] + vy) * h6, ez = (axz[i] + vz) * h6;
         const LK_T nx = wx + (avx[i] + Fx[i]) * s, ny = wy + (avy[i] + Fy[i]) * s, nz = wz + (avz[i] + Fz[i]) * s;
-        t_mv2[i] += mf * (vx * vx + vy * vy + vz * vz);
-        t_mvn2[i] += mf * (nx * nx + ny * ny + nz * nz);
-        t_gain[i] += mf * ((LK_T)0.5 * ((nx - wx) * (nx + wx) + (ny - wy) * (ny + wy) + (nz - wz) * (nz + wz)) -
-                          (g[0] * ex + g[1] * ey + g[2] * ez));
+        LK_ACC(t_mv2[i], mf * (vx * vx + vy * vy + vz * vz));
+        LK_ACC(t_mvn2[i], mf * (nx * nx + ny * ny + nz * nz));
+        LK_ACC(t_gain[i], mf * ((LK_T)0.5 * ((nx - wx) * (nx + wx) + (ny - wy) * (ny + wy) + (nz - wz) * (nz + wz)) -
+                                (g[0] * ex + g[1] * ey + g[2] * ez)));
     }
 }
 
@@ -230,11 +247,12 @@ LAT_INLINE void LK(row_move)(uint32_t n, bool sym, LK_T dt, const LK_T *g, LK_T 
      * run-time bool) */
 #define LK_ROW(sym)                                                                                             \
     LK(row)(n, sym, dt, g, drag, mass, inv_mass, X[0], X[1], X[2], V[0], V[1], V[2], ri[0], ri[1], ri[2], rg[0], \
-            rg[1], rg[2], ro ? ro[0] : NULL, ro ? ro[1] : NULL, ro ? ro[2] : NULL, cs->c[L_MV2], cs->c[L_GAIN],  \
-            cs->c[L_MVN2])
+            rg[1], rg[2], ro ? ro[0] : NULL, ro ? ro[1] : NULL, ro ? ro[2] : NULL, LK_TERMS(cs, L_MV2),          \
+            LK_TERMS(cs, L_GAIN), LK_TERMS(cs, L_MVN2))
     if (sym) LK_ROW(true);
     else LK_ROW(false);
 #undef LK_ROW
+    LK_DONE(cs, L_MV2, n), LK_DONE(cs, L_GAIN, n), LK_DONE(cs, L_MVN2, n);
 }
 
 /* The rows an RK4 stage reads and writes (3 arrays each, at the row): the
@@ -256,7 +274,10 @@ LAT_INLINE void LK(rk4_update)(uint32_t n, bool last, bool first, LK_T h, LK_T w
         /* m v^2 at a stage's state serves the drag's loss (and, at the first
          * stage, the energy before the step); without drag the later stages
          * skip it, as drag * m v^2 would add exactly zero */
-        if (first || drag != 0) LK(rk4_kin)(n, mass, inv_mass, R->V[0], R->V[1], R->V[2], cs->c[L_MV2]);
+        if (first || drag != 0) {
+            LK(rk4_kin)(n, mass, inv_mass, R->V[0], R->V[1], R->V[2], LK_TERMS(cs, L_MV2));
+            LK_DONE(cs, L_MV2, n);
+        }
         /* (three calls, not a loop: GCC 12 does not vectorise an inlined
          * function with restrict parameters inside a loop) */
         LK(rk4_stage)(n, first, h, wgt, inv_mass, R->V[0], F[0], R->xb[0], R->vb[0], R->xt[0], R->vt[0], R->ax[0],
@@ -268,9 +289,15 @@ LAT_INLINE void LK(rk4_update)(uint32_t n, bool last, bool first, LK_T h, LK_T w
         return;
     }
     LK(rk4_sums)(n, h, g, mass, inv_mass, R->V[0], R->V[1], R->V[2], F[0], F[1], F[2], R->ax[0], R->ax[1],
-                 R->ax[2], R->av[0], R->av[1], R->av[2], R->vb[0], R->vb[1], R->vb[2], cs->c[L_MV2], cs->c[L_GAIN],
-                 cs->c[L_MVN2]);
+                 R->ax[2], R->av[0], R->av[1], R->av[2], R->vb[0], R->vb[1], R->vb[2], LK_TERMS(cs, L_MV2),
+                 LK_TERMS(cs, L_GAIN), LK_TERMS(cs, L_MVN2));
+    LK_DONE(cs, L_MV2, n), LK_DONE(cs, L_GAIN, n), LK_DONE(cs, L_MVN2, n);
     LK(rk4_last)(n, h, inv_mass, R->V[0], F[0], R->ax[0], R->av[0], R->xb[0], R->vb[0]);
     LK(rk4_last)(n, h, inv_mass, R->V[1], F[1], R->ax[1], R->av[1], R->xb[1], R->vb[1]);
     LK(rk4_last)(n, h, inv_mass, R->V[2], F[2], R->ax[2], R->av[2], R->xb[2], R->vb[2]);
 }
+
+#undef LK_S
+#undef LK_ACC
+#undef LK_TERMS
+#undef LK_DONE
