@@ -15,9 +15,9 @@
  * an aggregate instead of stepping at its edge. The coarse operator is the
  * Galerkin product R A P, R = P^T (equilibrium_bsr.c). Smoothing widens the
  * stencil a level at a time; a level denser than MAX_SMOOTHED_ROW blocks a
- * row keeps P0 (on the 1M web levels 3-5 reached 145-338 blocks a row and
- * their products cost more than the whole solve). Levels stop at COARSEST
- * particles, solved by dense Cholesky.
+ * row keeps P0, a guard against a runaway stencil (the densest level of the
+ * 1M web has 145 blocks a row). Levels stop at COARSEST particles, solved by
+ * dense Cholesky.
  *
  * Smoothing: on the finest level one sweep of thread-line relaxation
  * (equilibrium_lines.c: exact solves along every thread, for the 50:1
@@ -59,7 +59,12 @@
 #define DENSE_MAX 300u  /* a coarsest level larger than this (coarsening stalled) gets Gauss-Seidel sweeps instead */
 #define COARSE_SWEEPS 4
 #define MAX_LEVELS 24
-#define MAX_SMOOTHED_ROW 64.0 /* blocks a row above which a level's prolongator is not smoothed */
+/* Blocks a row above which a level's prolongator is not smoothed. It was 64
+ * until 2026-11-22, which left level 3 of the 1M web (5,326 rows, 145 blocks
+ * a row) with P0: CG 62 -> 45 and the solve about 7 s faster with it
+ * smoothed, the first setup no dearer (its level 4 has 656 rows); the 5k and
+ * 100k webs keep 12 and 24 CG. */
+#define MAX_SMOOTHED_ROW 256.0
 #define POWER_STEPS 10  /* power iterations for rho(D^-1 A) on coarse levels */
 /* Free particles above which the slide matrix is factored again at every
  * Newton step instead of kept from the first (see spn__mg_setup). */
@@ -302,9 +307,8 @@ static bool add_level(spn__mg *mg, int l)
     if (!L->agg) return false;
     uint32_t nc = aggregate(&L->A, L->agg, THETA);
     bool ok = nc > 0;
-    /* smoothing widens the stencil a level at a time (5, 12, 47, 96 ... blocks a
-     * row on the 100k web, 145-338 on levels 3-5 of the 1M web, where the
-     * products then cost more than the solve): dense levels keep P0 */
+    /* smoothing widens the stencil a level at a time (5, 12, 46, 96 blocks a
+     * row on the 100k web, 5, 12, 41, 145 on the 1M web): dense levels keep P0 */
     if (ok && (double)L->A.start[n] <= MAX_SMOOTHED_ROW * n) {
         L->omega = 4.0 / (3.0 * (l == 0 ? 2.0 : spectral_radius(L, mg->threads)));
         ok = smoothed_prolongator(L, nc);
