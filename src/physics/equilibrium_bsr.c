@@ -93,20 +93,25 @@ static void row_sums(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_t
 }
 
 #if SPN__AVX
-/* c += a b on 256-bit vectors, a given as its nine numbers broadcast: row r
- * of c (three lanes and one spare) plus a_r0 b_0 + a_r1 b_1 + a_r2 b_2, rows
- * of b as vectors. Products and sums in the same order as spn__blk_mul_add,
- * no fused multiply-add: the same bits. Each row is read with the next
- * row's first number in its spare lane and written back in row order, so
- * the next row's store repairs it; the last row (and b's) is moved in two
- * and one numbers, never past the block. */
+/* acc += a b on 256-bit vectors, a given as its nine numbers broadcast and
+ * the sums of a block of C kept as three rows of four lanes (ACC doubles,
+ * 32-byte aligned; the fourth lane is a spare that is never read out): row
+ * r of acc plus a_r0 b_0 + a_r1 b_1 + a_r2 b_2, rows of b as vectors.
+ * Products and sums in the same order as spn__blk_mul_add, no fused
+ * multiply-add: the same bits. Whole, aligned, non-overlapping vectors
+ * matter: the next product into the same block finds its sums in the
+ * store buffer. (Until 2026-11-22 the sums were read and written in C's
+ * own nine numbers, rows overlapping by a lane: each load then needed two
+ * stores, could not be forwarded and waited for them to reach the cache;
+ * 60 ns a product on the 1M web's level 0.) */
+enum { ACC = 12 };
+
 __attribute__((target("avx"))) static inline void blk_mul_add_avx(const __m256d *a, const double *restrict b,
-                                                                   double *restrict c)
+                                                                   double *restrict acc)
 {
     __m256d b0 = _mm256_loadu_pd(b), b1 = _mm256_loadu_pd(b + 3);
     __m256d b2 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(b + 6)), _mm_load_sd(b + 8), 1);
-    __m256d c0 = _mm256_loadu_pd(c), c1 = _mm256_loadu_pd(c + 3);
-    __m256d c2 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(c + 6)), _mm_load_sd(c + 8), 1);
+    __m256d c0 = _mm256_load_pd(acc), c1 = _mm256_load_pd(acc + 4), c2 = _mm256_load_pd(acc + 8);
     c0 = _mm256_add_pd(c0, _mm256_mul_pd(a[0], b0));
     c1 = _mm256_add_pd(c1, _mm256_mul_pd(a[3], b0));
     c2 = _mm256_add_pd(c2, _mm256_mul_pd(a[6], b0));
@@ -116,17 +121,19 @@ __attribute__((target("avx"))) static inline void blk_mul_add_avx(const __m256d 
     c0 = _mm256_add_pd(c0, _mm256_mul_pd(a[2], b2));
     c1 = _mm256_add_pd(c1, _mm256_mul_pd(a[5], b2));
     c2 = _mm256_add_pd(c2, _mm256_mul_pd(a[8], b2));
-    _mm256_storeu_pd(c, c0);
-    _mm256_storeu_pd(c + 3, c1);
-    _mm_storeu_pd(c + 6, _mm256_castpd256_pd128(c2));
-    _mm_store_sd(c + 8, _mm256_extractf128_pd(c2, 1));
+    _mm256_store_pd(acc, c0);
+    _mm256_store_pd(acc + 4, c1);
+    _mm256_store_pd(acc + 8, c2);
 }
 
 /* row_sums with blk_mul_add_avx (a block of A broadcast once for the row
- * of B it multiplies): a third of the instructions. */
+ * of B it multiplies: a third of the instructions), into acc, ACC numbers
+ * a block of the row from its first, then copied out to C's nine. */
 __attribute__((target("avx"))) static void row_sums_avx(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_t i,
-                                                        bool upper, const uint32_t *pos)
+                                                        bool upper, const uint32_t *pos, double *restrict acc)
 {
+    const uint32_t q0 = c->start[i], cnt = c->start[i + 1] - q0;
+    memset(acc, 0, ACC * (size_t)cnt * sizeof *acc);
     for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) {
         const double *ab = a->val + 9 * (size_t)p;
         __m256d av[9];
@@ -134,19 +141,21 @@ __attribute__((target("avx"))) static void row_sums_avx(const spn__bsr *a, const
         uint32_t k = a->col[p];
         for (uint32_t q = b->start[k]; q < b->start[k + 1]; q++) {
             uint32_t j = b->col[q];
-            if (!upper || j >= i) blk_mul_add_avx(av, b->val + 9 * (size_t)q, c->val + 9 * (size_t)pos[j]);
+            if (!upper || j >= i) blk_mul_add_avx(av, b->val + 9 * (size_t)q, acc + ACC * (size_t)(pos[j] - q0));
         }
     }
+    double *cv = c->val + 9 * (size_t)q0;
+    for (uint32_t t = 0; t < cnt; t++)
+        for (int r = 0; r < 3; r++) memcpy(cv + 9 * (size_t)t + 3 * r, acc + ACC * (size_t)t + 4 * r, 3 * sizeof *cv);
 }
 #endif
 
 /* Row i of C = A B: its columns in the order met (mark as in row_count),
- * zero blocks, then the sums. */
+ * then the sums (acc: the AVX path's workspace, ACC numbers a block). */
 static void row_values(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_t i, bool diag_first, bool upper,
-                       bool avx, uint32_t *mark, uint32_t *pos)
+                       double *acc, uint32_t *mark, uint32_t *pos)
 {
     uint32_t q0 = c->start[i], cnt = q0;
-    memset(c->val + 9 * (size_t)q0, 0, 9 * (size_t)(c->start[i + 1] - q0) * sizeof *c->val);
     if (diag_first) {
         mark[i] = i;
         pos[i] = cnt;
@@ -161,13 +170,14 @@ static void row_values(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32
             c->col[cnt++] = j;
         }
 #if SPN__AVX
-    if (avx) {
-        row_sums_avx(a, b, c, i, upper, pos);
+    if (acc) {
+        row_sums_avx(a, b, c, i, upper, pos, acc);
         return;
     }
 #else
-    (void)avx;
+    (void)acc;
 #endif
+    memset(c->val + 9 * (size_t)q0, 0, 9 * (size_t)(c->start[i + 1] - q0) * sizeof *c->val);
     row_sums(a, b, c, i, upper, pos);
 }
 
@@ -202,7 +212,6 @@ static bool mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_fir
     c->cols = b->cols;
     int nt = team(a->rows, threads);
     size_t per = b->cols ? b->cols : 1;
-    bool avx = spn__have_avx();
     c->start = lasting ? spn__big_calloc((size_t)a->rows + 1, sizeof *c->start)
                        : calloc((size_t)a->rows + 1, sizeof *c->start);
     uint32_t *marks = malloc(2 * (size_t)nt * per * sizeof *marks);
@@ -217,11 +226,25 @@ static bool mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_fir
     c->val = alloc(9 * (nnz ? nnz : 1) * sizeof *c->val);
     if (!c->col || !c->val) goto fail;
     for (size_t t = 0; t < (size_t)nt * per; t++) marks[t] = UINT32_MAX;
+    double *accs = NULL;
+    size_t acc_per = 0;
+#if SPN__AVX
+    if (spn__have_avx()) {
+        uint32_t widest = 1;
+        for (uint32_t i = 0; i < a->rows; i++)
+            if (c->start[i + 1] - c->start[i] > widest) widest = c->start[i + 1] - c->start[i];
+        acc_per = ACC * (size_t)widest; /* a multiple of 4 doubles: each thread's part stays 32-byte aligned */
+        accs = aligned_alloc(32, (size_t)nt * acc_per * sizeof *accs);
+        if (!accs) goto fail;
+    }
+#endif
 #pragma omp parallel for schedule(static) num_threads(nt)
     for (uint32_t i = 0; i < a->rows; i++) {
-        uint32_t *mark = marks + (size_t)spn__thread_num() * per;
-        row_values(a, b, c, i, diag_first, upper, avx, mark, mark + (size_t)nt * per);
+        size_t t = (size_t)spn__thread_num();
+        uint32_t *mark = marks + t * per;
+        row_values(a, b, c, i, diag_first, upper, accs ? accs + t * acc_per : NULL, mark, mark + (size_t)nt * per);
     }
+    free(accs);
     free(marks);
     if (upper) mirror_lower(c, threads);
     return true;
