@@ -16,10 +16,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define PAR_MIN 16384u /* rows below which a loop stays on one thread */
+/* Blocks of work below which a loop stays on one thread. By work, not rows:
+ * a coarse level's rows are few and long (the 1M web's level 3: 5,326 rows
+ * of 145 blocks), and until 2026-11-22 a threshold of 16,384 rows kept the
+ * setup's densest products and those levels' products with vectors on one
+ * thread. Rows are independent, so any team gives the same bits. */
+#define PAR_MIN 65536.0
 
-
-static inline int team(uint32_t rows, int threads) { return rows < PAR_MIN ? 1 : threads; }
+static inline int team(double blocks, int threads) { return blocks < PAR_MIN ? 1 : threads; }
+static inline int team_rows(const spn__bsr *a, int threads) { return team((double)a->start[a->rows], threads); }
 
 void spn__bsr_free(spn__bsr *a)
 {
@@ -185,7 +190,7 @@ static void row_values(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32
  * above it: C_ij = C_ji^T (row j found by a scan: rows are short). */
 static void mirror_lower(spn__bsr *c, int threads)
 {
-#pragma omp parallel for schedule(static) num_threads(team(c->rows, threads))
+#pragma omp parallel for schedule(static) num_threads(team_rows(c, threads))
     for (uint32_t i = 0; i < c->rows; i++)
         for (uint32_t q = c->start[i]; q < c->start[i + 1]; q++) {
             uint32_t j = c->col[q], t = c->start[j];
@@ -210,14 +215,15 @@ static bool mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_fir
     memset(c, 0, sizeof *c);
     c->rows = a->rows;
     c->cols = b->cols;
-    int nt = team(a->rows, threads);
+    /* the block products of A B, about: rows of A vary, hence dynamic chunks */
+    int nt = team((double)a->start[a->rows] * b->start[b->rows] / (b->rows ? b->rows : 1), threads);
     size_t per = b->cols ? b->cols : 1;
     c->start = lasting ? spn__big_calloc((size_t)a->rows + 1, sizeof *c->start)
                        : calloc((size_t)a->rows + 1, sizeof *c->start);
     uint32_t *marks = malloc(2 * (size_t)nt * per * sizeof *marks);
     if (!c->start || !marks) goto fail;
     for (size_t t = 0; t < (size_t)nt * per; t++) marks[t] = UINT32_MAX;
-#pragma omp parallel for schedule(static) num_threads(nt)
+#pragma omp parallel for schedule(dynamic, 64) num_threads(nt)
     for (uint32_t i = 0; i < a->rows; i++)
         c->start[i + 1] = row_count(a, b, i, diag_first, marks + (size_t)spn__thread_num() * per);
     for (uint32_t i = 0; i < a->rows; i++) c->start[i + 1] += c->start[i];
@@ -238,7 +244,7 @@ static bool mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_fir
         if (!accs) goto fail;
     }
 #endif
-#pragma omp parallel for schedule(static) num_threads(nt)
+#pragma omp parallel for schedule(dynamic, 64) num_threads(nt)
     for (uint32_t i = 0; i < a->rows; i++) {
         size_t t = (size_t)spn__thread_num();
         uint32_t *mark = marks + t * per;
@@ -264,7 +270,7 @@ bool spn__bsr_galerkin(const spn__bsr *r, const spn__bsr *ap, spn__bsr *c, int t
     return mul(r, ap, c, true, true, true, threads);
 }
 
-bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm_out)
+bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm_out, int threads)
 {
     memset(t, 0, sizeof *t);
     t->rows = a->cols;
@@ -290,7 +296,7 @@ bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm_out)
         }
     free(fill);
     *perm_out = perm;
-    spn__bsr_transpose_values(a, t, perm, 1);
+    spn__bsr_transpose_values(a, t, perm, threads);
     return true;
 }
 
@@ -388,7 +394,7 @@ __attribute__((target("avx"))) static inline void row_sum_avx(const spn__bsr *a,
 __attribute__((target("avx"))) static void rows_avx(const spn__bsr *a, const double *b, const double *x, double *y,
                                                     bool add, int threads)
 {
-#pragma omp parallel for schedule(static) num_threads(team(a->rows, threads))
+#pragma omp parallel for schedule(static) num_threads(team_rows(a, threads))
     for (uint32_t i = 0; i < a->rows; i++) {
         double s[3], *o = y + 3 * (size_t)i;
         row_sum_avx(a, i, a->start[i], x, s);
@@ -420,7 +426,7 @@ static void rows(const spn__bsr *a, const double *b, const double *x, double *y,
         return;
     }
 #endif
-#pragma omp parallel for schedule(static) num_threads(team(a->rows, threads))
+#pragma omp parallel for schedule(static) num_threads(team_rows(a, threads))
     for (uint32_t i = 0; i < a->rows; i++) {
         double s[3], *o = y + 3 * (size_t)i;
         row_sum(a, i, a->start[i], x, s);

@@ -43,7 +43,7 @@ bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_f
  * (C exactly symmetric). false on out of memory. */
 bool spn__bsr_galerkin(const spn__bsr *r, const spn__bsr *ap, spn__bsr *c, int threads);
 /* T = A^T, blocks transposed; perm[k]: the entry of A that T's entry k came from. */
-bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm);
+bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm, int threads);
 void spn__bsr_transpose_values(const spn__bsr *a, spn__bsr *t, const uint32_t *perm, int threads);
 /* Replace the values by float32 copies (val becomes fval): the multigrid's levels
  * below the finest, its prolongators and restrictions, once built, are only

@@ -325,7 +325,7 @@ static bool add_level(spn__mg *mg, int l)
             P->val[9 * (size_t)i] = P->val[9 * (size_t)i + 4] = P->val[9 * (size_t)i + 8] = 1;
         }
     }
-    ok = ok && spn__bsr_mul(&L->A, &L->P, &ap, false, mg->threads) && spn__bsr_transpose(&L->P, &L->R, &rperm) &&
+    ok = ok && spn__bsr_mul(&L->A, &L->P, &ap, false, mg->threads) && spn__bsr_transpose(&L->P, &L->R, &rperm, mg->threads) &&
          spn__bsr_galerkin(&L->R, &ap, &C->A, mg->threads);
     spn__bsr_free(&ap);
     free(rperm);
