@@ -528,11 +528,16 @@ SPN__KERNEL static void panel_rows(double *f, size_t n, size_t i, size_t j, size
 /* Cholesky L L^T of the dense symmetric n x n matrix f (row-major; L into
  * its lower triangle), column by column in panels of four: a panel's own
  * rows first, then every row below it four columns at a time
- * (panel_row). The same bits as one column at a time with dot4 (the
- * matrix of thread slides: 1,999 rows on the 1M web, once a Newton step).
- * False if f is not positive definite. */
-bool spn__dense_cholesky(double *f, size_t n)
+ * (panel_row), pairs of rows shared among the threads from DENSE_PAR_MIN
+ * rows (each pair depends only on the finished panel). The same bits as one
+ * column at a time with dot4, on any thread count (the matrix of thread
+ * slides: 1,999 rows on the 1M web, once a Newton step). False if f is not
+ * positive definite. */
+#define DENSE_PAR_MIN 512u
+
+bool spn__dense_cholesky(double *f, size_t n, int threads)
 {
+    const int nt = n < DENSE_PAR_MIN ? 1 : threads;
     for (size_t k0 = 0; k0 < n; k0 += 4) {
         const size_t k1 = k0 + 4 <= n ? k0 + 4 : n;
         double d[4];
@@ -544,7 +549,12 @@ bool spn__dense_cholesky(double *f, size_t n)
             for (size_t i = k + 1; i < k1; i++) f[i * n + k] = (f[i * n + k] - dot4(f + i * n, f + k * n, k)) / dk;
         }
         if (k1 - k0 < 4) break; /* the last, narrower panel has no rows below it */
-        for (size_t i = k1; i < n; i += 2) panel_rows(f, n, i, i + 1 < n ? i + 1 : i, k0, d);
+        const size_t pairs = (n - k1 + 1) / 2;
+#pragma omp parallel for schedule(static) num_threads(n - k1 < 64 ? 1 : nt)
+        for (size_t p = 0; p < pairs; p++) {
+            const size_t i = k1 + 2 * p;
+            panel_rows(f, n, i, i + 1 < n ? i + 1 : i, k0, d);
+        }
     }
     return true;
 }

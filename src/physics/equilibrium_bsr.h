@@ -62,7 +62,7 @@ void spn__bsr_gauss_seidel(const spn__bsr *a, const double *dinv, const double *
 /* Dense Cholesky A = L L^T in place: f is n x n row-major, its lower
  * triangle read and overwritten with L. False when A is not positive
  * definite. (The multigrid's coarsest level and the thread slides.) */
-bool spn__dense_cholesky(double *f, size_t n);
+bool spn__dense_cholesky(double *f, size_t n, int threads);
 /* Solves L L^T x = b with a factor from spn__dense_cholesky; x may be b. */
 void spn__dense_cholesky_solve(const double *f, size_t n, const double *b, double *x);
 

@@ -349,7 +349,7 @@ static bool dense_factor(spn__mg *mg)
         for (uint32_t p = a->start[I]; p < a->start[I + 1]; p++)
             for (int r = 0; r < 3; r++)
                 for (int c = 0; c < 3; c++) f[(3 * I + r) * N + 3 * a->col[p] + c] += a->val[9 * (size_t)p + 3 * r + c];
-    return spn__dense_cholesky(f, N);
+    return spn__dense_cholesky(f, N, 1);
 }
 
 static void dense_solve(const spn__mg *mg, const double *b, double *x)

@@ -27,6 +27,16 @@ static inline int spn__thread_num(void)
 #endif
 }
 
+/* The size of the calling thread's OpenMP team (1 without OpenMP). */
+static inline int spn__thread_count(void)
+{
+#ifdef _OPENMP
+    return omp_get_num_threads();
+#else
+    return 1;
+#endif
+}
+
 #define SPN_SPRING_TENSION_ONLY 1u
 #define SPN_SPRING_BROKEN 2u
 
