@@ -49,6 +49,7 @@ typedef struct spn__eq {
     int32_t *lane_col;    /* SPN__EQ_LANES per slot: adj_col, or the row itself past a row's end */
     double *lane_val;     /* 6 SPN__EQ_LANES per slot: entry f of lane q at (6 slot + f) LANES + q */
     double *lane_diag;    /* 6 SPN__EQ_LANES per group, likewise */
+    float *lane_val32, *lane_diag32; /* the same rounded to float32, or NULL (spn__eq_matvec_mg) */
     double *kscale; /* n: sum of incident k, the scale of the Levenberg shift */
     double lambda;  /* the shift of the last assembly */
     double *f;    /* 3 n: net force = -gradient */
@@ -83,6 +84,8 @@ void spn__eq_lanes_store(spn__eq *e, uint32_t i);
  * (equilibrium_product.c). */
 void spn__eq_matvec(const spn__eq *e, const double *p, double *y);
 double spn__eq_matvec_dot(const spn__eq *e, const double *p, double *y);
+/* y = A p for the multigrid's residuals: float32 blocks on large webs. */
+void spn__eq_matvec_mg(const spn__eq *e, const double *p, double *y);
 /* p += alpha d, r -= alpha q; returns r . r and sets *rmax2 to the largest
  * |r_i|^2 of a particle. */
 double spn__eq_update(const spn__eq *e, double alpha, const double *d, const double *q, double *p, double *r,

@@ -457,7 +457,7 @@ static void smooth(const spn__mg *mg, int l, const double *b, double *x, bool fo
 static void slide_correct(const spn__mg *mg, const spn__eq *e, const double *b, double *x)
 {
     double *r = mg->lv[0].r;
-    spn__eq_matvec(e, x, r);
+    spn__eq_matvec_mg(e, x, r);
     for (uint32_t k = 0; k < 3 * e->n; k++) r[k] = b[k] - r[k];
     spn__slide_correct(mg->slide, e, r, x);
 }
@@ -479,9 +479,10 @@ static void vcycle(const spn__mg *mg, const spn__eq *e, int l, const double *b, 
     smooth(mg, l, b, x, true);
     bool slide = l == 0 && e->hs && mg->slide_ok;
     if (slide) slide_correct(mg, e, b, x);
-    if (l == 0 && e->hs) { /* the spring system's own product reads each spring's 6 numbers once, not 2 x 9
-                            * (the implicit step's system has no spring blocks: implicit_mg.c) */
-        spn__eq_matvec(e, x, L->r);
+    if (l == 0 && e->hs) { /* the spring system's own product reads each spring's 6 numbers once, not 2 x 9,
+                            * float32 on large webs (the implicit step's system has no spring blocks:
+                            * implicit_mg.c) */
+        spn__eq_matvec_mg(e, x, L->r);
         const uint32_t n3 = 3 * L->A.rows;
         for (uint32_t k = 0; k < n3; k++) L->r[k] = b[k] - L->r[k];
     } else {

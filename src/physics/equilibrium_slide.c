@@ -192,16 +192,26 @@ void spn__slide_correct(const spn__slide *S, const spn__eq *e, const double *r, 
     const double *f = S->c;
     double *w = S->w;
     const int nt = e->n < SLIDE_PAR_MIN ? 1 : e->threads;
-    /* Z^T r unknown by unknown, each over its particles in order: the same
-     * sums as one loop over the particles, which could not be shared */
+    /* Z^T r: on one thread in one loop over the particles, reading r in
+     * order; on more, unknown by unknown, each over its particles in order
+     * (the same sums, but gathered: a radial's particles are a ring apart) */
+    if (nt == 1) {
+        memset(w, 0, N * sizeof *w);
+        for (uint32_t p = 0; p < e->n; p++)
+            for (uint32_t q = S->pstart[p]; q < S->pstart[p + 1]; q++) {
+                const double *t = S->ptan + 3 * (size_t)q, *rp = r + 3 * (size_t)p;
+                w[S->pcol[q]] += t[0] * rp[0] + t[1] * rp[1] + t[2] * rp[2];
+            }
+    } else {
 #pragma omp parallel for schedule(dynamic, 16) num_threads(nt)
-    for (uint32_t z = 0; z < N; z++) {
-        double sum = 0;
-        for (uint32_t k = S->zstart[z]; k < S->zstart[z + 1]; k++) {
-            const double *t = S->ptan + 3 * (size_t)S->zq[k], *rp = r + 3 * (size_t)S->zp[k];
-            sum += t[0] * rp[0] + t[1] * rp[1] + t[2] * rp[2];
+        for (uint32_t z = 0; z < N; z++) {
+            double sum = 0;
+            for (uint32_t k = S->zstart[z]; k < S->zstart[z + 1]; k++) {
+                const double *t = S->ptan + 3 * (size_t)S->zq[k], *rp = r + 3 * (size_t)S->zp[k];
+                sum += t[0] * rp[0] + t[1] * rp[1] + t[2] * rp[2];
+            }
+            w[z] = sum;
         }
-        w[z] = sum;
     }
     spn__dense_cholesky_solve(f, N, w, w);
 #pragma omp parallel for schedule(static) num_threads(nt)
