@@ -49,6 +49,7 @@
 #include "core/big_alloc.h"
 #include "equilibrium_bsr.h"
 #include "equilibrium_internal.h"
+#include "world_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -249,36 +250,44 @@ static double spectral_radius(const mg_level *L, int threads)
  * (Keeping only the strong blocks, the weak ones lumped on the diagonal,
  * made the coarse levels sparser but the method weaker: 80 CG iterations
  * instead of 53 at 100k; measured.) */
-static bool smoothed_prolongator(mg_level *L, uint32_t nc)
+static bool smoothed_prolongator(mg_level *L, uint32_t nc, int threads)
 {
     const spn__bsr *A = &L->A;
-    uint32_t n = A->rows, *mark = malloc(2 * (size_t)(nc ? nc : 1) * sizeof *mark), *pos = mark + (nc ? nc : 1);
+    const uint32_t n = A->rows, per = nc ? nc : 1;
+    /* rows are independent: each thread marks its rows' aggregates in its
+     * own arrays (the same bits on any team) */
+    const int nt = (double)A->start[n] < 65536.0 ? 1 : threads;
+    uint32_t *marks = malloc(2 * (size_t)nt * per * sizeof *marks);
     spn__bsr *P = &L->P;
     P->rows = n, P->cols = nc;
     P->start = spn__big_alloc(((size_t)n + 1) * sizeof *P->start);
-    if (!mark || !P->start) {
-        free(mark);
+    if (!marks || !P->start) {
+        free(marks);
         return false;
     }
-    for (uint32_t c = 0; c < nc; c++) mark[c] = UINT32_MAX;
+    for (size_t c = 0; c < (size_t)nt * per; c++) marks[c] = UINT32_MAX;
     P->start[0] = 0;
+#pragma omp parallel for schedule(static) num_threads(nt)
     for (uint32_t i = 0; i < n; i++) {
-        uint32_t cnt = 0;
+        uint32_t *mark = marks + (size_t)spn__thread_num() * per, cnt = 0;
         for (uint32_t p = A->start[i]; p < A->start[i + 1]; p++) {
             uint32_t g = L->agg[A->col[p]];
             if (mark[g] != i) mark[g] = i, cnt++;
         }
-        P->start[i + 1] = P->start[i] + cnt;
+        P->start[i + 1] = cnt;
     }
+    for (uint32_t i = 0; i < n; i++) P->start[i + 1] += P->start[i];
     size_t nnz = P->start[n];
     P->col = spn__big_alloc((nnz ? nnz : 1) * sizeof *P->col);
     P->val = spn__big_calloc(9 * (nnz ? nnz : 1), sizeof *P->val);
     if (!P->col || !P->val) {
-        free(mark);
+        free(marks);
         return false;
     }
-    for (uint32_t c = 0; c < nc; c++) mark[c] = UINT32_MAX;
+    for (size_t c = 0; c < (size_t)nt * per; c++) marks[c] = UINT32_MAX;
+#pragma omp parallel for schedule(static) num_threads(nt)
     for (uint32_t i = 0; i < n; i++) {
+        uint32_t *mark = marks + (size_t)spn__thread_num() * per, *pos = marks + ((size_t)nt + spn__thread_num()) * per;
         const double *d = L->dinv + 6 * (size_t)i;
         double di[9] = {-L->omega * d[0], -L->omega * d[3], -L->omega * d[4], -L->omega * d[3], -L->omega * d[1],
                         -L->omega * d[5], -L->omega * d[4], -L->omega * d[5], -L->omega * d[2]};
@@ -291,7 +300,7 @@ static bool smoothed_prolongator(mg_level *L, uint32_t nc)
             if (c == i) pv[0] += 1, pv[4] += 1, pv[8] += 1;
         }
     }
-    free(mark);
+    free(marks);
     return true;
 }
 
@@ -311,7 +320,7 @@ static bool add_level(spn__mg *mg, int l, spn__bsr_keep *keep)
      * row on the 100k web, 5, 12, 41, 145 on the 1M web): dense levels keep P0 */
     if (ok && (double)L->A.start[n] <= MAX_SMOOTHED_ROW * n) {
         L->omega = 4.0 / (3.0 * (l == 0 ? 2.0 : spectral_radius(L, mg->threads)));
-        ok = smoothed_prolongator(L, nc);
+        ok = smoothed_prolongator(L, nc, mg->threads);
     } else if (ok) { /* P0: an aggregate's three translations copied to its members */
         spn__bsr *P = &L->P;
         P->rows = n, P->cols = nc;
