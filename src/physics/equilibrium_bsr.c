@@ -207,10 +207,9 @@ static void mirror_lower(spn__bsr *c, int threads)
 /* lasting: C outlives the setup (huge pages: spn__big_alloc); otherwise
  * it is a temporary read once (A P), on plain malloc, since in a VM
  * that hands huge pages out fresh from the host their first touch costs
- * 4x that of small pages (docs/physics-equilibrium.md), and in keep's
- * memory when it is large enough (spn__bsr_keep). */
+ * 4x that of small pages (docs/physics-equilibrium.md). */
 static bool mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, bool upper, bool lasting,
-                spn__bsr_keep *keep, int threads)
+                int threads)
 {
     void *(*alloc)(size_t) = lasting ? spn__big_alloc : malloc;
     memset(c, 0, sizeof *c);
@@ -229,13 +228,8 @@ static bool mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_fir
         c->start[i + 1] = row_count(a, b, i, diag_first, marks + (size_t)spn__thread_num() * per);
     for (uint32_t i = 0; i < a->rows; i++) c->start[i + 1] += c->start[i];
     size_t nnz = c->start[a->rows];
-    if (keep && keep->cap >= nnz) { /* taken; spn__bsr_keep_back returns it */
-        c->col = keep->col, c->val = keep->val;
-        keep->col = NULL, keep->val = NULL, keep->cap = 0;
-    } else {
-        c->col = alloc((nnz ? nnz : 1) * sizeof *c->col);
-        c->val = alloc(9 * (nnz ? nnz : 1) * sizeof *c->val);
-    }
+    c->col = alloc((nnz ? nnz : 1) * sizeof *c->col);
+    c->val = alloc(9 * (nnz ? nnz : 1) * sizeof *c->val);
     if (!c->col || !c->val) goto fail;
     for (size_t t = 0; t < (size_t)nt * per; t++) marks[t] = UINT32_MAX;
     double *accs = NULL;
@@ -266,32 +260,14 @@ fail:
     return false;
 }
 
-bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, spn__bsr_keep *keep,
-                  int threads)
+bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, int threads)
 {
-    return mul(a, b, c, diag_first, false, false, keep, threads);
+    return mul(a, b, c, diag_first, false, false, threads);
 }
 
 bool spn__bsr_galerkin(const spn__bsr *r, const spn__bsr *ap, spn__bsr *c, int threads)
 {
-    return mul(r, ap, c, true, true, true, NULL, threads);
-}
-
-void spn__bsr_keep_back(spn__bsr_keep *keep, spn__bsr *c)
-{
-    const size_t nnz = c->start ? c->start[c->rows] : 0;
-    if (c->col && nnz >= keep->cap) {
-        free(keep->col), free(keep->val);
-        keep->col = c->col, keep->val = c->val, keep->cap = nnz;
-        c->col = NULL, c->val = NULL;
-    }
-    spn__bsr_free(c);
-}
-
-void spn__bsr_keep_free(spn__bsr_keep *keep)
-{
-    free(keep->col), free(keep->val);
-    memset(keep, 0, sizeof *keep);
+    return mul(r, ap, c, true, true, true, threads);
 }
 
 bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm_out, int threads)

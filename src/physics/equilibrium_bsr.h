@@ -37,21 +37,7 @@ typedef struct spn__bsr {
 void spn__bsr_free(spn__bsr *a);
 /* Pattern and values of C = A B (C's square-matrix diagonal first when
  * diag_first), a temporary (plain malloc). false on out of memory. */
-/* Memory for a temporary product's blocks, kept from one product to the
- * next: the setup's A P of each level is read once and freed, and the next
- * level's, smaller, fits in it. Its first touch is what a fresh array costs
- * most in a VM (the 1M web: 300 MB of the coarse levels' A P). */
-typedef struct spn__bsr_keep {
-    uint32_t *col;
-    double *val;
-    size_t cap; /* blocks */
-} spn__bsr_keep;
-/* keep: NULL, or memory to take C's blocks from when it is large enough. */
-bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, spn__bsr_keep *keep,
-                  int threads);
-/* Frees C, its blocks' memory into keep when at least as large as keep's. */
-void spn__bsr_keep_back(spn__bsr_keep *keep, spn__bsr *c);
-void spn__bsr_keep_free(spn__bsr_keep *keep);
+bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, int threads);
 /* The Galerkin product C = R (A P), R = P^T, A symmetric: diagonal first,
  * the blocks above the diagonal computed and those below mirrored from them
  * (C exactly symmetric). false on out of memory. */

@@ -306,7 +306,7 @@ static bool smoothed_prolongator(mg_level *L, uint32_t nc, int threads)
 
 /* Aggregate level l; build P (smoothed, or P0 on a dense level), R = P^T
  * and level l + 1 = R (A P). */
-static bool add_level(spn__mg *mg, int l, spn__bsr_keep *keep)
+static bool add_level(spn__mg *mg, int l)
 {
     mg_level *L = &mg->lv[l], *C = &mg->lv[l + 1];
     uint32_t n = L->A.rows;
@@ -334,9 +334,9 @@ static bool add_level(spn__mg *mg, int l, spn__bsr_keep *keep)
             P->val[9 * (size_t)i] = P->val[9 * (size_t)i + 4] = P->val[9 * (size_t)i + 8] = 1;
         }
     }
-    ok = ok && spn__bsr_mul(&L->A, &L->P, &ap, false, keep, mg->threads) &&
-         spn__bsr_transpose(&L->P, &L->R, &rperm, mg->threads) && spn__bsr_galerkin(&L->R, &ap, &C->A, mg->threads);
-    spn__bsr_keep_back(keep, &ap);
+    ok = ok && spn__bsr_mul(&L->A, &L->P, &ap, false, mg->threads) && spn__bsr_transpose(&L->P, &L->R, &rperm, mg->threads) &&
+         spn__bsr_galerkin(&L->R, &ap, &C->A, mg->threads);
+    spn__bsr_free(&ap);
     free(rperm);
     if (!ok) return false;
     size_t n3 = 3 * (size_t)(nc ? nc : 1);
@@ -397,21 +397,13 @@ static spn_status build(spn__mg *mg, const spn__eq *e, const double *inv0)
     /* NULL: too many lines, or no memory; the cycle goes without */
     if (e->hs) mg->slide = spn__slide_build(e, L0->lines);
     mg->nlevels = 1;
-    spn__bsr_keep keep = {0};
     while (mg->nlevels < MAX_LEVELS && mg->lv[mg->nlevels - 1].A.rows > COARSEST) {
         int l = mg->nlevels - 1;
-        if (!add_level(mg, l, &keep)) {
-            spn__bsr_keep_free(&keep);
-            return SPN_ERR_NOMEM;
-        }
+        if (!add_level(mg, l)) return SPN_ERR_NOMEM;
         mg->nlevels++;
-        if (!level_inverse(&mg->lv[l + 1])) {
-            spn__bsr_keep_free(&keep);
-            return SPN_ERR_UNSTABLE;
-        }
+        if (!level_inverse(&mg->lv[l + 1])) return SPN_ERR_UNSTABLE;
         if ((uint64_t)mg->lv[l + 1].A.rows * 10 > (uint64_t)mg->lv[l].A.rows * 9) break; /* stalled */
     }
-    spn__bsr_keep_free(&keep);
     size_t N = 3 * (size_t)mg->lv[mg->nlevels - 1].A.rows;
     if (mg->nlevels > 1 && N <= 3 * DENSE_MAX) {
         mg->dense = spn__big_alloc((N ? N * N : 1) * sizeof *mg->dense);
