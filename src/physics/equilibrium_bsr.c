@@ -16,17 +16,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Blocks of work below which a loop stays on one thread. By work, not rows:
- * a coarse level's rows are few and long (the 1M web's level 3: 5,326 rows
- * of 145 blocks), and until 2026-11-22 a threshold of 16,384 rows kept the
- * setup's densest products and those levels' products with vectors on one
- * thread. Rows are independent, so any team gives the same bits. */
-#define PAR_MIN 65536.0
-
-#define PAR_MIN_PRODUCTS 1e6 /* block products below which a matrix product stays on one thread */
-
-static inline int team(double blocks, int threads) { return blocks < PAR_MIN ? 1 : threads; }
-static inline int team_rows(const spn__bsr *a, int threads) { return team((double)a->start[a->rows], threads); }
+/* Threads by work, not rows: a coarse level's rows are few and long (the
+ * 1M web's level 3: 5,326 rows of 145 blocks), and until 2026-11-22 a
+ * threshold of 16,384 rows kept the setup's densest products and those
+ * levels' products with vectors on one thread. Loops over a matrix's blocks
+ * share out from SPN__BSR_PAR_MIN blocks (equilibrium_bsr.h), matrix
+ * products from PAR_MIN_PRODUCTS block products. Rows are independent, so
+ * any team gives the same bits. */
+#define PAR_MIN_PRODUCTS 1e6
 
 void spn__bsr_free(spn__bsr *a)
 {
@@ -192,7 +189,7 @@ static void row_values(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32
  * above it: C_ij = C_ji^T (row j found by a scan: rows are short). */
 static void mirror_lower(spn__bsr *c, int threads)
 {
-#pragma omp parallel for schedule(static) num_threads(team_rows(c, threads))
+#pragma omp parallel for schedule(static) num_threads(spn__bsr_team(c, threads))
     for (uint32_t i = 0; i < c->rows; i++)
         for (uint32_t q = c->start[i]; q < c->start[i + 1]; q++) {
             uint32_t j = c->col[q], t = c->start[j];
@@ -308,7 +305,7 @@ bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm_out, int
 void spn__bsr_transpose_values(const spn__bsr *a, spn__bsr *t, const uint32_t *perm, int threads)
 {
     const uint32_t nnz = t->start[t->rows];
-#pragma omp parallel for schedule(static) num_threads(team(nnz, threads))
+#pragma omp parallel for schedule(static) num_threads(nnz < SPN__BSR_PAR_MIN ? 1 : threads)
     for (uint32_t q = 0; q < nnz; q++) {
         const double *s = a->val + 9 * (size_t)perm[q];
         double *d = t->val + 9 * (size_t)q;
@@ -399,7 +396,7 @@ __attribute__((target("avx"))) static inline void row_sum_avx(const spn__bsr *a,
 __attribute__((target("avx"))) static void rows_avx(const spn__bsr *a, const double *b, const double *x, double *y,
                                                     bool add, int threads)
 {
-#pragma omp parallel for schedule(static) num_threads(team_rows(a, threads))
+#pragma omp parallel for schedule(static) num_threads(spn__bsr_team(a, threads))
     for (uint32_t i = 0; i < a->rows; i++) {
         double s[3], *o = y + 3 * (size_t)i;
         row_sum_avx(a, i, a->start[i], x, s);
@@ -431,7 +428,7 @@ static void rows(const spn__bsr *a, const double *b, const double *x, double *y,
         return;
     }
 #endif
-#pragma omp parallel for schedule(static) num_threads(team_rows(a, threads))
+#pragma omp parallel for schedule(static) num_threads(spn__bsr_team(a, threads))
     for (uint32_t i = 0; i < a->rows; i++) {
         double s[3], *o = y + 3 * (size_t)i;
         row_sum(a, i, a->start[i], x, s);

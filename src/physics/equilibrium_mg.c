@@ -256,7 +256,7 @@ static bool smoothed_prolongator(mg_level *L, uint32_t nc, int threads)
     const uint32_t n = A->rows, per = nc ? nc : 1;
     /* rows are independent: each thread marks its rows' aggregates in its
      * own arrays (the same bits on any team) */
-    const int nt = (double)A->start[n] < 65536.0 ? 1 : threads;
+    const int nt = spn__bsr_team(A, threads);
     uint32_t *marks = malloc(2 * (size_t)nt * per * sizeof *marks);
     spn__bsr *P = &L->P;
     P->rows = n, P->cols = nc;
@@ -334,8 +334,8 @@ static bool add_level(spn__mg *mg, int l)
             P->val[9 * (size_t)i] = P->val[9 * (size_t)i + 4] = P->val[9 * (size_t)i + 8] = 1;
         }
     }
-    ok = ok && spn__bsr_mul(&L->A, &L->P, &ap, false, mg->threads) && spn__bsr_transpose(&L->P, &L->R, &rperm, mg->threads) &&
-         spn__bsr_galerkin(&L->R, &ap, &C->A, mg->threads);
+    ok = ok && spn__bsr_mul(&L->A, &L->P, &ap, false, mg->threads) &&
+         spn__bsr_transpose(&L->P, &L->R, &rperm, mg->threads) && spn__bsr_galerkin(&L->R, &ap, &C->A, mg->threads);
     spn__bsr_free(&ap);
     free(rperm);
     if (!ok) return false;

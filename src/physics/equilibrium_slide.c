@@ -44,9 +44,10 @@ struct spn__slide {
     double *ptan;       /* 3 per entry: the line's unit tangent at the particle */
     double *c;          /* nz x nz: C, then its Cholesky factor (lower, row-major) */
     double *w;          /* nz */
-    /* the same entries by coarse unknown, for Z^T r: each unknown's entries
-     * in the order of their particles, so each sum adds its terms in the
-     * order the loop over particles did */
+    /* the same entries by coarse unknown, for Z^T r on several threads (or
+     * NULL: on one, and below SLIDE_PAR_MIN): each unknown's entries in the
+     * order of their particles, so each sum adds its terms in the order the
+     * loop over particles does */
     uint32_t *zstart;   /* nz + 1 */
     uint32_t *zq, *zp;  /* per entry: the entry, its particle */
 };
@@ -109,11 +110,16 @@ spn__slide *spn__slide_build(const spn__eq *e, const spn__lines *L)
     }
     S->c = spn__big_alloc((nz ? (size_t)nz * nz : 1) * sizeof *S->c);
     S->w = spn__big_alloc((nz ? nz : 1) * sizeof *S->w);
+    if (!S->c || !S->w) {
+        spn__slide_free(S);
+        return NULL;
+    }
+    if (e->n < SLIDE_PAR_MIN || e->threads < 2) return S;
     const uint32_t entries = S->pstart[e->n];
     S->zstart = calloc((size_t)nz + 1, sizeof *S->zstart);
     S->zq = spn__big_alloc((entries ? entries : 1) * sizeof *S->zq);
     S->zp = spn__big_alloc((entries ? entries : 1) * sizeof *S->zp);
-    if (!S->c || !S->w || !S->zstart || !S->zq || !S->zp) {
+    if (!S->zstart || !S->zq || !S->zp) {
         spn__slide_free(S);
         return NULL;
     }
@@ -195,7 +201,7 @@ void spn__slide_correct(const spn__slide *S, const spn__eq *e, const double *r, 
     /* Z^T r: on one thread in one loop over the particles, reading r in
      * order; on more, unknown by unknown, each over its particles in order
      * (the same sums, but gathered: a radial's particles are a ring apart) */
-    if (nt == 1) {
+    if (!S->zstart) {
         memset(w, 0, N * sizeof *w);
         for (uint32_t p = 0; p < e->n; p++)
             for (uint32_t q = S->pstart[p]; q < S->pstart[p + 1]; q++) {
