@@ -153,6 +153,22 @@ MATVEC_LANES(matvec_lanes, double, lane_val, lane_diag)
 MATVEC_LANES(matvec_lanes32, float, lane_val32, lane_diag32)
 #undef MATVEC_LANES
 
+/* Rows of the groups [g0, g1) of A p: by lanes (float64 or float32
+ * blocks), or row by row where a group has a hub row. */
+static void matvec_groups(const spn__eq *e, uint32_t g0, uint32_t g1, bool f32, const double *p, double *y)
+{
+    const uint32_t W = SPN__EQ_LANES;
+    for (uint32_t g = g0; g < g1; g++) {
+        if (!e->lane_by_row[g]) {
+            if (f32) matvec_lanes32(e, g, p, y);
+            else matvec_lanes(e, g, p, y);
+            continue;
+        }
+        for (uint32_t i = g * W; i < g * W + W && i < e->n; i++)
+            matvec_row(e->diag, e->adj_start, e->adj_col, e->offd, i, p, y);
+    }
+}
+
 /* y = A p and p . y, in fixed chunks of rows added in order. */
 double spn__eq_matvec_dot(const spn__eq *e, const double *p, double *y)
 {
@@ -160,14 +176,7 @@ double spn__eq_matvec_dot(const spn__eq *e, const double *p, double *y)
 #pragma omp parallel for schedule(static) num_threads(team(e, n))
     for (uint32_t c = 0; c < nchunks; c++) {
         uint32_t begin = c * SPN__EQ_CHUNK, end = (c + 1) * SPN__EQ_CHUNK < n ? (c + 1) * SPN__EQ_CHUNK : n;
-        for (uint32_t g = begin / W; g * W < end; g++) {
-            if (!e->lane_by_row[g]) {
-                matvec_lanes(e, g, p, y);
-                continue;
-            }
-            for (uint32_t i = g * W; i < g * W + W && i < n; i++)
-                matvec_row(e->diag, e->adj_start, e->adj_col, e->offd, i, p, y);
-        }
+        matvec_groups(e, begin / W, (end + W - 1) / W, false, p, y);
         double s0 = 0, s1 = 0, s2 = 0;
         for (uint32_t i = begin; i < end; i++) {
             const double *pi = p + 3 * (size_t)i, *yi = y + 3 * (size_t)i;
@@ -202,12 +211,5 @@ void spn__eq_matvec_mg(const spn__eq *e, const double *p, double *y)
     }
     const uint32_t n = e->n, W = SPN__EQ_LANES, groups = (n + W - 1) / W;
 #pragma omp parallel for schedule(static) num_threads(team(e, n))
-    for (uint32_t g = 0; g < groups; g++) {
-        if (!e->lane_by_row[g]) {
-            matvec_lanes32(e, g, p, y);
-            continue;
-        }
-        for (uint32_t i = g * W; i < g * W + W && i < n; i++)
-            matvec_row(e->diag, e->adj_start, e->adj_col, e->offd, i, p, y);
-    }
+    for (uint32_t g = 0; g < groups; g++) matvec_groups(e, g, g + 1, true, p, y);
 }

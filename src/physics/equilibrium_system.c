@@ -54,7 +54,8 @@ void spn__eq_free(spn__eq *e)
     free(e->adj_other);
     free(e->adj_col);
     free(e->offd);
-    free(e->lane_start), free(e->lane_by_row), free(e->lane_col), free(e->lane_val), free(e->lane_diag), free(e->lane_val32), free(e->lane_diag32);
+    free(e->lane_start), free(e->lane_by_row), free(e->lane_col), free(e->lane_val), free(e->lane_diag);
+    free(e->lane_val32), free(e->lane_diag32);
     free(e->hs);
     free(e->fs);
     free(e->diag);
