@@ -66,6 +66,11 @@
  * smoothed, the first setup no dearer (its level 4 has 656 rows); the 5k and
  * 100k webs keep 12 and 24 CG. */
 #define MAX_SMOOTHED_ROW 256.0
+/* A row longer than LONG_ROW_FACTOR times its level's mean and than
+ * LONG_ROW_MIN blocks (the hub, where every radial meets) keeps its
+ * tentative prolongator row: see smoothed_prolongator. */
+#define LONG_ROW_FACTOR 8.0
+#define LONG_ROW_MIN 64.0
 #define POWER_STEPS 10  /* power iterations for rho(D^-1 A) on coarse levels */
 /* Free particles above which the slide matrix is factored again at every
  * Newton step instead of kept from the first (see spn__mg_setup). */
@@ -249,11 +254,29 @@ static double spectral_radius(const mg_level *L, int threads)
  * did the same with three times the arithmetic and a matrix more memory.
  * (Keeping only the strong blocks, the weak ones lumped on the diagonal,
  * made the coarse levels sparser but the method weaker: 80 CG iterations
- * instead of 53 at 100k; measured.) */
+ * instead of 53 at 100k; measured.)
+ *
+ * Long rows (long_row) keep P0's row, one identity block. Smoothed, the
+ * hub's row of P would have a block for each aggregate among its 1,000
+ * radials, and the Galerkin product R A P puts the outer product of that
+ * row with itself into the next level: a dense 333 x 333 block there, and
+ * again below. On the 1M web that one row made 88% of level 1's block
+ * products (72M instead of 8.4M) and a third of the coarse levels' blocks
+ * (levels 1-3: 4.1M instead of 2.9M); kept tentative, the first setup
+ * took 2.5-3.0 s instead of 4.6 s (two threads) and the solve 45 -> 47 CG.
+ * Measured 2026-11-22; the 5k and 100k webs keep 12 and 24 CG, the species
+ * webs (hubs below the limit) their bits. */
+static bool long_row(const spn__bsr *A, uint32_t i, double limit)
+{
+    return A->start[i + 1] - A->start[i] > limit;
+}
+
 static bool smoothed_prolongator(mg_level *L, uint32_t nc, int threads)
 {
     const spn__bsr *A = &L->A;
     const uint32_t n = A->rows, per = nc ? nc : 1;
+    const double mean = n ? (double)A->start[n] / n : 0,
+                 limit = LONG_ROW_FACTOR * mean > LONG_ROW_MIN ? LONG_ROW_FACTOR * mean : LONG_ROW_MIN;
     /* rows are independent: each thread marks its rows' aggregates in its
      * own arrays (the same bits on any team) */
     const int nt = spn__bsr_team(A, threads);
@@ -270,6 +293,10 @@ static bool smoothed_prolongator(mg_level *L, uint32_t nc, int threads)
 #pragma omp parallel for schedule(static) num_threads(nt)
     for (uint32_t i = 0; i < n; i++) {
         uint32_t *mark = marks + (size_t)spn__thread_num() * per, cnt = 0;
+        if (long_row(A, i, limit)) {
+            P->start[i + 1] = 1;
+            continue;
+        }
         for (uint32_t p = A->start[i]; p < A->start[i + 1]; p++) {
             uint32_t g = L->agg[A->col[p]];
             if (mark[g] != i) mark[g] = i, cnt++;
@@ -292,6 +319,12 @@ static bool smoothed_prolongator(mg_level *L, uint32_t nc, int threads)
         double di[9] = {-L->omega * d[0], -L->omega * d[3], -L->omega * d[4], -L->omega * d[3], -L->omega * d[1],
                         -L->omega * d[5], -L->omega * d[4], -L->omega * d[5], -L->omega * d[2]};
         uint32_t cnt = P->start[i];
+        if (long_row(A, i, limit)) { /* P0's row */
+            double *pv = P->val + 9 * (size_t)cnt;
+            P->col[cnt] = L->agg[i];
+            pv[0] = pv[4] = pv[8] = 1;
+            continue;
+        }
         for (uint32_t p = A->start[i]; p < A->start[i + 1]; p++) {
             uint32_t c = A->col[p], g = L->agg[c];
             if (mark[g] != i) mark[g] = i, pos[g] = cnt, P->col[cnt++] = g;
@@ -316,8 +349,8 @@ static bool add_level(spn__mg *mg, int l)
     if (!L->agg) return false;
     uint32_t nc = aggregate(&L->A, L->agg, THETA);
     bool ok = nc > 0;
-    /* smoothing widens the stencil a level at a time (5, 12, 46, 96 blocks a
-     * row on the 100k web, 5, 12, 41, 145 on the 1M web): dense levels keep P0 */
+    /* smoothing widens the stencil a level at a time (5, 10, 22, 45 blocks a
+     * row on the 100k web, 5, 10, 27, 63 on the 1M web): dense levels keep P0 */
     if (ok && (double)L->A.start[n] <= MAX_SMOOTHED_ROW * n) {
         L->omega = 4.0 / (3.0 * (l == 0 ? 2.0 : spectral_radius(L, mg->threads)));
         ok = smoothed_prolongator(L, nc, mg->threads);
