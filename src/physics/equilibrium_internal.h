@@ -126,6 +126,9 @@ bool spn__sym_inverse(const double *h, double *inv);
 spn_status spn__mg_setup(spn__mg **mg, const spn__eq *e, const double *inv0);
 void spn__mg_apply(const spn__mg *mg, const spn__eq *e, const double *r, double *z);
 void spn__mg_free(spn__mg *mg);
+/* Level l of a built hierarchy: its rows, its blocks and its longest row's
+ * blocks (for tests and diagnostics); false when there is no level l. */
+bool spn__mg_level(const spn__mg *mg, int l, uint32_t *rows, uint32_t *blocks, uint32_t *longest);
 
 /* Thread-line smoother (equilibrium_lines.c) over level 0 of the multigrid. */
 typedef struct spn__lines spn__lines;

@@ -417,6 +417,17 @@ void spn__mg_free(spn__mg *mg)
     free(mg);
 }
 
+bool spn__mg_level(const spn__mg *mg, int l, uint32_t *rows, uint32_t *blocks, uint32_t *longest)
+{
+    if (!mg || l < 0 || l >= mg->nlevels) return false;
+    const spn__bsr *A = &mg->lv[l].A;
+    uint32_t widest = 0;
+    for (uint32_t i = 0; i < A->rows; i++)
+        if (A->start[i + 1] - A->start[i] > widest) widest = A->start[i + 1] - A->start[i];
+    *rows = A->rows, *blocks = A->start[A->rows], *longest = widest;
+    return true;
+}
+
 static spn_status build(spn__mg *mg, const spn__eq *e, const double *inv0)
 {
     mg->threads = e->threads;
