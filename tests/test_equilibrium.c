@@ -353,17 +353,26 @@ static void test_same_bits_twice_and_with_two_threads(void **state)
  * aggregation it replaced needed 168 at 5k and 648 at 100k). Measured: 13
  * (1k) and 18 (20k); without the thread slides 20 and 32, which these
  * bounds reject; block Jacobi 421 at 5k. */
+/* The standard web's solve: its pretension T0 the force scale, T0 spread
+ * over the free particles as an out-of-plane load. */
+static spn_equilibrium_def loaded_def(const spn_world *w, spn_precond pc)
+{
+    spn_orb_scene_def od = spn_orb_scene_def_default();
+    uint32_t nfree = 0;
+    for (uint32_t i = 0; i < spn_world_particle_count(w); i++) nfree += !spn_world_is_fixed(w, i);
+    spn_equilibrium_def d = spn_equilibrium_def_default();
+    d.force_scale = od.ea * od.prestrain;
+    d.load = spn_v3(0, 0, d.force_scale / nfree);
+    d.preconditioner = pc;
+    return d;
+}
+
 static int multigrid_cg(int rings, int radials)
 {
     spn_orb_scene_def od = spn_orb_scene_def_default();
     double t0 = od.ea * od.prestrain;
     spn_world *w = small_orb(rings, radials, od.prestrain, 1);
-    uint32_t nfree = 0;
-    for (uint32_t i = 0; i < spn_world_particle_count(w); i++) nfree += !spn_world_is_fixed(w, i);
-    spn_equilibrium_def d = spn_equilibrium_def_default();
-    d.load = spn_v3(0, 0, t0 / nfree);
-    d.force_scale = t0;
-    d.preconditioner = SPN_PRECOND_MULTIGRID;
+    spn_equilibrium_def d = loaded_def(w, SPN_PRECOND_MULTIGRID);
     spn_equilibrium_report r;
     assert_int_equal(spn_world_equilibrium(w, &d, &r), SPN_OK);
     assert_int_equal(r.reason, SPN_EQUILIBRIUM_CONVERGED);
@@ -434,23 +443,11 @@ static void test_species_web_multigrid(void **state)
  * a 400-radial hub, its hierarchy built through the internal setup: level 1
  * measured 71,565 blocks, 53.8 a row, with the hub's row smoothed, and
  * 20,215, 15.2 a row, with the rule (2026-11-22). */
-static spn_equilibrium_def hub_web_def(spn_world *w, spn_precond pc)
-{
-    spn_orb_scene_def od = spn_orb_scene_def_default();
-    uint32_t nfree = 0;
-    for (uint32_t i = 0; i < spn_world_particle_count(w); i++) nfree += !spn_world_is_fixed(w, i);
-    spn_equilibrium_def d = spn_equilibrium_def_default();
-    d.force_scale = od.ea * od.prestrain;
-    d.load = spn_v3(0, 0, d.force_scale / nfree);
-    d.preconditioner = pc;
-    return d;
-}
-
 static void test_hub_row_makes_no_dense_level(void **state)
 {
     (void)state;
     spn_world *w = small_orb(12, 400, 0.02, 1);
-    spn_equilibrium_def d = hub_web_def(w, SPN_PRECOND_MULTIGRID);
+    spn_equilibrium_def d = loaded_def(w, SPN_PRECOND_MULTIGRID);
     spn__eq e;
     assert_int_equal(spn__eq_init(&e, w, &d), SPN_OK);
     uint32_t worst = 0;
@@ -475,7 +472,7 @@ static void test_hub_web_settles_as_block_jacobi_does(void **state)
 {
     (void)state;
     spn_world *a = small_orb(12, 400, 0.02, 1), *b = small_orb(12, 400, 0.02, 1);
-    spn_equilibrium_def dm = hub_web_def(a, SPN_PRECOND_MULTIGRID), dj = hub_web_def(b, SPN_PRECOND_BLOCK_JACOBI);
+    spn_equilibrium_def dm = loaded_def(a, SPN_PRECOND_MULTIGRID), dj = loaded_def(b, SPN_PRECOND_BLOCK_JACOBI);
     spn_equilibrium_report rm, rj;
     assert_int_equal(spn_world_equilibrium(a, &dm, &rm), SPN_OK);
     assert_int_equal(spn_world_equilibrium(b, &dj, &rj), SPN_OK);
