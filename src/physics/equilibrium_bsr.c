@@ -214,9 +214,12 @@ static bool mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_fir
     memset(c, 0, sizeof *c);
     c->rows = a->rows;
     c->cols = b->cols;
-    /* the block products of A B, about (rows of A vary, hence dynamic
-     * chunks); from PAR_MIN_PRODUCTS: the 5k web's level-0 A P (65,000)
-     * took 18.4 -> 22.3 ms wall on two threads when shared */
+    /* the block products of A B, estimated from B's mean row (rows of A
+     * vary, hence dynamic chunks); from PAR_MIN_PRODUCTS: the 5k web's
+     * level-0 A P (65,000) took 18.4 -> 22.3 ms wall on two threads when
+     * shared. Only the team hangs on it: where long rows of A meet long rows
+     * of B it undercounts (the 1M web's level 1 before the hub rule of
+     * equilibrium_mg.c: 10.6M estimated, 72M counted) */
     const double products = (double)a->start[a->rows] * b->start[b->rows] / (b->rows ? b->rows : 1);
     int nt = products < PAR_MIN_PRODUCTS ? 1 : threads;
     size_t per = b->cols ? b->cols : 1;

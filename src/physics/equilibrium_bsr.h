@@ -35,8 +35,6 @@ typedef struct spn__bsr {
 } spn__bsr;
 
 void spn__bsr_free(spn__bsr *a);
-/* Pattern and values of C = A B (C's square-matrix diagonal first when
- * diag_first), a temporary (plain malloc). false on out of memory. */
 /* Blocks from which a loop over a matrix's rows shares them out. */
 #define SPN__BSR_PAR_MIN 65536.0
 /* The team for a loop over the rows of a: threads, or 1 below SPN__BSR_PAR_MIN blocks. */
@@ -44,6 +42,8 @@ static inline int spn__bsr_team(const spn__bsr *a, int threads)
 {
     return (double)a->start[a->rows] < SPN__BSR_PAR_MIN ? 1 : threads;
 }
+/* Pattern and values of C = A B (C's square-matrix diagonal first when
+ * diag_first), a temporary (plain malloc). false on out of memory. */
 bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, int threads);
 /* The Galerkin product C = R (A P), R = P^T, A symmetric: diagonal first,
  * the blocks above the diagonal computed and those below mirrored from them
