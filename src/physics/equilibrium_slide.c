@@ -36,6 +36,7 @@
 #define SLIDE_MAX 3000u
 /* Free particles from which the assembly and the correction use threads. */
 #define SLIDE_PAR_MIN 16384u
+static inline int slide_team(const spn__eq *e) { return e->n < SLIDE_PAR_MIN ? 1 : e->threads; }
 /* Entries ahead of Z^T r's sum whose r is prefetched: an unknown's
  * particles are a ring apart, beyond the hardware prefetcher's reach (1M
  * web: 0.47 s of the solve without, 0.38-0.40 s with 48 ahead) */
@@ -119,7 +120,7 @@ spn__slide *spn__slide_build(const spn__eq *e, const spn__lines *L)
         spn__slide_free(S);
         return NULL;
     }
-    if (e->n < SLIDE_PAR_MIN || e->threads < 2) return S;
+    if (slide_team(e) < 2) return S;
     const uint32_t entries = S->pstart[e->n];
     S->zstart = calloc((size_t)nz + 1, sizeof *S->zstart);
     S->ztan = spn__big_alloc(3 * (size_t)(entries ? entries : 1) * sizeof *S->ztan);
@@ -176,7 +177,7 @@ bool spn__slide_factor(spn__slide *S, const spn__eq *e)
 {
     const size_t N = S->nz;
     double *f = S->c;
-    const int nt = e->n < SLIDE_PAR_MIN ? 1 : e->threads;
+    const int nt = slide_team(e);
 #pragma omp parallel num_threads(nt)
     {
         const uint32_t t = (uint32_t)spn__thread_num(), team = (uint32_t)spn__thread_count();
@@ -203,7 +204,7 @@ void spn__slide_correct(const spn__slide *S, const spn__eq *e, const double *r, 
     const size_t N = S->nz;
     const double *f = S->c;
     double *w = S->w;
-    const int nt = e->n < SLIDE_PAR_MIN ? 1 : e->threads;
+    const int nt = slide_team(e);
     /* Z^T r: on one thread in one loop over the particles, reading r in
      * order; on more, unknown by unknown, each over its particles in order
      * (the same sums, but gathered: a radial's particles are a ring apart;
