@@ -329,11 +329,13 @@ void spn__bsr_transpose_values(const spn__bsr *a, spn__bsr *t, const uint32_t *p
  * (The sums in block order, m0 v0 + m1 v1 + m2 v2 added to s each block,
  * took half as many vector instructions again with AVX but would give other
  * bits on a machine without it.) */
-static inline void row_sum(const spn__bsr *a, uint32_t i, uint32_t p0, const double *x, double *s)
+static inline void row_sum_split(const spn__bsr *a, uint32_t i, uint32_t p0, const double *x, const double *xo,
+                                 uint32_t lo, uint32_t span, double *s)
 {
     double l[2][9] = {{0, 0, 0, 0, 0, 0, 0, 0, 0}, {0, 0, 0, 0, 0, 0, 0, 0, 0}};
     for (uint32_t p = p0; p < a->start[i + 1]; p++) {
-        const double *v = x + 3 * (size_t)a->col[p];
+        const uint32_t c = a->col[p];
+        const double *v = (c - lo < span ? x : xo) + 3 * (size_t)c;
         double m[9], *o = l[(p - p0) & 1u];
         for (int k = 0; k < 9; k++) m[k] = a->val ? a->val[9 * (size_t)p + k] : (double)a->fval[9 * (size_t)p + k];
         for (int r = 0; r < 3; r++) {
@@ -344,6 +346,11 @@ static inline void row_sum(const spn__bsr *a, uint32_t i, uint32_t p0, const dou
     }
     for (int r = 0; r < 3; r++)
         s[r] = (l[0][3 * r] + l[1][3 * r] + (l[0][3 * r + 1] + l[1][3 * r + 1])) + (l[0][3 * r + 2] + l[1][3 * r + 2]);
+}
+
+static inline void row_sum(const spn__bsr *a, uint32_t i, uint32_t p0, const double *x, double *s)
+{
+    row_sum_split(a, i, p0, x, x, 0, UINT32_MAX, s);
 }
 
 #if SPN__AVX
@@ -357,20 +364,20 @@ static inline void row_sum(const spn__bsr *a, uint32_t i, uint32_t p0, const dou
     __m256d r0 = _mm256_cvtps_pd(_mm_loadu_ps(m)), r1 = _mm256_cvtps_pd(_mm_loadu_ps((m) + 3));                     \
     __m256d r2 = _mm256_cvtps_pd(_mm_loadu_ps((m) + 6))
 
-#define ROW_SUM_AVX(T, ROWS)                                                                                         \
+#define ROW_SUM_AVX(T, ROWS, SRC)                                                                                       \
     __m256d l0 = _mm256_setzero_pd(), l1 = l0, l2 = l0, k0 = l0, k1 = l0, k2 = l0;                                   \
     uint32_t p = p0;                                                                                                 \
     const uint32_t p1 = a->start[i + 1];                                                                             \
     for (; p < p1; p++) {                                                                                            \
         const T *m = vals + 9 * (size_t)p;                                                                           \
-        const double *v = x + 3 * (size_t)a->col[p];                                                                 \
+        const double *v = SRC(a->col[p]) + 3 * (size_t)a->col[p];                                                    \
         __m256d v4 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(v)), _mm_load_sd(v + 2), 1);          \
         ROWS(m, m0, m1, m2);                                                                                         \
         l0 = _mm256_add_pd(l0, _mm256_mul_pd(m0, v4));                                                               \
         l1 = _mm256_add_pd(l1, _mm256_mul_pd(m1, v4));                                                               \
         l2 = _mm256_add_pd(l2, _mm256_mul_pd(m2, v4));                                                               \
         if (++p == p1) break;                                                                                        \
-        m = vals + 9 * (size_t)p, v = x + 3 * (size_t)a->col[p];                                                     \
+        m = vals + 9 * (size_t)p, v = SRC(a->col[p]) + 3 * (size_t)a->col[p];                                        \
         v4 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(v)), _mm_load_sd(v + 2), 1);                  \
         ROWS(m, n0, n1, n2);                                                                                         \
         k0 = _mm256_add_pd(k0, _mm256_mul_pd(n0, v4));                                                               \
@@ -382,16 +389,33 @@ static inline void row_sum(const spn__bsr *a, uint32_t i, uint32_t p0, const dou
     _mm256_storeu_pd(t, l0), _mm256_storeu_pd(t + 4, l1), _mm256_storeu_pd(t + 8, l2);                               \
     for (int r = 0; r < 3; r++) s[r] = (t[4 * r] + t[4 * r + 1]) + t[4 * r + 2]
 
+#define SRC_ONE(c) x
+#define SRC_SPLIT(c) ((c) - lo < span ? x : xo)
+
 /* row_sum on 256-bit vectors: lanes (m_r0 v0, m_r1 v1, m_r2 v2, 0). */
 __attribute__((target("avx"))) static inline void row_sum_avx(const spn__bsr *a, uint32_t i, uint32_t p0,
                                                                const double *x, double *s)
 {
     if (a->val) {
         const double *vals = a->val;
-        ROW_SUM_AVX(double, ROWS_D);
+        ROW_SUM_AVX(double, ROWS_D, SRC_ONE);
     } else {
         const float *vals = a->fval;
-        ROW_SUM_AVX(float, ROWS_F);
+        ROW_SUM_AVX(float, ROWS_F, SRC_ONE);
+    }
+}
+
+/* row_sum_split on 256-bit vectors */
+__attribute__((target("avx"))) static inline void row_sum_split_avx(const spn__bsr *a, uint32_t i, uint32_t p0,
+                                                                     const double *x, const double *xo, uint32_t lo,
+                                                                     uint32_t span, double *s)
+{
+    if (a->val) {
+        const double *vals = a->val;
+        ROW_SUM_AVX(double, ROWS_D, SRC_SPLIT);
+    } else {
+        const float *vals = a->fval;
+        ROW_SUM_AVX(float, ROWS_F, SRC_SPLIT);
     }
 }
 
@@ -409,14 +433,14 @@ __attribute__((target("avx"))) static void rows_avx(const spn__bsr *a, const dou
     }
 }
 
-__attribute__((target("avx"))) static void gauss_seidel_avx(const spn__bsr *a, const double *dinv, const double *b,
-                                                            double *x, bool forward)
+__attribute__((target("avx"))) static void gauss_seidel_part_avx(const spn__bsr *a, const double *dinv,
+                                                                 const double *b, double *x, const double *xo,
+                                                                 uint32_t lo, uint32_t hi, bool forward)
 {
-    const uint32_t n = a->rows;
-    for (uint32_t k = 0; k < n; k++) {
-        uint32_t i = forward ? k : n - 1 - k;
+    for (uint32_t k = lo; k < hi; k++) {
+        uint32_t i = forward ? k : hi - 1 - (k - lo);
         double s[3];
-        row_sum_avx(a, i, a->start[i] + 1, x, s); /* the diagonal is first */
+        row_sum_split_avx(a, i, a->start[i] + 1, x, xo, lo, hi - lo, s); /* the diagonal is first */
         s[0] = b[3 * i] - s[0], s[1] = b[3 * i + 1] - s[1], s[2] = b[3 * i + 2] - s[2];
         spn__sym_mul(dinv + 6 * (size_t)i, s, x + 3 * (size_t)i);
     }
@@ -451,22 +475,46 @@ void spn__bsr_residual(const spn__bsr *a, const double *b, const double *x, doub
     rows(a, b, x, r, false, threads);
 }
 
-void spn__bsr_gauss_seidel(const spn__bsr *a, const double *dinv, const double *b, double *x, bool forward)
+static void gauss_seidel_part(const spn__bsr *a, const double *dinv, const double *b, double *x, const double *xo,
+                              uint32_t lo, uint32_t hi, bool forward)
 {
 #if SPN__AVX
     if (spn__have_avx()) {
-        gauss_seidel_avx(a, dinv, b, x, forward);
+        gauss_seidel_part_avx(a, dinv, b, x, xo, lo, hi, forward);
         return;
     }
 #endif
-    const uint32_t n = a->rows;
-    for (uint32_t k = 0; k < n; k++) {
-        uint32_t i = forward ? k : n - 1 - k;
+    for (uint32_t k = lo; k < hi; k++) {
+        uint32_t i = forward ? k : hi - 1 - (k - lo);
         double s[3];
-        row_sum(a, i, a->start[i] + 1, x, s); /* the diagonal is first */
+        row_sum_split(a, i, a->start[i] + 1, x, xo, lo, hi - lo, s); /* the diagonal is first */
         s[0] = b[3 * i] - s[0], s[1] = b[3 * i + 1] - s[1], s[2] = b[3 * i + 2] - s[2];
         spn__sym_mul(dinv + 6 * (size_t)i, s, x + 3 * (size_t)i);
     }
+}
+
+uint32_t spn__bsr_gs_parts(const spn__bsr *a)
+{
+    uint32_t k = 1;
+    while (2 * k <= SPN__BSR_GS_MAX_PARTS && (uint64_t)a->rows >= 2 * (uint64_t)k * SPN__BSR_GS_PART_ROWS) k *= 2;
+    return k;
+}
+
+void spn__bsr_gauss_seidel(const spn__bsr *a, const double *dinv, const double *b, double *x, bool forward,
+                           double *scratch, int threads)
+{
+    const uint32_t n = a->rows, parts = spn__bsr_gs_parts(a);
+    if (parts == 1) {
+        gauss_seidel_part(a, dinv, b, x, x, 0, n, forward);
+        return;
+    }
+    /* the other parts' values as they were when the sweep began */
+    memcpy(scratch, x, 3 * (size_t)n * sizeof *x);
+    const int team = threads < (int)parts ? threads : (int)parts;
+#pragma omp parallel for schedule(static) num_threads(team)
+    for (uint32_t q = 0; q < parts; q++)
+        gauss_seidel_part(a, dinv, b, x, scratch, (uint32_t)((uint64_t)n * q / parts),
+                          (uint32_t)((uint64_t)n * (q + 1) / parts), forward);
 }
 
 /* Sum of a[q] b[q], q < n, in four running sums (fixed order, so the same

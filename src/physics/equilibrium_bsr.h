@@ -63,8 +63,19 @@ void spn__bsr_apply(const spn__bsr *a, const double *x, double *y, bool add, int
 /* r = b - A x. */
 void spn__bsr_residual(const spn__bsr *a, const double *b, const double *x, double *r, int threads);
 /* One block Gauss-Seidel sweep in place, rows in order (forward) or reverse;
- * dinv: 6 per row, the inverted (symmetric) diagonal blocks. */
-void spn__bsr_gauss_seidel(const spn__bsr *a, const double *dinv, const double *b, double *x, bool forward);
+ * dinv: 6 per row, the inverted (symmetric) diagonal blocks.
+ *
+ * A matrix of 2 SPN__BSR_GS_PART_ROWS rows or more is swept in parts (a
+ * power of two of them, at most SPN__BSR_GS_MAX_PARTS, each at least
+ * SPN__BSR_GS_PART_ROWS rows), each part on its own and in parallel: a row
+ * reads its own part's values as the sweep leaves them and the other parts'
+ * as they were when it began (copied into scratch, 3 rows doubles). The parts
+ * depend only on the matrix, so the result is the same bits on any team. */
+#define SPN__BSR_GS_PART_ROWS 2048u
+#define SPN__BSR_GS_MAX_PARTS 8u
+uint32_t spn__bsr_gs_parts(const spn__bsr *a);
+void spn__bsr_gauss_seidel(const spn__bsr *a, const double *dinv, const double *b, double *x, bool forward,
+                           double *scratch, int threads);
 
 /* Dense Cholesky A = L L^T in place: f is n x n row-major, its lower
  * triangle read and overwritten with L. False when A is not positive

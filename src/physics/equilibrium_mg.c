@@ -503,7 +503,7 @@ static void smooth(const spn__mg *mg, int l, const double *b, double *x, bool fo
 {
     const mg_level *L = &mg->lv[l];
     if (L->lines) spn__lines_sweep(L->lines, b, x, forward, mg->threads);
-    else spn__bsr_gauss_seidel(&L->A, L->dinv, b, x, forward);
+    else spn__bsr_gauss_seidel(&L->A, L->dinv, b, x, forward, L->r, mg->threads); /* r is free while smoothing */
 }
 
 /* x += Z C^-1 Z^T (b - A x) on level 0 (equilibrium_slide.c). */
@@ -524,8 +524,8 @@ static void vcycle(const spn__mg *mg, const spn__eq *e, int l, const double *b, 
     }
     if (l == mg->nlevels - 1) { /* symmetric: as many sweeps back as forth */
         memset(x, 0, 3 * (size_t)L->A.rows * sizeof *x);
-        for (int k = 0; k < COARSE_SWEEPS; k++) spn__bsr_gauss_seidel(&L->A, L->dinv, b, x, true);
-        for (int k = 0; k < COARSE_SWEEPS; k++) spn__bsr_gauss_seidel(&L->A, L->dinv, b, x, false);
+        for (int k = 0; k < COARSE_SWEEPS; k++) spn__bsr_gauss_seidel(&L->A, L->dinv, b, x, true, L->r, mg->threads);
+        for (int k = 0; k < COARSE_SWEEPS; k++) spn__bsr_gauss_seidel(&L->A, L->dinv, b, x, false, L->r, mg->threads);
         return;
     }
     memset(x, 0, 3 * (size_t)L->A.rows * sizeof *x);
