@@ -86,6 +86,9 @@ void spn__eq_matvec(const spn__eq *e, const double *p, double *y);
 double spn__eq_matvec_dot(const spn__eq *e, const double *p, double *y);
 /* y = A p for the multigrid's residuals: float32 blocks on large webs. */
 void spn__eq_matvec_mg(const spn__eq *e, const double *p, double *y);
+/* The same on the rows of groups [g0, g1) of SPN__EQ_LANES rows, on the
+ * calling thread: each row the same bits as in spn__eq_matvec_mg. */
+void spn__eq_matvec_mg_rows(const spn__eq *e, uint32_t g0, uint32_t g1, const double *p, double *y);
 /* p += alpha d, r -= alpha q; returns r . r and sets *rmax2 to the largest
  * |r_i|^2 of a particle. */
 double spn__eq_update(const spn__eq *e, double alpha, const double *d, const double *q, double *p, double *r,
@@ -145,8 +148,9 @@ typedef struct spn__slide spn__slide;
 spn__slide *spn__slide_build(const spn__eq *e, const spn__lines *L);
 /* C = Z^T A Z from the spring system's blocks and shift; false if not positive definite. */
 bool spn__slide_factor(spn__slide *S, const spn__eq *e);
-/* x += Z C^-1 Z^T r. */
-void spn__slide_correct(const spn__slide *S, const spn__eq *e, const double *r, double *x);
+/* x += Z C^-1 Z^T (b - A x), A x from spn__eq_matvec_mg; r (3 n) is
+ * scratch, left holding b - A x at the x it was given. */
+void spn__slide_correct(const spn__slide *S, const spn__eq *e, const double *b, double *x, double *r);
 void spn__slide_free(spn__slide *S);
 
 #endif

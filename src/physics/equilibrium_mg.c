@@ -509,10 +509,7 @@ static void smooth(const spn__mg *mg, int l, const double *b, double *x, bool fo
 /* x += Z C^-1 Z^T (b - A x) on level 0 (equilibrium_slide.c). */
 static void slide_correct(const spn__mg *mg, const spn__eq *e, const double *b, double *x)
 {
-    double *r = mg->lv[0].r;
-    spn__eq_matvec_mg(e, x, r);
-    for (uint32_t k = 0; k < 3 * e->n; k++) r[k] = b[k] - r[k];
-    spn__slide_correct(mg->slide, e, r, x);
+    spn__slide_correct(mg->slide, e, b, x, mg->lv[0].r);
 }
 
 static void vcycle(const spn__mg *mg, const spn__eq *e, int l, const double *b, double *x)

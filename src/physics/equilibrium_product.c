@@ -213,3 +213,8 @@ void spn__eq_matvec_mg(const spn__eq *e, const double *p, double *y)
 #pragma omp parallel for schedule(static) num_threads(team(e, n))
     for (uint32_t g = 0; g < groups; g++) matvec_groups(e, g, g + 1, true, p, y);
 }
+
+void spn__eq_matvec_mg_rows(const spn__eq *e, uint32_t g0, uint32_t g1, const double *p, double *y)
+{
+    matvec_groups(e, g0, g1, e->lane_val32 != NULL, p, y);
+}

@@ -37,10 +37,11 @@
 /* Free particles from which the assembly and the correction use threads. */
 #define SLIDE_PAR_MIN 16384u
 static inline int slide_team(const spn__eq *e) { return e->n < SLIDE_PAR_MIN ? 1 : e->threads; }
-/* Entries ahead of Z^T r's sum whose r is prefetched: an unknown's
- * particles are a ring apart, beyond the hardware prefetcher's reach (1M
- * web: 0.47 s of the solve without, 0.38-0.40 s with 48 ahead) */
-#define SLIDE_AHEAD 48u
+/* Parts of the particles that Z^T (b - A x) sums separately from
+ * SLIDE_PAR_MIN particles (then adds in order): fixed, so the same bits on
+ * any team; below, one, in particle order. */
+#define SLIDE_PARTS 16u
+static inline uint32_t slide_parts(const spn__eq *e) { return e->n < SLIDE_PAR_MIN ? 1 : SLIDE_PARTS; }
 
 struct spn__slide {
     uint32_t nz;        /* coarse unknowns: lines of two or more particles */
@@ -49,19 +50,13 @@ struct spn__slide {
     double *ptan;       /* 3 per entry: the line's unit tangent at the particle */
     double *c;          /* nz x nz: C, then its Cholesky factor (lower, row-major) */
     double *w;          /* nz */
-    /* the same entries by coarse unknown, for Z^T r on several threads (or
-     * NULL: on one, and below SLIDE_PAR_MIN): each unknown's entries in the
-     * order of their particles, so each sum adds its terms in the order the
-     * loop over particles does */
-    uint32_t *zstart;   /* nz + 1 */
-    double *ztan;       /* 3 per entry: its tangent, copied from ptan into this order */
-    uint32_t *zp;       /* per entry: its particle */
+    double *wpart;      /* nz per part (slide_parts): its particles' share of Z^T (b - A x) */
 };
 
 void spn__slide_free(spn__slide *S)
 {
     if (!S) return;
-    free(S->pstart), free(S->pcol), free(S->ptan), free(S->c), free(S->w), free(S->zstart), free(S->ztan), free(S->zp);
+    free(S->pstart), free(S->pcol), free(S->ptan), free(S->c), free(S->w), free(S->wpart);
     free(S);
 }
 
@@ -116,29 +111,11 @@ spn__slide *spn__slide_build(const spn__eq *e, const spn__lines *L)
     }
     S->c = spn__big_alloc((nz ? (size_t)nz * nz : 1) * sizeof *S->c);
     S->w = spn__big_alloc((nz ? nz : 1) * sizeof *S->w);
-    if (!S->c || !S->w) {
+    S->wpart = malloc((size_t)slide_parts(e) * (nz ? nz : 1) * sizeof *S->wpart);
+    if (!S->c || !S->w || !S->wpart) {
         spn__slide_free(S);
         return NULL;
     }
-    if (slide_team(e) < 2) return S;
-    const uint32_t entries = S->pstart[e->n];
-    S->zstart = calloc((size_t)nz + 1, sizeof *S->zstart);
-    S->ztan = spn__big_alloc(3 * (size_t)(entries ? entries : 1) * sizeof *S->ztan);
-    S->zp = spn__big_alloc((entries ? entries : 1) * sizeof *S->zp);
-    if (!S->zstart || !S->ztan || !S->zp) {
-        spn__slide_free(S);
-        return NULL;
-    }
-    for (uint32_t q = 0; q < entries; q++) S->zstart[S->pcol[q] + 1]++;
-    for (uint32_t z = 0; z < nz; z++) S->zstart[z + 1] += S->zstart[z];
-    for (uint32_t p = 0; p < e->n; p++) /* particles in order: a counting sort keeps it within each unknown */
-        for (uint32_t q = S->pstart[p]; q < S->pstart[p + 1]; q++) {
-            uint32_t k = S->zstart[S->pcol[q]]++;
-            memcpy(S->ztan + 3 * (size_t)k, S->ptan + 3 * (size_t)q, 3 * sizeof *S->ztan);
-            S->zp[k] = p;
-        }
-    for (uint32_t z = nz; z > 0; z--) S->zstart[z] = S->zstart[z - 1];
-    S->zstart[0] = 0;
     return S;
 }
 
@@ -199,39 +176,47 @@ bool spn__slide_factor(spn__slide *S, const spn__eq *e)
     return spn__dense_cholesky(f, N, nt);
 }
 
-void spn__slide_correct(const spn__slide *S, const spn__eq *e, const double *r, double *x)
+/* Z^T (b - A x) in one pass: each part of the particles (whole groups of
+ * the product's lanes) forms its rows of A x, turns them into r = b - A x
+ * while they are in cache, and adds t . r_p into its own sums, in particle
+ * order; the parts' sums are then added in order. Before, r was written by
+ * the product, subtracted from b in a second pass and gathered a third time
+ * by coarse unknown (a radial's particles are a ring apart). */
+static void project_residual(const spn__slide *S, const spn__eq *e, const double *b, const double *x, double *r)
 {
-    const size_t N = S->nz;
-    const double *f = S->c;
-    double *w = S->w;
-    const int nt = slide_team(e);
-    /* Z^T r: on one thread in one loop over the particles, reading r in
-     * order; on more, unknown by unknown, each over its particles in order
-     * (the same sums, but gathered: a radial's particles are a ring apart;
-     * the tangents are a copy in this order, which halved this loop's time
-     * on the 1M web: 0.87-0.95 -> 0.44-0.50 s a solve) */
-    if (!S->zstart) {
-        memset(w, 0, N * sizeof *w);
-        for (uint32_t p = 0; p < e->n; p++)
+    const uint32_t N = S->nz, W = SPN__EQ_LANES, groups = (e->n + W - 1) / W, parts = slide_parts(e);
+    const int nt = slide_team(e) < (int)parts ? slide_team(e) : (int)parts;
+    (void)nt;
+#pragma omp parallel for schedule(static) num_threads(nt)
+    for (uint32_t k = 0; k < parts; k++) {
+        const uint32_t g0 = (uint32_t)((uint64_t)groups * k / parts), g1 = (uint32_t)((uint64_t)groups * (k + 1) / parts);
+        const uint32_t p1 = W * g1 < e->n ? W * g1 : e->n;
+        double *wk = S->wpart + (size_t)k * N;
+        memset(wk, 0, N * sizeof *wk);
+        spn__eq_matvec_mg_rows(e, g0, g1, x, r);
+        for (uint32_t p = W * g0; p < p1; p++) {
+            double *rp = r + 3 * (size_t)p;
+            const double *bp = b + 3 * (size_t)p;
+            rp[0] = bp[0] - rp[0], rp[1] = bp[1] - rp[1], rp[2] = bp[2] - rp[2];
             for (uint32_t q = S->pstart[p]; q < S->pstart[p + 1]; q++) {
-                const double *t = S->ptan + 3 * (size_t)q, *rp = r + 3 * (size_t)p;
-                w[S->pcol[q]] += t[0] * rp[0] + t[1] * rp[1] + t[2] * rp[2];
+                const double *t = S->ptan + 3 * (size_t)q;
+                wk[S->pcol[q]] += t[0] * rp[0] + t[1] * rp[1] + t[2] * rp[2];
             }
-    } else {
-#pragma omp parallel for schedule(dynamic, 16) num_threads(nt)
-        for (uint32_t z = 0; z < N; z++) {
-            double sum = 0;
-            const uint32_t k1 = S->zstart[z + 1];
-            for (uint32_t k = S->zstart[z]; k < k1; k++) {
-                if (k + SLIDE_AHEAD < k1) __builtin_prefetch(r + 3 * (size_t)S->zp[k + SLIDE_AHEAD]);
-                const double *t = S->ztan + 3 * (size_t)k, *rp = r + 3 * (size_t)S->zp[k];
-                sum += t[0] * rp[0] + t[1] * rp[1] + t[2] * rp[2];
-            }
-            w[z] = sum;
         }
     }
-    spn__dense_cholesky_solve(f, N, w, w);
-#pragma omp parallel for schedule(static) num_threads(nt)
+    double *w = S->w;
+    memcpy(w, S->wpart, N * sizeof *w);
+    for (uint32_t k = 1; k < parts; k++)
+        for (uint32_t z = 0; z < N; z++) w[z] += S->wpart[(size_t)k * N + z];
+}
+
+void spn__slide_correct(const spn__slide *S, const spn__eq *e, const double *b, double *x, double *r)
+{
+    const size_t N = S->nz;
+    double *w = S->w;
+    project_residual(S, e, b, x, r);
+    spn__dense_cholesky_solve(S->c, N, w, w);
+#pragma omp parallel for schedule(static) num_threads(slide_team(e))
     for (uint32_t p = 0; p < e->n; p++)
         for (uint32_t q = S->pstart[p]; q < S->pstart[p + 1]; q++) {
             const double *t = S->ptan + 3 * (size_t)q, y = w[S->pcol[q]];
