@@ -40,7 +40,11 @@ typedef struct spn__eq {
     double *hs;   /* 6 m: projected Hessian block of each spring */
     double *fs;   /* 3 m: force on end a */
     double *diag; /* 6 n: diagonal blocks (springs + shift) */
-    double *offd; /* 6 per adjacency entry: -H_s of the row's spring (0 to a fixed end) */
+    /* 6 per adjacency entry: the row's off-diagonal block, or NULL when it
+     * is -H_s of the entry's spring (0 to a fixed end) and read through
+     * spn__eq_offd from hs (equilibrium: the blocks were a second copy of hs,
+     * 192 MB on the 1M web); implicit_mg.c stores its own */
+    double *offd;
     /* The product's copy of diag and offd: rows in groups of SPN__EQ_LANES
      * side by side (equilibrium_system.c); a group with a row of more than
      * SPN__EQ_LANE_SLOTS entries (a hub) has no slots and goes row by row. */
@@ -62,6 +66,16 @@ typedef struct spn__eq {
     uint32_t nchunks;
     double *partial; /* nchunks * 4 */
 } spn__eq;
+
+/* Adjacency entry j's off-diagonal block (6 numbers): offd's, or -H_s
+ * (0 to a fixed end) written into tmp. */
+static inline const double *spn__eq_offd(const spn__eq *e, uint32_t j, double *tmp)
+{
+    if (e->offd) return e->offd + 6 * (size_t)j;
+    const double *h = e->hs + 6 * (size_t)(e->adj[j] >> 1), keep = e->adj_other[j] >= 0 ? -1 : 0;
+    for (int c = 0; c < 6; c++) tmp[c] = keep * h[c];
+    return tmp;
+}
 
 /* Build the problem from the world; SPN_ERR_NOMEM or SPN_OK. */
 spn_status spn__eq_init(spn__eq *e, const spn_world *w, const spn_equilibrium_def *def);

@@ -143,8 +143,10 @@ static void level0_values(spn__mg *mg, const spn__eq *e)
         double *row = a->val + 9 * (size_t)a->start[i];
         memset(row, 0, 9 * (size_t)(a->start[i + 1] - a->start[i]) * sizeof *row);
         sym_to_full(e->diag + 6 * (size_t)i, 1, row);
-        for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++)
-            if (mg->map0[j] != UINT32_MAX) sym_to_full(e->offd + 6 * (size_t)j, 1, a->val + 9 * (size_t)mg->map0[j]);
+        for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++) {
+            double o[6];
+            if (mg->map0[j] != UINT32_MAX) sym_to_full(spn__eq_offd(e, j, o), 1, a->val + 9 * (size_t)mg->map0[j]);
+        }
     }
 }
 

@@ -55,14 +55,13 @@ void spn__sgs_apply(const spn__eq *e, const double *inv, const double *r, double
     const uint32_t n = e->n;
     const uint32_t *start = e->adj_start;
     const int32_t *col = e->adj_col;
-    const double *offd = e->offd;
     for (uint32_t i = 0; i < n; i++) {
         double acc[3] = {r[3 * i], r[3 * i + 1], r[3 * i + 2]};
         for (uint32_t j = start[i]; j < start[i + 1]; j++) {
             uint32_t c = (uint32_t)col[j];
             if (c >= i) continue;
-            double t[3];
-            spn__sym_mul(offd + 6 * (size_t)j, z + 3 * (size_t)c, t);
+            double t[3], o[6];
+            spn__sym_mul(spn__eq_offd(e, j, o), z + 3 * (size_t)c, t);
             acc[0] -= t[0], acc[1] -= t[1], acc[2] -= t[2];
         }
         spn__sym_mul(inv + 6 * (size_t)i, acc, z + 3 * (size_t)i);
@@ -73,8 +72,8 @@ void spn__sgs_apply(const spn__eq *e, const double *inv, const double *r, double
         for (uint32_t j = start[i]; j < start[i + 1]; j++) {
             uint32_t c = (uint32_t)col[j];
             if (c <= i) continue;
-            double t[3];
-            spn__sym_mul(offd + 6 * (size_t)j, z + 3 * (size_t)c, t);
+            double t[3], o[6];
+            spn__sym_mul(spn__eq_offd(e, j, o), z + 3 * (size_t)c, t);
             acc[0] += t[0], acc[1] += t[1], acc[2] += t[2];
         }
         double d[3];

@@ -76,28 +76,32 @@ void spn__eq_lanes_store(spn__eq *e, uint32_t i)
         e->lane_diag[k] = e->diag[6 * (size_t)i + f];
         if (e->lane_diag32) e->lane_diag32[k] = (float)e->lane_diag[k];
     }
-    for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++)
+    for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++) {
+        double tmp[6];
+        const double *o = spn__eq_offd(e, j, tmp);
         for (int f = 0; f < 6; f++) {
             const size_t k = (6 * (size_t)(slot0 + j - e->adj_start[i]) + f) * W + q;
-            e->lane_val[k] = e->offd[6 * (size_t)j + f];
+            e->lane_val[k] = o[f];
             if (e->lane_val32) e->lane_val32[k] = (float)e->lane_val[k];
         }
+    }
 }
 
 /* Row i of A p: the diagonal block, then the row's off-diagonal blocks
  * stored in adjacency order (a fixed neighbour's entry is zero and points at
  * the row itself, so the loop has no branch). */
-static inline void matvec_row(const double *restrict diag, const uint32_t *restrict start,
-                              const int32_t *restrict col, const double *restrict offd, uint32_t i,
-                              const double *restrict p, double *restrict y)
+static inline void matvec_row(const spn__eq *e, uint32_t i, const double *restrict p, double *restrict y)
 {
-    const double *d = diag + 6 * (size_t)i, *pi = p + 3 * (size_t)i;
+    const uint32_t *start = e->adj_start;
+    const int32_t *col = e->adj_col;
+    const double *d = e->diag + 6 * (size_t)i, *pi = p + 3 * (size_t)i;
     /* scalars, not an array: a copy out of a stack array stalls on store forwarding */
     double a0 = d[0] * pi[0] + d[3] * pi[1] + d[4] * pi[2];
     double a1 = d[3] * pi[0] + d[1] * pi[1] + d[5] * pi[2];
     double a2 = d[4] * pi[0] + d[5] * pi[1] + d[2] * pi[2];
     for (uint32_t j = start[i]; j < start[i + 1]; j++) {
-        const double *h = offd + 6 * (size_t)j, *v = p + 3 * (size_t)col[j];
+        double tmp[6];
+        const double *h = spn__eq_offd(e, j, tmp), *v = p + 3 * (size_t)col[j];
         a0 += h[0] * v[0] + h[3] * v[1] + h[4] * v[2];
         a1 += h[3] * v[0] + h[1] * v[1] + h[5] * v[2];
         a2 += h[4] * v[0] + h[5] * v[1] + h[2] * v[2];
@@ -165,7 +169,7 @@ static void matvec_groups(const spn__eq *e, uint32_t g0, uint32_t g1, bool f32, 
             continue;
         }
         for (uint32_t i = g * W; i < g * W + W && i < e->n; i++)
-            matvec_row(e->diag, e->adj_start, e->adj_col, e->offd, i, p, y);
+            matvec_row(e, i, p, y);
     }
 }
 

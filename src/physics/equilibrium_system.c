@@ -156,10 +156,9 @@ static spn_status build_adjacency(spn__eq *e)
     e->adj = spn__big_alloc(2 * (size_t)(e->m ? e->m : 1) * sizeof *e->adj);
     e->adj_other = spn__big_alloc(2 * (size_t)(e->m ? e->m : 1) * sizeof *e->adj_other);
     e->adj_col = spn__big_alloc(2 * (size_t)(e->m ? e->m : 1) * sizeof *e->adj_col);
-    e->offd = spn__big_alloc(12 * (size_t)(e->m ? e->m : 1) * sizeof *e->offd);
     e->kscale = spn__big_calloc(n ? n : 1, sizeof *e->kscale);
     uint32_t *fill = calloc(n ? n : 1, sizeof *fill);
-    if (!e->adj_start || !e->adj || !e->adj_other || !e->adj_col || !e->offd || !e->kscale || !fill) {
+    if (!e->adj_start || !e->adj || !e->adj_other || !e->adj_col || !e->kscale || !fill) {
         free(fill);
         return SPN_ERR_NOMEM;
     }
@@ -303,12 +302,8 @@ static void gather_particle(spn__eq *e, uint32_t i, double lambda)
         uint32_t s = e->adj[j] >> 1;
         const double *fs = e->fs + 3 * (size_t)s, *h = e->hs + 6 * (size_t)s;
         double sign = (e->adj[j] & 1u) ? -1 : 1;
-        double *o = e->offd + 6 * (size_t)j, keep = e->adj_other[j] >= 0 ? -1 : 0;
         for (int c = 0; c < 3; c++) f[c] += sign * fs[c];
-        for (int c = 0; c < 6; c++) {
-            d[c] += h[c];
-            o[c] = keep * h[c];
-        }
+        for (int c = 0; c < 6; c++) d[c] += h[c];
     }
     double shift = lambda * e->kscale[i];
     d[0] += shift;

@@ -24,6 +24,7 @@
  * The preconditioner is a fixed linear map within a solve, so CG's result
  * differs from block Jacobi's only within the solver tolerance; every product
  * is summed in a fixed order, so the bits do not depend on the thread count. */
+#include "core/big_alloc.h"
 #include "equilibrium_internal.h"
 #include "world_internal.h"
 
@@ -123,11 +124,12 @@ static spn__imp_mg *create(const spn_world *w)
      * assembled matrix (the Jacobian's air terms do not fit that form) */
     free(m->e.hs);
     m->e.hs = NULL;
+    m->e.offd = spn__big_alloc(12 * (size_t)(m->e.m ? m->e.m : 1) * sizeof *m->e.offd);
     size_t n = m->e.n ? m->e.n : 1;
     m->inv0 = malloc(6 * n * sizeof *m->inv0);
     m->r = malloc(3 * n * sizeof *m->r);
     m->z = malloc(3 * n * sizeof *m->z);
-    if (!m->inv0 || !m->r || !m->z || !map_springs(m, w)) {
+    if (!m->e.offd || !m->inv0 || !m->r || !m->z || !map_springs(m, w)) {
         spn__imp_mg_free(m);
         return NULL;
     }
