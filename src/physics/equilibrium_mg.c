@@ -439,9 +439,6 @@ static spn_status build(spn__mg *mg, const spn__eq *e, const double *inv0)
     L0->x = spn__big_alloc(3 * (size_t)(e->n ? e->n : 1) * sizeof *L0->x);
     if (!L0->r || !L0->x || !level0_pattern(mg, e)) return SPN_ERR_NOMEM;
     level0_values(mg, e);
-    if (!(L0->lines = spn__lines_build(e, &L0->A))) return SPN_ERR_NOMEM;
-    /* NULL: too many lines, or no memory; the cycle goes without */
-    if (e->hs) mg->slide = spn__slide_build(e, L0->lines);
     mg->nlevels = 1;
     while (mg->nlevels < MAX_LEVELS && mg->lv[mg->nlevels - 1].A.rows > COARSEST) {
         int l = mg->nlevels - 1;
@@ -466,6 +463,14 @@ static spn_status build(spn__mg *mg, const spn__eq *e, const double *inv0)
         if (L->P.val) spn__bsr_round(&L->P);
         if (L->R.val) spn__bsr_round(&L->R);
     }
+    /* The line smoother and the slides last: their arrays then take the
+     * pages the setup's temporaries (each level's A P) and the rounding have
+     * just given back, which the host still backs, instead of fresh ones
+     * (a fresh page costs the VM measured about 7 us, one given back
+     * moments ago about 1.5: docs/physics-equilibrium.md) */
+    if (!(L0->lines = spn__lines_build(e, &L0->A))) return SPN_ERR_NOMEM;
+    /* NULL: too many lines, or no memory; the cycle goes without */
+    if (e->hs) mg->slide = spn__slide_build(e, L0->lines);
     return SPN_OK;
 }
 
