@@ -4,7 +4,8 @@
  * bits of the plain column-by-column method with four running sums per dot
  * product; this test holds it to that against a reference written here,
  * over sizes that end panels and row pairs at every remainder, checks
- * L L^T = A and the solve, and that an indefinite matrix is refused. */
+ * L L^T = A and the solve (the same bits on a team), and that an
+ * indefinite matrix is refused. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -96,13 +97,48 @@ static void test_solve(void **state)
     memcpy(f, a, n * n * sizeof *f);
     for (size_t i = 0; i < n; i++) b[i] = sin((double)i);
     assert_true(spn__dense_cholesky(f, n, 1));
-    spn__dense_cholesky_solve(f, n, b, x);
+    spn__dense_cholesky_solve(f, n, b, x, 1);
     for (size_t i = 0; i < n; i++) {
         double r = b[i];
         for (size_t j = 0; j < n; j++) r -= a[i * n + j] * x[j];
         assert_true(fabs(r) < 1e-12);
     }
     free(a), free(f);
+}
+
+/* Large enough for the team (and ending blocks and lanes off their
+ * multiples): the same bits on one, two and three threads, in place as
+ * well, and a small residual. */
+static void test_solve_on_a_team(void **state)
+{
+    (void)state;
+    const size_t sizes[] = {515, 1031};
+    for (size_t k = 0; k < 2; k++) {
+        const size_t n = sizes[k];
+        double *a = spd(n, 7u + (unsigned)n), *f = malloc(n * n * sizeof *f), *b = malloc(n * sizeof *b),
+               *x[4];
+        assert_true(f && b);
+        memcpy(f, a, n * n * sizeof *f);
+        for (size_t i = 0; i < n; i++) b[i] = cos(0.3 * (double)i);
+        assert_true(spn__dense_cholesky(f, n, 2));
+        for (int t = 0; t < 4; t++) {
+            x[t] = malloc(n * sizeof *x[t]);
+            assert_non_null(x[t]);
+        }
+        spn__dense_cholesky_solve(f, n, b, x[0], 1);
+        spn__dense_cholesky_solve(f, n, b, x[1], 2);
+        spn__dense_cholesky_solve(f, n, b, x[2], 3);
+        memcpy(x[3], b, n * sizeof *b);
+        spn__dense_cholesky_solve(f, n, x[3], x[3], 2);
+        for (int t = 1; t < 4; t++) assert_memory_equal(x[0], x[t], n * sizeof *x[0]);
+        for (size_t i = 0; i < n; i++) {
+            double r = b[i];
+            for (size_t j = 0; j < n; j++) r -= a[i * n + j] * x[0][j];
+            assert_true(fabs(r) < 1e-11);
+        }
+        for (int t = 0; t < 4; t++) free(x[t]);
+        free(a), free(f), free(b);
+    }
 }
 
 /* A matrix with a negative eigenvalue: refused, whether the failing pivot
@@ -125,6 +161,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_same_bits_as_columns),
         cmocka_unit_test(test_solve),
+        cmocka_unit_test(test_solve_on_a_team),
         cmocka_unit_test(test_indefinite),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

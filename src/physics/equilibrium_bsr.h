@@ -81,8 +81,9 @@ void spn__bsr_gauss_seidel(const spn__bsr *a, const double *dinv, const double *
  * triangle read and overwritten with L. False when A is not positive
  * definite. (The multigrid's coarsest level and the thread slides.) */
 bool spn__dense_cholesky(double *f, size_t n, int threads);
-/* Solves L L^T x = b with a factor from spn__dense_cholesky; x may be b. */
-void spn__dense_cholesky_solve(const double *f, size_t n, const double *b, double *x);
+/* Solves L L^T x = b with a factor from spn__dense_cholesky; x may be b.
+ * The same bits on any team (threads). */
+void spn__dense_cholesky_solve(const double *f, size_t n, const double *b, double *x, int threads);
 
 static inline void spn__blk_mul_vec(const double *m, const double *v, double *o)
 {

@@ -398,7 +398,7 @@ static bool dense_factor(spn__mg *mg)
 
 static void dense_solve(const spn__mg *mg, const double *b, double *x)
 {
-    spn__dense_cholesky_solve(mg->dense, 3 * (size_t)mg->lv[mg->nlevels - 1].A.rows, b, x);
+    spn__dense_cholesky_solve(mg->dense, 3 * (size_t)mg->lv[mg->nlevels - 1].A.rows, b, x, mg->threads);
 }
 
 /* ---- setup ---------------------------------------------------------------- */

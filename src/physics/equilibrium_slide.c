@@ -215,7 +215,7 @@ void spn__slide_correct(const spn__slide *S, const spn__eq *e, const double *b, 
     const size_t N = S->nz;
     double *w = S->w;
     project_residual(S, e, b, x, r);
-    spn__dense_cholesky_solve(S->c, N, w, w);
+    spn__dense_cholesky_solve(S->c, N, w, w, slide_team(e));
 #pragma omp parallel for schedule(static) num_threads(slide_team(e))
     for (uint32_t p = 0; p < e->n; p++)
         for (uint32_t q = S->pstart[p]; q < S->pstart[p + 1]; q++) {
