@@ -59,6 +59,18 @@ void spn__bsr_round(spn__bsr *a)
     a->val = NULL;
 }
 
+/* Block p's nine numbers: from val, or from a transpose's source (tsrc,
+ * tperm: spn__bsr_transpose) through tmp. */
+static inline const double *blk9(const spn__bsr *m, size_t p, double *tmp)
+{
+    if (m->val) return m->val + 9 * p;
+    const double *s = m->tsrc->val + 9 * (size_t)m->tperm[p];
+    tmp[0] = s[0], tmp[1] = s[3], tmp[2] = s[6];
+    tmp[3] = s[1], tmp[4] = s[4], tmp[5] = s[7];
+    tmp[6] = s[2], tmp[7] = s[5], tmp[8] = s[8];
+    return tmp;
+}
+
 /* The number of distinct columns of row i of A B (mark: per column, the
  * last row that saw it). */
 static uint32_t row_count(const spn__bsr *a, const spn__bsr *b, uint32_t i, bool diag_first, uint32_t *mark)
@@ -86,8 +98,9 @@ static uint32_t row_count(const spn__bsr *a, const spn__bsr *b, uint32_t i, bool
  * halves the Galerkin product's block arithmetic. */
 static void row_sums(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_t i, bool upper, const uint32_t *pos)
 {
+    double ta[9];
     for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) {
-        const double *ab = a->val + 9 * (size_t)p;
+        const double *ab = blk9(a, p, ta);
         uint32_t k = a->col[p];
         for (uint32_t q = b->start[k]; q < b->start[k + 1]; q++) {
             uint32_t j = b->col[q];
@@ -138,8 +151,9 @@ __attribute__((target("avx"))) static void row_sums_avx(const spn__bsr *a, const
 {
     const uint32_t q0 = c->start[i], cnt = c->start[i + 1] - q0;
     memset(acc, 0, ACC * (size_t)cnt * sizeof *acc);
+    double ta[9];
     for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) {
-        const double *ab = a->val + 9 * (size_t)p;
+        const double *ab = blk9(a, p, ta);
         __m256d av[9];
         for (int k = 0; k < 9; k++) av[k] = _mm256_broadcast_sd(ab + k);
         uint32_t k = a->col[p];
@@ -277,15 +291,15 @@ bool spn__bsr_galerkin(const spn__bsr *r, const spn__bsr *ap, spn__bsr *c, int t
 
 bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm_out, int threads)
 {
+    (void)threads;
     memset(t, 0, sizeof *t);
     t->rows = a->cols;
     t->cols = a->rows;
     size_t nnz = a->start[a->rows];
     t->start = spn__big_calloc((size_t)t->rows + 1, sizeof *t->start);
     t->col = spn__big_alloc((nnz ? nnz : 1) * sizeof *t->col);
-    t->val = spn__big_alloc(9 * (nnz ? nnz : 1) * sizeof *t->val);
     uint32_t *perm = malloc((nnz ? nnz : 1) * sizeof *perm), *fill = calloc(t->rows ? t->rows : 1, sizeof *fill);
-    if (!t->start || !t->col || !t->val || !perm || !fill) {
+    if (!t->start || !t->col || !perm || !fill) {
         free(perm);
         free(fill);
         spn__bsr_free(t);
@@ -300,22 +314,33 @@ bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm_out, int
             perm[q] = p;
         }
     free(fill);
+    t->tsrc = a;
+    t->tperm = perm;
     *perm_out = perm;
-    spn__bsr_transpose_values(a, t, perm, threads);
     return true;
 }
 
-void spn__bsr_transpose_values(const spn__bsr *a, spn__bsr *t, const uint32_t *perm, int threads)
+bool spn__bsr_transpose_round(spn__bsr *t, int threads)
 {
     const uint32_t nnz = t->start[t->rows];
+    const double *src = t->tsrc->val;
+    const uint32_t *perm = t->tperm;
+    float *d = spn__big_alloc((9 * (size_t)nnz + 1) * sizeof *d);
+    if (!d) return false;
+    (void)threads;
 #pragma omp parallel for schedule(static) num_threads(nnz < SPN__BSR_PAR_MIN ? 1 : threads)
     for (uint32_t q = 0; q < nnz; q++) {
-        const double *s = a->val + 9 * (size_t)perm[q];
-        double *d = t->val + 9 * (size_t)q;
-        d[0] = s[0], d[1] = s[3], d[2] = s[6];
-        d[3] = s[1], d[4] = s[4], d[5] = s[7];
-        d[6] = s[2], d[7] = s[5], d[8] = s[8];
+        const double *s = src + 9 * (size_t)perm[q];
+        float *o = d + 9 * (size_t)q;
+        o[0] = (float)s[0], o[1] = (float)s[3], o[2] = (float)s[6];
+        o[3] = (float)s[1], o[4] = (float)s[4], o[5] = (float)s[7];
+        o[6] = (float)s[2], o[7] = (float)s[5], o[8] = (float)s[8];
     }
+    d[9 * (size_t)nnz] = 0; /* the spare a float block's last row reads */
+    t->fval = d;
+    t->tsrc = NULL;
+    t->tperm = NULL;
+    return true;
 }
 
 /* Block rows times a vector: s = sum over the row's blocks from entry p0 of

@@ -32,6 +32,10 @@ typedef struct spn__bsr {
     uint32_t *col;   /* start[rows] */
     double *val;     /* 9 * start[rows], or NULL once rounded to fval */
     float *fval;     /* 9 * start[rows] + 1 (spn__bsr_round), or NULL */
+    /* neither: a transpose's values read from its source (spn__bsr_transpose),
+     * block k being the transpose of tsrc's float64 block tperm[k] */
+    const struct spn__bsr *tsrc;
+    const uint32_t *tperm;
 } spn__bsr;
 
 void spn__bsr_free(spn__bsr *a);
@@ -49,9 +53,15 @@ bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_f
  * the blocks above the diagonal computed and those below mirrored from them
  * (C exactly symmetric). false on out of memory. */
 bool spn__bsr_galerkin(const spn__bsr *r, const spn__bsr *ap, spn__bsr *c, int threads);
-/* T = A^T, blocks transposed; perm[k]: the entry of A that T's entry k came from. */
+/* T = A^T (A in float64): its pattern, and perm[k], the entry of A that
+ * T's entry k comes from. T's values are read from A through perm (no copy:
+ * the Galerkin product is the only reader of R = P^T in float64) until
+ * spn__bsr_transpose_round gives T its own float32 blocks; A must outlive
+ * that, and perm too. */
 bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm, int threads);
-void spn__bsr_transpose_values(const spn__bsr *a, spn__bsr *t, const uint32_t *perm, int threads);
+/* T's blocks rounded to float32 from its source (as spn__bsr_round would
+ * from a float64 copy: the same floats); false on out of memory. */
+bool spn__bsr_transpose_round(spn__bsr *t, int threads);
 /* Replace the values by float32 copies (val becomes fval): the multigrid's levels
  * below the finest, its prolongators and restrictions, once built, are only
  * multiplied by vectors, and a preconditioner does not need them exact (see
