@@ -389,20 +389,20 @@ static inline void row_sum(const spn__bsr *a, uint32_t i, uint32_t p0, const dou
     __m256d r0 = _mm256_cvtps_pd(_mm_loadu_ps(m)), r1 = _mm256_cvtps_pd(_mm_loadu_ps((m) + 3));                     \
     __m256d r2 = _mm256_cvtps_pd(_mm_loadu_ps((m) + 6))
 
-#define ROW_SUM_AVX(T, ROWS, SRC)                                                                                       \
+#define ROW_SUM_AVX(T, ROWS)                                                                                            \
     __m256d l0 = _mm256_setzero_pd(), l1 = l0, l2 = l0, k0 = l0, k1 = l0, k2 = l0;                                   \
     uint32_t p = p0;                                                                                                 \
     const uint32_t p1 = a->start[i + 1];                                                                             \
     for (; p < p1; p++) {                                                                                            \
         const T *m = vals + 9 * (size_t)p;                                                                           \
-        const double *v = SRC(a->col[p]) + 3 * (size_t)a->col[p];                                                    \
+        const double *v = SRC_OF(a->col[p]) + 3 * (size_t)a->col[p];                                                 \
         __m256d v4 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(v)), _mm_load_sd(v + 2), 1);          \
         ROWS(m, m0, m1, m2);                                                                                         \
         l0 = _mm256_add_pd(l0, _mm256_mul_pd(m0, v4));                                                               \
         l1 = _mm256_add_pd(l1, _mm256_mul_pd(m1, v4));                                                               \
         l2 = _mm256_add_pd(l2, _mm256_mul_pd(m2, v4));                                                               \
         if (++p == p1) break;                                                                                        \
-        m = vals + 9 * (size_t)p, v = SRC(a->col[p]) + 3 * (size_t)a->col[p];                                        \
+        m = vals + 9 * (size_t)p, v = SRC_OF(a->col[p]) + 3 * (size_t)a->col[p];                                     \
         v4 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(v)), _mm_load_sd(v + 2), 1);                  \
         ROWS(m, n0, n1, n2);                                                                                         \
         k0 = _mm256_add_pd(k0, _mm256_mul_pd(n0, v4));                                                               \
@@ -414,34 +414,28 @@ static inline void row_sum(const spn__bsr *a, uint32_t i, uint32_t p0, const dou
     _mm256_storeu_pd(t, l0), _mm256_storeu_pd(t + 4, l1), _mm256_storeu_pd(t + 8, l2);                               \
     for (int r = 0; r < 3; r++) s[r] = (t[4 * r] + t[4 * r + 1]) + t[4 * r + 2]
 
-#define SRC_ONE(c) x
-#define SRC_SPLIT(c) ((c) - lo < span ? x : xo)
+/* the vector column c is read from: x inside [lo, lo + span), xo outside */
+#define SRC_OF(c) ((c) - lo < span ? x : xo)
 
-/* row_sum on 256-bit vectors: lanes (m_r0 v0, m_r1 v1, m_r2 v2, 0). */
-__attribute__((target("avx"))) static inline void row_sum_avx(const spn__bsr *a, uint32_t i, uint32_t p0,
-                                                               const double *x, double *s)
-{
-    if (a->val) {
-        const double *vals = a->val;
-        ROW_SUM_AVX(double, ROWS_D, SRC_ONE);
-    } else {
-        const float *vals = a->fval;
-        ROW_SUM_AVX(float, ROWS_F, SRC_ONE);
-    }
-}
-
-/* row_sum_split on 256-bit vectors */
+/* row_sum_split on 256-bit vectors: lanes (m_r0 v0, m_r1 v1, m_r2 v2, 0). */
 __attribute__((target("avx"))) static inline void row_sum_split_avx(const spn__bsr *a, uint32_t i, uint32_t p0,
                                                                      const double *x, const double *xo, uint32_t lo,
                                                                      uint32_t span, double *s)
 {
     if (a->val) {
         const double *vals = a->val;
-        ROW_SUM_AVX(double, ROWS_D, SRC_SPLIT);
+        ROW_SUM_AVX(double, ROWS_D);
     } else {
         const float *vals = a->fval;
-        ROW_SUM_AVX(float, ROWS_F, SRC_SPLIT);
+        ROW_SUM_AVX(float, ROWS_F);
     }
+}
+
+/* row_sum on 256-bit vectors (xo = x: the compiler drops the choice) */
+__attribute__((target("avx"))) static inline void row_sum_avx(const spn__bsr *a, uint32_t i, uint32_t p0,
+                                                               const double *x, double *s)
+{
+    row_sum_split_avx(a, i, p0, x, x, 0, UINT32_MAX, s);
 }
 
 /* y = A x (add: y += A x) on rows [r0, r1), or r = b - A x when b is given. */
