@@ -81,7 +81,7 @@ static uint32_t row_count(const spn__bsr *a, const spn__bsr *b, uint32_t i, bool
         cnt++;
     }
     for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) {
-        uint32_t k = a->col[p];
+        uint32_t k = a->col[p] - b->base;
         for (uint32_t q = b->start[k]; q < b->start[k + 1]; q++) {
             uint32_t j = b->col[q];
             if (mark[j] == i) continue;
@@ -101,7 +101,7 @@ static void row_sums(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_t
     double ta[9];
     for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) {
         const double *ab = blk9(a, p, ta);
-        uint32_t k = a->col[p];
+        uint32_t k = a->col[p] - b->base;
         for (uint32_t q = b->start[k]; q < b->start[k + 1]; q++) {
             uint32_t j = b->col[q];
             if (!upper || j >= i) spn__blk_mul_add(ab, b->val + 9 * (size_t)q, c->val + 9 * (size_t)pos[j]);
@@ -149,14 +149,14 @@ __attribute__((target("avx"))) static inline void blk_mul_add_avx(const __m256d 
 __attribute__((target("avx"))) static void row_sums_avx(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_t i,
                                                         bool upper, const uint32_t *pos, double *restrict acc)
 {
-    const uint32_t q0 = c->start[i], cnt = c->start[i + 1] - q0;
+    const uint32_t q0 = c->start[i - c->base], cnt = c->start[i - c->base + 1] - q0;
     memset(acc, 0, ACC * (size_t)cnt * sizeof *acc);
     double ta[9];
     for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) {
         const double *ab = blk9(a, p, ta);
         __m256d av[9];
         for (int k = 0; k < 9; k++) av[k] = _mm256_broadcast_sd(ab + k);
-        uint32_t k = a->col[p];
+        uint32_t k = a->col[p] - b->base;
         for (uint32_t q = b->start[k]; q < b->start[k + 1]; q++) {
             uint32_t j = b->col[q];
             if (!upper || j >= i) blk_mul_add_avx(av, b->val + 9 * (size_t)q, acc + ACC * (size_t)(pos[j] - q0));
@@ -168,25 +168,34 @@ __attribute__((target("avx"))) static void row_sums_avx(const spn__bsr *a, const
 }
 #endif
 
-/* Row i of C = A B: its columns in the order met (mark as in row_count),
- * then the sums (acc: the AVX path's workspace, ACC numbers a block). */
-static void row_values(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_t i, bool diag_first, bool upper,
-                       double *acc, uint32_t *mark, uint32_t *pos)
+/* Row i of C = A B: its columns in the order met (mark as in row_count;
+ * pos[j]: where column j went). */
+static void row_cols(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_t i, bool diag_first, uint32_t *mark,
+                     uint32_t *pos)
 {
-    uint32_t q0 = c->start[i], cnt = q0;
+    uint32_t cnt = c->start[i - c->base];
     if (diag_first) {
         mark[i] = i;
         pos[i] = cnt;
         c->col[cnt++] = i;
     }
-    for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++)
-        for (uint32_t q = b->start[a->col[p]]; q < b->start[a->col[p] + 1]; q++) {
+    for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) {
+        const uint32_t k = a->col[p] - b->base;
+        for (uint32_t q = b->start[k]; q < b->start[k + 1]; q++) {
             uint32_t j = b->col[q];
             if (mark[j] == i) continue;
             mark[j] = i;
             pos[j] = cnt;
             c->col[cnt++] = j;
         }
+    }
+}
+
+/* The sums of row i of C = A B, its columns in place (pos; acc: the AVX
+ * path's workspace, ACC numbers a block). */
+static void row_sums_of(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_t i, bool upper, double *acc,
+                        const uint32_t *pos)
+{
 #if SPN__AVX
     if (acc) {
         row_sums_avx(a, b, c, i, upper, pos, acc);
@@ -195,8 +204,17 @@ static void row_values(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32
 #else
     (void)acc;
 #endif
-    memset(c->val + 9 * (size_t)q0, 0, 9 * (size_t)(c->start[i + 1] - q0) * sizeof *c->val);
+    const uint32_t q0 = c->start[i - c->base], q1 = c->start[i - c->base + 1];
+    memset(c->val + 9 * (size_t)q0, 0, 9 * (size_t)(q1 - q0) * sizeof *c->val);
     row_sums(a, b, c, i, upper, pos);
+}
+
+/* Row i of C = A B, columns and sums. */
+static void row_values(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_t i, bool diag_first, bool upper,
+                       double *acc, uint32_t *mark, uint32_t *pos)
+{
+    row_cols(a, b, c, i, diag_first, mark, pos);
+    row_sums_of(a, b, c, i, upper, acc, pos);
 }
 
 /* The blocks below the diagonal of a structurally symmetric C from those
@@ -287,6 +305,141 @@ bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_f
 bool spn__bsr_galerkin(const spn__bsr *r, const spn__bsr *ap, spn__bsr *c, int threads)
 {
     return mul(r, ap, c, true, true, true, threads);
+}
+
+/* Coarse rows a chunk of spn__bsr_galerkin_ap has, and how much its chunks'
+ * windows of A P may add up to, in blocks, against A P itself before it
+ * forms A P whole instead (webs numbered so that an aggregate's neighbours
+ * are far apart in it). */
+#define GALERKIN_CHUNK 4096u
+#define WINDOW_SLACK 1.5
+
+/* Row i of C = A B when C's pattern is already in place. */
+static void row_known(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_t i, double *acc, uint32_t *pos)
+{
+    for (uint32_t q = c->start[i - c->base]; q < c->start[i - c->base + 1]; q++) pos[c->col[q]] = q;
+    row_sums_of(a, b, c, i, false, acc, pos);
+}
+
+/* The widest row of a square or rectangular pattern (1 at least). */
+static uint32_t widest_row(const spn__bsr *m)
+{
+    uint32_t w = 1;
+    for (uint32_t i = 0; i < m->rows; i++) w = m->start[i + 1] - m->start[i] > w ? m->start[i + 1] - m->start[i] : w;
+    return w;
+}
+
+/* Why: A P of the 1M web's finest level is 350 MB, written once and read
+ * once by R (A P); in a VM that backs fresh pages slowly (about 7 us each,
+ * docs/physics-equilibrium.md) touching it cost more than computing it.
+ * A P's pattern is formed whole (4 bytes a block); its values only chunk
+ * by chunk of C's rows, over the range of A P's rows that the chunk's rows
+ * of R read (aggregates are numbered in the order of their roots, so that
+ * range is the chunk's own particles and a ring or so either side). */
+bool spn__bsr_galerkin_ap(const spn__bsr *a, const spn__bsr *p, const spn__bsr *r, spn__bsr *c, int threads)
+{
+    const uint32_t n = a->rows, nc = p->cols, rows = r->rows, chunks = (rows + GALERKIN_CHUNK - 1) / GALERKIN_CHUNK;
+    const double products = (double)a->start[n] * p->start[p->rows] / (p->rows ? p->rows : 1);
+    const int nt = products < PAR_MIN_PRODUCTS ? 1 : threads;
+    const size_t per = nc ? nc : 1;
+    spn__bsr ap = {.rows = n, .cols = nc};
+    uint32_t *marks = malloc(2 * (size_t)nt * per * sizeof *marks), *range = malloc(2 * (size_t)(chunks + 1) * sizeof *range);
+    uint32_t *wstart = NULL;
+    double *wval = NULL, *accs = NULL;
+    bool ok = false;
+    memset(c, 0, sizeof *c);
+    ap.start = calloc((size_t)n + 1, sizeof *ap.start);
+    if (!marks || !range || !ap.start) goto done;
+    /* A P's pattern */
+    for (size_t t = 0; t < (size_t)nt * per; t++) marks[t] = UINT32_MAX;
+#pragma omp parallel for schedule(dynamic, 64) num_threads(nt)
+    for (uint32_t i = 0; i < n; i++) ap.start[i + 1] = row_count(a, p, i, false, marks + (size_t)spn__thread_num() * per);
+    for (uint32_t i = 0; i < n; i++) ap.start[i + 1] += ap.start[i];
+    const size_t nnz = ap.start[n];
+    ap.col = malloc((nnz ? nnz : 1) * sizeof *ap.col);
+    if (!ap.col) goto done;
+    for (size_t t = 0; t < (size_t)nt * per; t++) marks[t] = UINT32_MAX;
+#pragma omp parallel for schedule(dynamic, 64) num_threads(nt)
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t *mark = marks + (size_t)spn__thread_num() * per;
+        row_cols(a, p, &ap, i, false, mark, mark + (size_t)nt * per);
+    }
+    /* each chunk's range of A P's rows [lo, hi] */
+    size_t total = 0, wide_rows = 1, wide_nnz = 1;
+    for (uint32_t ch = 0; ch < chunks; ch++) {
+        uint32_t lo = UINT32_MAX, hi = 0;
+        const uint32_t i0 = ch * GALERKIN_CHUNK, i1 = i0 + GALERKIN_CHUNK < rows ? i0 + GALERKIN_CHUNK : rows;
+        for (uint32_t q = r->start[i0]; q < r->start[i1]; q++) {
+            lo = r->col[q] < lo ? r->col[q] : lo;
+            hi = r->col[q] > hi ? r->col[q] : hi;
+        }
+        if (lo > hi) lo = 1, hi = 0; /* no entries: an empty window */
+        range[2 * ch] = lo, range[2 * ch + 1] = hi;
+        if (lo > hi) continue;
+        const size_t wr = (size_t)hi - lo + 1, wn = ap.start[hi + 1] - ap.start[lo];
+        total += wn;
+        wide_rows = wr > wide_rows ? wr : wide_rows;
+        wide_nnz = wn > wide_nnz ? wn : wide_nnz;
+    }
+    if ((double)total > WINDOW_SLACK * (double)nnz) { /* A P whole, then the plain product */
+        ap.val = malloc(9 * (nnz ? nnz : 1) * sizeof *ap.val);
+        if (!ap.val) goto done;
+        const uint32_t widest = widest_row(&ap);
+#if SPN__AVX
+        if (spn__have_avx() && !(accs = aligned_alloc(32, (size_t)nt * ACC * widest * sizeof *accs))) goto done;
+#endif
+#pragma omp parallel for schedule(dynamic, 64) num_threads(nt)
+        for (uint32_t i = 0; i < n; i++) {
+            const size_t t = (size_t)spn__thread_num();
+            row_known(a, p, &ap, i, accs ? accs + t * ACC * widest : NULL, marks + (size_t)(nt + (int)t) * per);
+        }
+        ok = mul(r, &ap, c, true, true, true, threads);
+        goto done;
+    }
+    /* C's pattern, from A P's */
+    c->rows = rows, c->cols = nc;
+    c->start = spn__big_calloc((size_t)rows + 1, sizeof *c->start);
+    if (!c->start) goto done;
+    for (size_t t = 0; t < (size_t)nt * per; t++) marks[t] = UINT32_MAX;
+#pragma omp parallel for schedule(dynamic, 64) num_threads(nt)
+    for (uint32_t i = 0; i < rows; i++) c->start[i + 1] = row_count(r, &ap, i, true, marks + (size_t)spn__thread_num() * per);
+    for (uint32_t i = 0; i < rows; i++) c->start[i + 1] += c->start[i];
+    const size_t cnnz = c->start[rows];
+    c->col = spn__big_alloc((cnnz ? cnnz : 1) * sizeof *c->col);
+    c->val = spn__big_alloc(9 * (cnnz ? cnnz : 1) * sizeof *c->val);
+    const uint32_t widest_c = widest_row(c), widest_ap = widest_row(&ap);
+    const size_t acc_per = ACC * (size_t)(widest_c > widest_ap ? widest_c : widest_ap); /* 32-byte multiples */
+    wstart = malloc((size_t)nt * (wide_rows + 1) * sizeof *wstart);
+    wval = malloc((size_t)nt * 9 * wide_nnz * sizeof *wval);
+    if (!c->col || !c->val || !wstart || !wval) goto done;
+#if SPN__AVX
+    if (spn__have_avx() && !(accs = aligned_alloc(32, (size_t)nt * acc_per * sizeof *accs))) goto done;
+#endif
+    for (size_t t = 0; t < (size_t)nt * per; t++) marks[t] = UINT32_MAX;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
+    for (uint32_t ch = 0; ch < chunks; ch++) {
+        const size_t t = (size_t)spn__thread_num();
+        uint32_t *mark = marks + t * per, *pos = marks + ((size_t)nt + t) * per;
+        double *acc = accs ? accs + t * acc_per : NULL;
+        const uint32_t lo = range[2 * ch], hi = range[2 * ch + 1];
+        spn__bsr win = {.rows = hi + 1, .cols = nc, .base = lo};
+        if (lo <= hi) {
+            win.start = wstart + t * (wide_rows + 1);
+            for (uint32_t k = lo; k <= hi + 1; k++) win.start[k - lo] = ap.start[k] - ap.start[lo];
+            win.col = ap.col + ap.start[lo];
+            win.val = wval + t * 9 * wide_nnz;
+            for (uint32_t k = lo; k <= hi; k++) row_known(a, p, &win, k, acc, pos);
+        }
+        const uint32_t i0 = ch * GALERKIN_CHUNK, i1 = i0 + GALERKIN_CHUNK < rows ? i0 + GALERKIN_CHUNK : rows;
+        for (uint32_t i = i0; i < i1; i++) row_values(r, &win, c, i, true, true, acc, mark, pos);
+    }
+    mirror_lower(c, threads);
+    ok = true;
+done:
+    if (!ok) spn__bsr_free(c);
+    spn__bsr_free(&ap);
+    free(marks), free(range), free(wstart), free(wval), free(accs);
+    return ok;
 }
 
 bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm_out, int threads)

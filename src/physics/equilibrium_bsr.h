@@ -36,6 +36,9 @@ typedef struct spn__bsr {
      * block k being the transpose of tsrc's float64 block tperm[k] */
     const struct spn__bsr *tsrc;
     const uint32_t *tperm;
+    /* a window onto rows [base, rows) of a larger matrix: row r is stored
+     * as row r - base (0 for a whole matrix; spn__bsr_galerkin_ap) */
+    uint32_t base;
 } spn__bsr;
 
 void spn__bsr_free(spn__bsr *a);
@@ -53,6 +56,12 @@ bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_f
  * the blocks above the diagonal computed and those below mirrored from them
  * (C exactly symmetric). false on out of memory. */
 bool spn__bsr_galerkin(const spn__bsr *r, const spn__bsr *ap, spn__bsr *c, int threads);
+/* The same from A and P, without holding all of A P: C's rows go in chunks,
+ * each with the rows of A P it reads computed into a window that is used
+ * again (every row of A P is its own sum, so the same bits as forming A P
+ * whole and calling spn__bsr_galerkin, which it falls back to when the
+ * windows would overlap too much). */
+bool spn__bsr_galerkin_ap(const spn__bsr *a, const spn__bsr *p, const spn__bsr *r, spn__bsr *c, int threads);
 /* T = A^T (A in float64): its pattern, and perm[k], the entry of A that
  * T's entry k comes from. T's values are read from A through perm (no copy:
  * the Galerkin product is the only reader of R = P^T in float64) until

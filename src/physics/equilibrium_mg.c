@@ -345,7 +345,6 @@ static bool add_level(spn__mg *mg, int l)
 {
     mg_level *L = &mg->lv[l], *C = &mg->lv[l + 1];
     uint32_t n = L->A.rows;
-    spn__bsr ap = {0};
     uint32_t *rperm = NULL;
     L->agg = spn__big_alloc((n ? n : 1) * sizeof *L->agg);
     if (!L->agg) return false;
@@ -369,11 +368,9 @@ static bool add_level(spn__mg *mg, int l)
             P->val[9 * (size_t)i] = P->val[9 * (size_t)i + 4] = P->val[9 * (size_t)i + 8] = 1;
         }
     }
-    ok = ok && spn__bsr_mul(&L->A, &L->P, &ap, false, mg->threads) &&
-         spn__bsr_transpose(&L->P, &L->R, &rperm, mg->threads) && spn__bsr_galerkin(&L->R, &ap, &C->A, mg->threads);
-    spn__bsr_free(&ap);
-    /* R's float32 blocks after A P is freed: they take its pages (about 90 MB
-     * on the 1M web's level 0), not fresh ones; R in float64 was never made */
+    ok = ok && spn__bsr_transpose(&L->P, &L->R, &rperm, mg->threads) &&
+         spn__bsr_galerkin_ap(&L->A, &L->P, &L->R, &C->A, mg->threads);
+    /* R's float32 blocks from P (R in float64 was never made) */
     ok = ok && spn__bsr_transpose_round(&L->R, mg->threads);
     free(rperm);
     if (!ok) return false;

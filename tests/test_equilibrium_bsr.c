@@ -1,11 +1,18 @@
-/* The block Gauss-Seidel sweep of the multigrid's coarse levels
- * (spn__bsr_gauss_seidel, equilibrium_bsr.c). A large matrix is swept in
- * parts, in parallel, each part reading the others' values from the start of
- * the sweep. This test holds the sweep to a reference written here (rows
- * in order inside a part, the other parts' values from a copy), checks that
- * the parts depend on the matrix alone (the same bits on one, two and three
- * threads), that a small matrix is swept whole, and that symmetric sweeps
- * still solve a positive definite system. */
+/* The block sparse kernels of the multigrid's setup and coarse levels
+ * (equilibrium_bsr.c).
+ *
+ * The block Gauss-Seidel sweep (spn__bsr_gauss_seidel): a large matrix is
+ * swept in parts, in parallel, each part reading the others' values from
+ * the start of the sweep. Held to a reference written here (rows in order
+ * inside a part, the other parts' values from a copy), the parts depend on
+ * the matrix alone (the same bits on one, two and three threads), a small
+ * matrix is swept whole, and symmetric sweeps still solve a positive
+ * definite system.
+ *
+ * The Galerkin product from A and P in chunks (spn__bsr_galerkin_ap): the
+ * same bits as forming A P whole and multiplying by R = P^T, with chunks
+ * whose windows of A P are local and with a numbering that makes it fall
+ * back to A P whole, on one and two threads. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -213,6 +220,81 @@ static void test_parted_sweeps_solve(void **state)
     free_grid(&g);
 }
 
+/* P for the grid: particle i's 2 x 2 aggregate (numbered row by row of
+ * aggregates, or scrambled by a fixed permutation) with the identity, and
+ * its right neighbour's aggregate, when another, with 0.25 I + 0.01 E. */
+static spn__bsr make_p(uint32_t side, bool scrambled)
+{
+    const uint32_t n = side * side, ac = (side + 1) / 2, nc = ac * ac;
+    uint32_t *id = malloc(nc * sizeof *id);
+    assert_non_null(id);
+    for (uint32_t k = 0; k < nc; k++) id[k] = k;
+    if (scrambled) {
+        unsigned seed = 17;
+        for (uint32_t k = nc - 1; k > 0; k--) {
+            next(&seed);
+            uint32_t j = (seed >> 8) % (k + 1), t = id[k];
+            id[k] = id[j], id[j] = t;
+        }
+    }
+    spn__bsr p = {.rows = n, .cols = nc};
+    p.start = malloc(((size_t)n + 1) * sizeof *p.start);
+    p.col = malloc(2 * (size_t)n * sizeof *p.col);
+    p.val = calloc(18 * (size_t)n, sizeof *p.val);
+    assert_true(p.start && p.col && p.val);
+    uint32_t q = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t r = i / side, c = i % side, own = id[(r / 2) * ac + c / 2];
+        p.start[i] = q;
+        p.col[q] = own;
+        p.val[9 * (size_t)q] = p.val[9 * (size_t)q + 4] = p.val[9 * (size_t)q + 8] = 1;
+        q++;
+        if (c + 1 < side && (c + 1) / 2 != c / 2) {
+            p.col[q] = id[(r / 2) * ac + (c + 1) / 2];
+            for (int k = 0; k < 9; k++) p.val[9 * (size_t)q + k] = (k % 4 == 0 ? 0.25 : 0) + 0.01 * edge_entry(i, i + 1, k % 6);
+            q++;
+        }
+    }
+    p.start[n] = q;
+    free(id);
+    return p;
+}
+
+static void check_galerkin(uint32_t side, bool scrambled)
+{
+    grid g = make_grid(side);
+    spn__bsr p = make_p(side, scrambled), r, ap, ref;
+    uint32_t *perm;
+    assert_true(spn__bsr_transpose(&p, &r, &perm, 1));
+    assert_true(spn__bsr_mul(&g.a, &p, &ap, false, 1));
+    assert_true(spn__bsr_galerkin(&r, &ap, &ref, 1));
+    for (int t = 1; t <= 2; t++) {
+        spn__bsr c;
+        assert_true(spn__bsr_galerkin_ap(&g.a, &p, &r, &c, t));
+        assert_int_equal(c.rows, ref.rows);
+        assert_memory_equal(c.start, ref.start, ((size_t)ref.rows + 1) * sizeof *c.start);
+        assert_memory_equal(c.col, ref.col, ref.start[ref.rows] * sizeof *c.col);
+        assert_memory_equal(c.val, ref.val, 9 * (size_t)ref.start[ref.rows] * sizeof *c.val);
+        spn__bsr_free(&c);
+    }
+    spn__bsr_free(&ref), spn__bsr_free(&ap), spn__bsr_free(&r), spn__bsr_free(&p);
+    free(perm);
+    free_grid(&g);
+}
+
+static void test_galerkin_in_chunks(void **state)
+{
+    (void)state;
+    check_galerkin(150, false); /* 5,625 coarse rows: two chunks */
+    check_galerkin(40, false);  /* one */
+}
+
+static void test_galerkin_scrambled_falls_back(void **state)
+{
+    (void)state;
+    check_galerkin(150, true);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -220,6 +302,8 @@ int main(void)
         cmocka_unit_test(test_small_matrix_swept_whole),
         cmocka_unit_test(test_large_matrix_swept_in_parts),
         cmocka_unit_test(test_parted_sweeps_solve),
+        cmocka_unit_test(test_galerkin_in_chunks),
+        cmocka_unit_test(test_galerkin_scrambled_falls_back),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
