@@ -265,7 +265,7 @@ static void check_galerkin(uint32_t side, bool scrambled)
     grid g = make_grid(side);
     spn__bsr p = make_p(side, scrambled), r, ap, ref;
     uint32_t *perm;
-    assert_true(spn__bsr_transpose(&p, &r, &perm, 1));
+    assert_true(spn__bsr_transpose(&p, &r, &perm));
     assert_true(spn__bsr_mul(&g.a, &p, &ap, false, 1));
     assert_true(spn__bsr_galerkin(&r, &ap, &ref, 1));
     for (int t = 1; t <= 2; t++) {

@@ -391,9 +391,9 @@ bool spn__bsr_galerkin_ap(const spn__bsr *a, const spn__bsr *p, const spn__bsr *
 #pragma omp parallel for schedule(dynamic, 64) num_threads(nt)
         for (uint32_t i = 0; i < n; i++) {
             const size_t t = (size_t)spn__thread_num();
-            row_known(a, p, &ap, i, accs ? accs + t * ACC * widest : NULL, marks + (size_t)(nt + (int)t) * per);
+            row_known(a, p, &ap, i, accs ? accs + t * ACC * widest : NULL, marks + ((size_t)nt + t) * per);
         }
-        ok = mul(r, &ap, c, true, true, true, threads);
+        ok = spn__bsr_galerkin(r, &ap, c, threads);
         goto done;
     }
     /* C's pattern, from A P's */
@@ -442,9 +442,8 @@ done:
     return ok;
 }
 
-bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm_out, int threads)
+bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm_out)
 {
-    (void)threads;
     memset(t, 0, sizeof *t);
     t->rows = a->cols;
     t->cols = a->rows;

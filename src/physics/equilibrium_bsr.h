@@ -50,7 +50,9 @@ static inline int spn__bsr_team(const spn__bsr *a, int threads)
     return (double)a->start[a->rows] < SPN__BSR_PAR_MIN ? 1 : threads;
 }
 /* Pattern and values of C = A B (C's square-matrix diagonal first when
- * diag_first), a temporary (plain malloc). false on out of memory. */
+ * diag_first), a temporary (plain malloc). false on out of memory. (The
+ * setup forms A P through spn__bsr_galerkin_ap; the tests keep this as its
+ * reference.) */
 bool spn__bsr_mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_first, int threads);
 /* The Galerkin product C = R (A P), R = P^T, A symmetric: diagonal first,
  * the blocks above the diagonal computed and those below mirrored from them
@@ -67,7 +69,7 @@ bool spn__bsr_galerkin_ap(const spn__bsr *a, const spn__bsr *p, const spn__bsr *
  * the Galerkin product is the only reader of R = P^T in float64) until
  * spn__bsr_transpose_round gives T its own float32 blocks; A must outlive
  * that, and perm too. */
-bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm, int threads);
+bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm);
 /* T's blocks rounded to float32 from its source (as spn__bsr_round would
  * from a float64 copy: the same floats); false on out of memory. */
 bool spn__bsr_transpose_round(spn__bsr *t, int threads);

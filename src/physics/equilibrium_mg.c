@@ -368,7 +368,7 @@ static bool add_level(spn__mg *mg, int l)
             P->val[9 * (size_t)i] = P->val[9 * (size_t)i + 4] = P->val[9 * (size_t)i + 8] = 1;
         }
     }
-    ok = ok && spn__bsr_transpose(&L->P, &L->R, &rperm, mg->threads) &&
+    ok = ok && spn__bsr_transpose(&L->P, &L->R, &rperm) &&
          spn__bsr_galerkin_ap(&L->A, &L->P, &L->R, &C->A, mg->threads);
     /* R's float32 blocks from P (R in float64 was never made) */
     ok = ok && spn__bsr_transpose_round(&L->R, mg->threads);
