@@ -285,14 +285,14 @@ static void check_galerkin(uint32_t side, bool scrambled)
 static void test_galerkin_in_chunks(void **state)
 {
     (void)state;
-    check_galerkin(150, false); /* 5,625 coarse rows: two chunks */
-    check_galerkin(40, false);  /* one */
+    check_galerkin(400, false); /* 40,000 coarse rows: ten chunks, and enough block products for a team */
+    check_galerkin(40, false);  /* one chunk */
 }
 
 static void test_galerkin_scrambled_falls_back(void **state)
 {
     (void)state;
-    check_galerkin(150, true);
+    check_galerkin(400, true);
 }
 
 int main(void)
