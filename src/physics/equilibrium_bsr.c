@@ -235,6 +235,14 @@ static void mirror_lower(spn__bsr *c, int threads)
         }
 }
 
+/* The widest row of a square or rectangular pattern (1 at least). */
+static uint32_t widest_row(const spn__bsr *m)
+{
+    uint32_t w = 1;
+    for (uint32_t i = 0; i < m->rows; i++) w = m->start[i + 1] - m->start[i] > w ? m->start[i + 1] - m->start[i] : w;
+    return w;
+}
+
 /* lasting: C outlives the setup (huge pages: spn__big_alloc); otherwise
  * it is a temporary read once (A P), on plain malloc, since in a VM
  * that hands huge pages out fresh from the host their first touch costs
@@ -273,10 +281,7 @@ static bool mul(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, bool diag_fir
     size_t acc_per = 0;
 #if SPN__AVX
     if (spn__have_avx()) {
-        uint32_t widest = 1;
-        for (uint32_t i = 0; i < a->rows; i++)
-            if (c->start[i + 1] - c->start[i] > widest) widest = c->start[i + 1] - c->start[i];
-        acc_per = ACC * (size_t)widest; /* a multiple of 4 doubles: each thread's part stays 32-byte aligned */
+        acc_per = ACC * (size_t)widest_row(c); /* a multiple of 4 doubles: each thread's part stays 32-byte aligned */
         accs = aligned_alloc(32, (size_t)nt * acc_per * sizeof *accs);
         if (!accs) goto fail;
     }
@@ -319,14 +324,6 @@ static void row_known(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_
 {
     for (uint32_t q = c->start[i - c->base]; q < c->start[i - c->base + 1]; q++) pos[c->col[q]] = q;
     row_sums_of(a, b, c, i, false, acc, pos);
-}
-
-/* The widest row of a square or rectangular pattern (1 at least). */
-static uint32_t widest_row(const spn__bsr *m)
-{
-    uint32_t w = 1;
-    for (uint32_t i = 0; i < m->rows; i++) w = m->start[i + 1] - m->start[i] > w ? m->start[i + 1] - m->start[i] : w;
-    return w;
 }
 
 /* Why: A P of the 1M web's finest level is 350 MB, written once and read
