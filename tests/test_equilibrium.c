@@ -2,8 +2,8 @@
  * independently: a spring stretched F/k, the catenary, a dense Newton
  * reference on a small orb web, a residual computed here from the positions,
  * slack and compressed threads, the same bits twice and with two threads, the
- * multigrid's hierarchy on a web with a large hub, and bad definitions
- * named. */
+ * multigrid's hierarchy on a web with a large hub, doubled threads against
+ * threads twice as stiff, and bad definitions named. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -490,6 +490,45 @@ static void test_hub_web_settles_as_block_jacobi_does(void **state)
     spn_world_destroy(b);
 }
 
+/* Two springs between the same particles are one spring of twice the
+ * stiffness. The multigrid's level 0 merges them into one block, and the
+ * line factors, which read their blocks from the springs, must sum both: a
+ * web with every thread doubled has to settle as the web with every thread
+ * twice as stiff, in as many Newton steps and CG iterations (a line factor
+ * that read one spring of each pair did not converge in 200 Newton steps), to the same positions
+ * within what the tolerance leaves (3e-7 of the sag measured). */
+static void test_doubled_threads_settle_as_twice_as_stiff(void **state)
+{
+    (void)state;
+    spn_world *a = small_orb(20, 50, 0.02, 1), *b = small_orb(20, 50, 0.02, 1);
+    const uint32_t m = spn_world_spring_count(a);
+    for (uint32_t s = 0; s < m; s++) {
+        spn_spring_info si = spn_world_spring(a, s);
+        spn_spring_def sd = spn_spring_def_default();
+        sd.a = si.a, sd.b = si.b, sd.k = si.k, sd.kd = spn_world_spring_damping(a, s), sd.rest = si.rest;
+        sd.tension_only = si.tension_only;
+        assert_int_equal(spn_world_add_spring(a, &sd, NULL), SPN_OK);
+        spn_world_set_spring_stiffness(b, s, 2 * si.k, 2 * sd.kd);
+    }
+    spn_equilibrium_def da = loaded_def(a, SPN_PRECOND_MULTIGRID), db = loaded_def(b, SPN_PRECOND_MULTIGRID);
+    spn_equilibrium_report ra, rb;
+    assert_int_equal(spn_world_equilibrium(a, &da, &ra), SPN_OK);
+    assert_int_equal(spn_world_equilibrium(b, &db, &rb), SPN_OK);
+    print_message("doubled threads: %d Newton, %d CG; twice as stiff: %d Newton, %d CG\n", ra.iterations,
+                  ra.cg_iterations, rb.iterations, rb.cg_iterations);
+    assert_int_equal(ra.reason, SPN_EQUILIBRIUM_CONVERGED);
+    assert_int_equal(rb.reason, SPN_EQUILIBRIUM_CONVERGED);
+    assert_int_equal(ra.iterations, rb.iterations);
+    assert_int_equal(ra.cg_iterations, rb.cg_iterations);
+    double sag = fabs(spn_world_position(b, 0).z), apart = 0;
+    assert_true(sag > 1e-6);
+    for (uint32_t i = 0; i < spn_world_particle_count(a); i++)
+        apart = fmax(apart, spn_v3_len(spn_v3_sub(spn_world_position(a, i), spn_world_position(b, i))));
+    assert_true(apart < 1e-5 * sag);
+    spn_world_destroy(a);
+    spn_world_destroy(b);
+}
+
 static void test_bad_definitions_are_named(void **state)
 {
     (void)state;
@@ -534,6 +573,7 @@ int main(void)
         cmocka_unit_test(test_species_web_multigrid),
         cmocka_unit_test(test_hub_row_makes_no_dense_level),
         cmocka_unit_test(test_hub_web_settles_as_block_jacobi_does),
+        cmocka_unit_test(test_doubled_threads_settle_as_twice_as_stiff),
         cmocka_unit_test(test_bad_definitions_are_named),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -454,17 +454,47 @@ fail:
     return NULL;
 }
 
-/* The six distinct entries of a symmetric 3x3 block, as floats at stride W
- * (0 1 2 the diagonal, 3 4 5 the entries (0,1) (0,2) (1,2)); a NONE entry,
- * a padded lane, keeps the zeros it was allocated with. (On the species webs
- * the lanes are three quarters padding, and rewriting their zeros at every
- * Newton step cost more than the real blocks.) */
-static void to_float6(const spn__bsr *a0, uint32_t entry, float *f)
+/* Level-0 entry p of particle i's row, the six distinct entries of its
+ * symmetric block (0 1 2 the diagonal, 3 4 5 the entries (0,1) (0,2) (1,2)),
+ * read from the spring system: from zero, the particle's diagonal block or
+ * the blocks of the springs to the entry's column, in adjacency order. That
+ * is how the level-0 matrix sums them (equilibrium_mg.c, level0_values), so
+ * the values are its bits; the factorisation needs no copy of that matrix
+ * (the 1M web's is 360 MB), only its pattern. */
+static void l0_block(const spn__eq *e, const spn__bsr *a0, uint32_t i, uint32_t p, double h[6])
 {
-    static const int src[6] = {0, 4, 8, 1, 2, 5};
-    if (entry == NONE) return;
-    const double *v = a0->val + 9 * (size_t)entry;
-    for (int q = 0; q < 6; q++) f[W * q] = (float)v[src[q]];
+    for (int k = 0; k < 6; k++) h[k] = 0;
+    const uint32_t c = a0->col[p];
+    if (c == i) {
+        for (int k = 0; k < 6; k++) h[k] += e->diag[6 * (size_t)i + k];
+        return;
+    }
+    for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++)
+        if (e->adj_other[j] == (int32_t)c) {
+            double tmp[6];
+            const double *o = spn__eq_offd(e, j, tmp);
+            for (int k = 0; k < 6; k++) h[k] += o[k];
+        }
+}
+
+/* Entry p of row i as floats at stride W; a NONE entry, a padded lane, keeps
+ * the zeros it was allocated with. (On the species webs the lanes are three
+ * quarters padding, and rewriting their zeros at every Newton step cost
+ * more than the real blocks.) */
+static void to_float6(const spn__eq *e, const spn__bsr *a0, uint32_t i, uint32_t p, float *f)
+{
+    if (p == NONE) return;
+    double h[6];
+    l0_block(e, a0, i, p, h);
+    for (int q = 0; q < 6; q++) f[W * q] = (float)h[q];
+}
+
+/* The full 3x3 of a block's six entries, row by row */
+static void sym_full(const double h[6], double m[9])
+{
+    m[0] = h[0], m[1] = h[3], m[2] = h[4];
+    m[3] = h[3], m[4] = h[1], m[5] = h[5];
+    m[6] = h[4], m[7] = h[5], m[8] = h[2];
 }
 
 /* Block Thomas factorisation of group g's lines, all eight lanes at once:
@@ -473,7 +503,7 @@ static void to_float6(const spn__bsr *a0, uint32_t entry, float *f)
  * replaced and of spn__sym_inverse, so the bits are the same. A padded
  * lane (past its line's end) factors an identity pivot and stores zeros. False if a pivot is not
  * positive definite. */
-SPN__KERNEL static bool factor_group(spn__lines *L, const spn__bsr *a0, uint32_t g)
+SPN__KERNEL static bool factor_group(spn__lines *L, const spn__eq *sys, const spn__bsr *a0, uint32_t g)
 {
     static const double ident[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, zero[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
     static const int R[6] = {0, 1, 2, 0, 0, 1}, C[6] = {0, 1, 2, 1, 2, 2};
@@ -486,8 +516,11 @@ SPN__KERNEL static bool factor_group(spn__lines *L, const spn__bsr *a0, uint32_t
         for (uint32_t q = 0; q < W; q++) {
             const uint32_t i = L->snode[W * s + q], up = first ? NONE : L->supos[W * (s - 1) + q];
             on[q] = i != NONE;
-            const double *dd = on[q] ? a0->val + 9 * (size_t)a0->start[i] : ident;
-            const double *uu = up == NONE ? zero : a0->val + 9 * (size_t)up;
+            double h[6], dd[9], uu[9];
+            if (on[q]) l0_block(sys, a0, i, a0->start[i], h), sym_full(h, dd);
+            else memcpy(dd, ident, sizeof dd);
+            if (up != NONE) l0_block(sys, a0, L->snode[W * (s - 1) + q], up, h), sym_full(h, uu);
+            else memcpy(uu, zero, sizeof uu);
             for (int f = 0; f < 9; f++) d[f][q] = dd[f], u[f][q] = uu[f];
         }
         if (first) {
@@ -534,7 +567,7 @@ SPN__KERNEL static bool factor_group(spn__lines *L, const spn__bsr *a0, uint32_t
     return ok;
 }
 
-bool spn__lines_factor(spn__lines *L, const spn__bsr *a0, int threads)
+bool spn__lines_factor(spn__lines *L, const spn__eq *e, const spn__bsr *a0, int threads)
 {
     /* float copies of the blocks the sweep reads, in the order it reads them
      * (level-0 blocks are symmetric: sums of -H_s or of H_s); each group's
@@ -546,10 +579,11 @@ bool spn__lines_factor(spn__lines *L, const spn__bsr *a0, int threads)
     for (uint32_t g = 0; g < L->groups; g++) {
         for (size_t s = L->group_step[g]; s < L->group_step[g + 1]; s++) {
             for (size_t j = L->off_step[s]; j < L->off_step[s + 1]; j++)
-                for (uint32_t q = 0; q < W; q++) to_float6(a0, L->soff[W * j + q], L->offval + 6 * W * j + q);
-            for (uint32_t q = 0; q < W; q++) to_float6(a0, L->supos[W * s + q], L->uval + 6 * W * s + q);
+                for (uint32_t q = 0; q < W; q++)
+                    to_float6(e, a0, L->snode[W * s + q], L->soff[W * j + q], L->offval + 6 * W * j + q);
+            for (uint32_t q = 0; q < W; q++) to_float6(e, a0, L->snode[W * s + q], L->supos[W * s + q], L->uval + 6 * W * s + q);
         }
-        bad += !factor_group(L, a0, g);
+        bad += !factor_group(L, e, a0, g);
     }
     return bad == 0;
 }

@@ -77,7 +77,8 @@
 #define SLIDE_REFRESH_N 50000u
 
 typedef struct mg_level {
-    spn__bsr A;         /* the level's matrix, diagonal block first in each row */
+    spn__bsr A;         /* the level's matrix, diagonal block first in each row; level 0 of a
+                         * spring system keeps only its pattern once the hierarchy is built */
     double *dinv;       /* 6 per row: inverted diagonal blocks */
     double *x, *b, *r;  /* 3 per row */
     /* to the next coarser level */
@@ -454,14 +455,20 @@ static spn_status build(spn__mg *mg, const spn__eq *e, const double *inv0)
         if (!dense_factor(mg)) return SPN_ERR_UNSTABLE;
     }
     /* Built: from here the coarse levels and the transfers are only
-     * multiplied by vectors (the finest level's values are refreshed each
-     * Newton step and stay float64): float32 copies halve the bytes those
-     * products read. */
+     * multiplied by vectors (the finest level stays float64, below): float32
+     * copies halve the bytes those products read. */
     for (int l = 0; l < mg->nlevels; l++) {
         mg_level *L = &mg->lv[l];
         if (l > 0) spn__bsr_round(&L->A);
         if (L->P.val) spn__bsr_round(&L->P);
         if (L->R.val) spn__bsr_round(&L->R);
+    }
+    /* A spring system's level 0 is multiplied from its springs
+     * (spn__eq_matvec_mg) and the line factors read their blocks from there
+     * too: its values (360 MB on the 1M web) served the hierarchy only */
+    if (e->hs) {
+        free(L0->A.val);
+        L0->A.val = NULL;
     }
     /* The line smoother and the slides last: their arrays then take the
      * pages the setup's temporaries (each level's A P) and the rounding have
@@ -488,7 +495,7 @@ spn_status spn__mg_setup(spn__mg **out, const spn__eq *e, const double *inv0)
         *out = mg;
     } else {
         mg->lv[0].dinv = (double *)inv0;
-        level0_values(mg, e);
+        if (!e->hs) level0_values(mg, e);
     }
     /* Like the hierarchy, the slide matrix of the first system is kept on a
      * small web: the later ones needed the same CG iterations (5k: 12, 100k:
@@ -501,7 +508,7 @@ spn_status spn__mg_setup(spn__mg **out, const spn__eq *e, const double *inv0)
      * steps and 62 CG. Why the first matrix fits at 100k and not at 1M was
      * not found out. */
     if (mg->slide && (!mg->slide_ok || e->n > SLIDE_REFRESH_N)) mg->slide_ok = spn__slide_factor(mg->slide, e);
-    return spn__lines_factor(mg->lv[0].lines, &mg->lv[0].A, mg->threads) ? SPN_OK : SPN_ERR_UNSTABLE;
+    return spn__lines_factor(mg->lv[0].lines, e, &mg->lv[0].A, mg->threads) ? SPN_OK : SPN_ERR_UNSTABLE;
 }
 
 /* ---- the cycle ------------------------------------------------------------ */
