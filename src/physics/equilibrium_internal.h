@@ -151,7 +151,7 @@ bool spn__mg_level(const spn__mg *mg, int l, uint32_t *rows, uint32_t *blocks, u
 typedef struct spn__lines spn__lines;
 struct spn__bsr;
 spn__lines *spn__lines_build(const spn__eq *e, const struct spn__bsr *a0);
-bool spn__lines_factor(spn__lines *L, const spn__eq *e, const struct spn__bsr *a0, int threads);
+bool spn__lines_factor(spn__lines *L, const spn__eq *e, int threads);
 void spn__lines_sweep(const spn__lines *L, const double *b, double *x, bool forward, int threads);
 void spn__lines_free(spn__lines *L);
 /* The lines' particles: line l is node[start[l] .. start[l + 1]). */

@@ -92,10 +92,11 @@ struct spn__lines {
     uint32_t groups, *colour_group; /* colours + 1: groups [colour_group[c], colour_group[c + 1]) */
     uint32_t steps, *group_step;    /* groups + 1: steps [group_step[g], group_step[g + 1]) */
     bool prefetch;                  /* a web too big for the caches: solve_group prefetches */
+    bool merged;                    /* some pair of particles is joined by several springs */
     uint32_t *snode;                /* W per step: the lane's particle, or NONE */
-    uint32_t *supos;                /* W per step: the BSR entry (particle, next particle), or NONE */
+    uint32_t *supos;                /* W per step: the adjacency entry (particle, next particle), or NONE */
     uint32_t *off_step;             /* steps + 1: off blocks [off_step[s], off_step[s + 1]) of step s */
-    uint32_t *soff;                 /* W per off block: the BSR entry off the line's tridiagonal part, or NONE */
+    uint32_t *soff;                 /* W per off block: the adjacency entry off the line's tridiagonal part, or NONE */
     uint32_t *soffcol;              /* W per off block: the particle it couples (0 in a padded lane) */
     /* float32 copies (see the file comment): entry f of lane q at (n j + f) W + q */
     float *offval;                  /* n = 6 per off block: its symmetric block */
@@ -184,12 +185,13 @@ static bool pair_springs(const spn__eq *e, uint32_t *partner)
     return true;
 }
 
-/* The BSR entry of (i, c) in row i (the merged block of every spring between them). */
-static uint32_t find_entry(const spn__bsr *a, uint32_t i, uint32_t c)
+/* The adjacency entry of particle i's first spring to particle c (when
+ * several springs join them, the factorisation sums them from there) */
+static uint32_t first_spring(const spn__eq *e, uint32_t i, uint32_t c)
 {
-    for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++)
-        if (a->col[p] == c) return p;
-    return UINT32_MAX;
+    for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++)
+        if (e->adj_other[j] == (int32_t)c) return j;
+    return NONE;
 }
 
 typedef struct walker {
@@ -345,16 +347,17 @@ static bool colour_lines(spn__lines *L, const spn__bsr *a)
 /* The entries of line node k's row off the line's block tridiagonal part T
  * (not the diagonal, not the previous or next node of line l): the sweep
  * solves T x_line = b - (A - T) x over those alone. Their count, and, with
- * `put`, the entries themselves into ent[], col[] at stride W. */
-static uint32_t off_entries(const spn__lines *L, const spn__bsr *a0, uint32_t l, uint32_t k, uint32_t *ent,
-                            uint32_t *col)
+ * `put`, their particles into col[] and the adjacency entries of their
+ * (first) springs into ent[], at stride W. */
+static uint32_t off_entries(const spn__lines *L, const spn__eq *e, const spn__bsr *a0, uint32_t l, uint32_t k,
+                            uint32_t *ent, uint32_t *col)
 {
     uint32_t i = L->node[k], prev = k > L->start[l] ? L->node[k - 1] : i;
     uint32_t next = k + 1 < L->start[l + 1] ? L->node[k + 1] : i, cnt = 0;
     for (uint32_t p = a0->start[i]; p < a0->start[i + 1]; p++) {
         uint32_t c = a0->col[p];
         if (c == i || c == prev || c == next) continue;
-        if (ent) ent[(size_t)W * cnt] = p, col[(size_t)W * cnt] = c;
+        if (ent) ent[(size_t)W * cnt] = first_spring(e, i, c), col[(size_t)W * cnt] = c;
         cnt++;
     }
     return cnt;
@@ -370,7 +373,7 @@ static uint32_t lane_line(const spn__lines *L, uint32_t c, uint32_t g, uint32_t 
 /* Steps of the lines laid side by side: group and step offsets first (a
  * group's steps: its longest line; a step's off blocks: the most any lane
  * has), then the particles and BSR entries of each lane. */
-static bool lay_out(spn__lines *L, const spn__bsr *a0)
+static bool lay_out(spn__lines *L, const spn__eq *e, const spn__bsr *a0)
 {
     L->colour_group = spn__big_alloc(((size_t)L->colours + 1) * sizeof *L->colour_group);
     if (!L->colour_group) return false;
@@ -399,18 +402,18 @@ static bool lay_out(spn__lines *L, const spn__bsr *a0)
                 for (uint32_t q = 0; q < W; q++) {
                     uint32_t l = lane_line(L, c, g, q), len = l == UINT32_MAX ? 0 : L->start[l + 1] - L->start[l];
                     for (uint32_t s = L->group_step[g], t = 0; s < L->group_step[g + 1]; s++, t++) {
-                        const size_t e = W * (size_t)s + q;
+                        const size_t slot = W * (size_t)s + q;
                         uint32_t k = t < len ? L->start[l] + t : UINT32_MAX;
                         if (pass == 0) {
-                            uint32_t cnt = k == UINT32_MAX ? 0 : off_entries(L, a0, l, k, NULL, NULL);
+                            uint32_t cnt = k == UINT32_MAX ? 0 : off_entries(L, e, a0, l, k, NULL, NULL);
                             if (cnt > L->off_step[s + 1]) L->off_step[s + 1] = cnt;
-                            L->snode[e] = k == UINT32_MAX ? NONE : L->node[k];
-                            L->supos[e] = k == UINT32_MAX || t + 1 >= len ? NONE : find_entry(a0, L->node[k], L->node[k + 1]);
+                            L->snode[slot] = k == UINT32_MAX ? NONE : L->node[k];
+                            L->supos[slot] = k == UINT32_MAX || t + 1 >= len ? NONE : first_spring(e, L->node[k], L->node[k + 1]);
                             continue;
                         }
                         size_t j0 = L->off_step[s], j1 = L->off_step[s + 1];
                         uint32_t cnt = k == UINT32_MAX ? 0
-                                                       : off_entries(L, a0, l, k, L->soff + W * j0 + q, L->soffcol + W * j0 + q);
+                                                       : off_entries(L, e, a0, l, k, L->soff + W * j0 + q, L->soffcol + W * j0 + q);
                         for (size_t j = j0 + cnt; j < j1; j++) L->soff[W * j + q] = NONE, L->soffcol[W * j + q] = 0;
                     }
                 }
@@ -445,7 +448,11 @@ spn__lines *spn__lines_build(const spn__eq *e, const spn__bsr *a0)
     free(partner);
     partner = NULL;
     if (!colour_lines(L, a0)) goto fail;
-    if (!lay_out(L, a0)) goto fail;
+    if (!lay_out(L, e, a0)) goto fail;
+    /* level 0 has a block per pair of particles: fewer than the adjacency's entries when a pair has several springs */
+    uint32_t joined = 0;
+    for (uint32_t j = 0; j < nadj; j++) joined += e->adj_other[j] >= 0;
+    L->merged = a0->start[a0->rows] - a0->rows != joined;
     L->prefetch = a0->rows >= PREFETCH_MIN;
     return L;
 fail:
@@ -454,38 +461,40 @@ fail:
     return NULL;
 }
 
-/* Level-0 entry p of particle i's row, the six distinct entries of its
- * symmetric block (0 1 2 the diagonal, 3 4 5 the entries (0,1) (0,2) (1,2)),
- * read from the spring system: from zero, the particle's diagonal block or
- * the blocks of the springs to the entry's column, in adjacency order. That
- * is how the level-0 matrix sums them (equilibrium_mg.c, level0_values), so
- * the values are its bits; the factorisation needs no copy of that matrix
- * (the 1M web's is 360 MB), only its pattern. */
-static void l0_block(const spn__eq *e, const spn__bsr *a0, uint32_t i, uint32_t p, double h[6])
+/* The six distinct entries (0 1 2 the diagonal, 3 4 5 the entries (0,1)
+ * (0,2) (1,2)) of a level-0 block, read from the spring system: from zero,
+ * particle i's diagonal block (diag_block), or the blocks of its springs to
+ * the particle at the other end of adjacency entry j, its first spring there,
+ * in adjacency order (spring_block). That is how the level-0 matrix sums them
+ * (equilibrium_mg.c, level0_values), so the values are its bits; the
+ * factorisation needs no copy of that matrix (the 1M web's is 360 MB). */
+static void diag_block(const spn__eq *e, uint32_t i, double h[6])
 {
-    for (int k = 0; k < 6; k++) h[k] = 0;
-    const uint32_t c = a0->col[p];
-    if (c == i) {
-        for (int k = 0; k < 6; k++) h[k] += e->diag[6 * (size_t)i + k];
-        return;
-    }
-    for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++)
-        if (e->adj_other[j] == (int32_t)c) {
-            double tmp[6];
-            const double *o = spn__eq_offd(e, j, tmp);
+    for (int k = 0; k < 6; k++) h[k] = 0, h[k] += e->diag[6 * (size_t)i + k];
+}
+
+static void spring_block(const spn__lines *L, const spn__eq *e, uint32_t i, uint32_t j, double h[6])
+{
+    double tmp[6];
+    const double *o = spn__eq_offd(e, j, tmp);
+    for (int k = 0; k < 6; k++) h[k] = 0, h[k] += o[k];
+    if (!L->merged) return;
+    for (uint32_t jj = j + 1; jj < e->adj_start[i + 1]; jj++)
+        if (e->adj_other[jj] == e->adj_other[j]) {
+            o = spn__eq_offd(e, jj, tmp);
             for (int k = 0; k < 6; k++) h[k] += o[k];
         }
 }
 
-/* Entry p of row i as floats at stride W; a NONE entry, a padded lane, keeps
- * the zeros it was allocated with. (On the species webs the lanes are three
- * quarters padding, and rewriting their zeros at every Newton step cost
- * more than the real blocks.) */
-static void to_float6(const spn__eq *e, const spn__bsr *a0, uint32_t i, uint32_t p, float *f)
+/* The block of particle i and adjacency entry j as floats at stride W; a
+ * NONE entry, a padded lane, keeps the zeros it was allocated with. (On the
+ * species webs the lanes are three quarters padding, and rewriting their
+ * zeros at every Newton step cost more than the real blocks.) */
+static void to_float6(const spn__lines *L, const spn__eq *e, uint32_t i, uint32_t j, float *f)
 {
-    if (p == NONE) return;
+    if (j == NONE) return;
     double h[6];
-    l0_block(e, a0, i, p, h);
+    spring_block(L, e, i, j, h);
     for (int q = 0; q < 6; q++) f[W * q] = (float)h[q];
 }
 
@@ -503,7 +512,7 @@ static void sym_full(const double h[6], double m[9])
  * replaced and of spn__sym_inverse, so the bits are the same. A padded
  * lane (past its line's end) factors an identity pivot and stores zeros. False if a pivot is not
  * positive definite. */
-SPN__KERNEL static bool factor_group(spn__lines *L, const spn__eq *sys, const spn__bsr *a0, uint32_t g)
+SPN__KERNEL static bool factor_group(spn__lines *L, const spn__eq *sys, uint32_t g)
 {
     static const double ident[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, zero[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
     static const int R[6] = {0, 1, 2, 0, 0, 1}, C[6] = {0, 1, 2, 1, 2, 2};
@@ -517,9 +526,9 @@ SPN__KERNEL static bool factor_group(spn__lines *L, const spn__eq *sys, const sp
             const uint32_t i = L->snode[W * s + q], up = first ? NONE : L->supos[W * (s - 1) + q];
             on[q] = i != NONE;
             double h[6], dd[9], uu[9];
-            if (on[q]) l0_block(sys, a0, i, a0->start[i], h), sym_full(h, dd);
+            if (on[q]) diag_block(sys, i, h), sym_full(h, dd);
             else memcpy(dd, ident, sizeof dd);
-            if (up != NONE) l0_block(sys, a0, L->snode[W * (s - 1) + q], up, h), sym_full(h, uu);
+            if (up != NONE) spring_block(L, sys, L->snode[W * (s - 1) + q], up, h), sym_full(h, uu);
             else memcpy(uu, zero, sizeof uu);
             for (int f = 0; f < 9; f++) d[f][q] = dd[f], u[f][q] = uu[f];
         }
@@ -567,7 +576,7 @@ SPN__KERNEL static bool factor_group(spn__lines *L, const spn__eq *sys, const sp
     return ok;
 }
 
-bool spn__lines_factor(spn__lines *L, const spn__eq *e, const spn__bsr *a0, int threads)
+bool spn__lines_factor(spn__lines *L, const spn__eq *e, int threads)
 {
     /* float copies of the blocks the sweep reads, in the order it reads them
      * (level-0 blocks are symmetric: sums of -H_s or of H_s); each group's
@@ -580,10 +589,10 @@ bool spn__lines_factor(spn__lines *L, const spn__eq *e, const spn__bsr *a0, int 
         for (size_t s = L->group_step[g]; s < L->group_step[g + 1]; s++) {
             for (size_t j = L->off_step[s]; j < L->off_step[s + 1]; j++)
                 for (uint32_t q = 0; q < W; q++)
-                    to_float6(e, a0, L->snode[W * s + q], L->soff[W * j + q], L->offval + 6 * W * j + q);
-            for (uint32_t q = 0; q < W; q++) to_float6(e, a0, L->snode[W * s + q], L->supos[W * s + q], L->uval + 6 * W * s + q);
+                    to_float6(L, e, L->snode[W * s + q], L->soff[W * j + q], L->offval + 6 * W * j + q);
+            for (uint32_t q = 0; q < W; q++) to_float6(L, e, L->snode[W * s + q], L->supos[W * s + q], L->uval + 6 * W * s + q);
         }
-        bad += !factor_group(L, e, a0, g);
+        bad += !factor_group(L, e, g);
     }
     return bad == 0;
 }

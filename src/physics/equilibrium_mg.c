@@ -508,7 +508,7 @@ spn_status spn__mg_setup(spn__mg **out, const spn__eq *e, const double *inv0)
      * steps and 62 CG. Why the first matrix fits at 100k and not at 1M was
      * not found out. */
     if (mg->slide && (!mg->slide_ok || e->n > SLIDE_REFRESH_N)) mg->slide_ok = spn__slide_factor(mg->slide, e);
-    return spn__lines_factor(mg->lv[0].lines, e, &mg->lv[0].A, mg->threads) ? SPN_OK : SPN_ERR_UNSTABLE;
+    return spn__lines_factor(mg->lv[0].lines, e, mg->threads) ? SPN_OK : SPN_ERR_UNSTABLE;
 }
 
 /* ---- the cycle ------------------------------------------------------------ */
