@@ -395,9 +395,9 @@ static void test_multigrid_iterations_stay_bounded(void **state)
  * smoother's groups of eight are mostly padding and a group mixes lines
  * that end at different steps. The multigrid must still solve it as block
  * Jacobi does, in a few hundred CG iterations where block Jacobi needs
- * thousands (measured: 190 against 5,943; the two answers 3.6e-6 m apart,
- * 7.5e-4 of the largest move, both at a residual of 1e-6 of the force
- * scale), and give the same bits on two threads. */
+ * thousands (measured: 176 against 5,943, both to a residual of 1e-6 of
+ * the force scale), to the same rest (below), and give the same bits on
+ * two threads. */
 static void test_species_web_multigrid(void **state)
 {
     (void)state;
@@ -423,15 +423,41 @@ static void test_species_web_multigrid(void **state)
     assert_int_equal(rb.reason, SPN_EQUILIBRIUM_CONVERGED);
     assert_true(rm.cg_iterations <= 400);
     assert_true(rb.cg_iterations > 10 * rm.cg_iterations);
+    /* A particle whose threads are all slack feels no force anywhere in the
+     * slack they leave it, and one held by a thread of tension T only
+     * transversely, with stiffness about T / l: a residual of 1e-6 of the
+     * force scale F leaves it free by about 1e-6 F l / T. So the two
+     * answers agree in energy and on the particles that a thread of
+     * T >= 1e-4 F holds (to 5e-3 l, about 1e-2 of the largest move here);
+     * the rest may rest anywhere in their slack. Measured 2026-11-23, with
+     * the slides' tents: 11 particles held by no such thread, one of them
+     * 0.67 mm from block Jacobi's answer; the held ones 19 um apart (3.6 um
+     * before the tents, by the luck of the Newton path). */
+    const uint32_t np = spn_world_particle_count(mg);
+    bool *held = calloc(np, sizeof *held);
+    assert_non_null(held);
+    for (uint32_t s = 0; s < spn_world_spring_count(mg); s++) {
+        spn_spring_info si = spn_world_spring(mg, s);
+        double len = spn_v3_len(spn_v3_sub(spn_world_position(mg, si.a), spn_world_position(mg, si.b)));
+        if (si.k * (len - si.rest) >= 1e-4 * rm.force_scale)
+            held[si.a] = held[si.b] = true;
+    }
     double apart = 0;
-    for (uint32_t i = 0; i < spn_world_particle_count(mg); i++) {
+    uint32_t loose = 0;
+    for (uint32_t i = 0; i < np; i++) {
         spn_vec3 a = spn_world_position(mg, i), b = spn_world_position(bj, i), c = spn_world_position(two, i);
-        apart = fmax(apart, spn_v3_len(spn_v3_sub(a, b)));
+        if (held[i]) apart = fmax(apart, spn_v3_len(spn_v3_sub(a, b)));
+        loose += !held[i] && !spn_world_is_fixed(mg, i);
         assert_memory_equal(&a, &c, sizeof a);
     }
-    print_message("answers %.3g m apart, largest move %.3g m\n", apart, rm.max_displacement);
+    free(held);
+    print_message("answers %.3g m apart where a taut thread holds them (%u particles held by none), largest move "
+                  "%.3g m, energy change %.9g J and %.9g J\n",
+                  apart, loose, rm.max_displacement, rm.energy_change, rb.energy_change);
     assert_true(rm.max_displacement > 1e-3);
-    assert_true(apart <= 2e-3 * rm.max_displacement);
+    assert_true(loose < np / 100);
+    assert_true(apart <= 1e-2 * rm.max_displacement);
+    assert_true(fabs(rm.energy_change - rb.energy_change) <= 1e-6 * fabs(rb.energy_change));
     spn_world_destroy(mg), spn_world_destroy(bj), spn_world_destroy(two);
 }
 

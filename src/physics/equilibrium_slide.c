@@ -14,7 +14,18 @@
  * coarse levels do not see these modes as soft.
  *
  * What: one coarse unknown per thread line (equilibrium_lines.c) of two or
- * more particles: its particles displaced by 1 along the line's tangent. The
+ * more particles: its particles displaced along the line's tangent, by 1
+ * (a uniform slide) or by a tent, 0 one node beyond either end and 1 in the
+ * middle, whichever stretches the web less for its size (z^T A z / z^T z
+ * of the first Newton system). A ring slides uniformly: it turns. A radial
+ * of the orb web, held at the hub and at the frame, cannot slide uniformly
+ * without stretching its end springs, and the tent is the cheaper shape by
+ * a factor of about 2.7 there. The V-cycle leaves, with uniform slides, an
+ * error of radial displacements smooth from hub to frame and waving 11-14
+ * times round the web (the 1M web, stationary cycles), and the spectrum of
+ * the preconditioned system a tail of a dozen eigenvalues from 0.03 to 0.11
+ * (Lanczos from CG): the radials' tents took the 1M web from 47 to 37 CG
+ * and 100k from 24 to 21 (1e-6 T0; 71 -> 64 and 38 -> 35 at 1e-9). The
  * coarse matrix C = Z^T A Z (Z: the slide vectors as columns) is assembled
  * spring by spring from the projected Hessian blocks and factored densely
  * (lines: 164 on the 5k web, 649 at 100k, 1,999 at 1M). The correction
@@ -73,6 +84,45 @@ static void tangent(const spn__eq *e, const uint32_t *node, uint32_t k0, uint32_
     for (int c = 0; c < 3; c++) t[c] = len > 0 ? t[c] / len : 0;
 }
 
+/* A slide's weight at node t of a line of len nodes: 1 (uniform), or a tent
+ * that is 0 one node beyond either end and 1 in the middle. */
+static double slide_weight(bool tent, uint32_t t, uint32_t len)
+{
+    if (!tent) return 1;
+    double x = (double)(t + 1) / (len + 1);
+    return x < 0.5 ? 2 * x : 2 * (1 - x);
+}
+
+/* z^T A z / z^T z for the slide z of line nodes [k0, k1) in the given
+ * shape, from each spring at a line node: at[p] is particle p's node when it
+ * is on the line, else UINT32_MAX (a spring between two of the line's nodes
+ * is met from both ends and counted half each time). */
+static double slide_energy(const spn__eq *e, const uint32_t *node, const uint32_t *at, uint32_t k0, uint32_t k1,
+                           bool tent)
+{
+    double energy = 0, norm = 0;
+    for (uint32_t k = k0; k < k1; k++) {
+        double z[3], w = slide_weight(tent, k - k0, k1 - k0);
+        tangent(e, node, k0, k1, k, z);
+        for (int c = 0; c < 3; c++) z[c] *= w;
+        norm += w * w;
+        const uint32_t i = node[k];
+        for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++) {
+            const int32_t o = e->adj_other[j];
+            double d[3] = {z[0], z[1], z[2]}, hd[3], part = 1;
+            if (o >= 0 && at[o] != UINT32_MAX) {
+                double zo[3], wo = slide_weight(tent, at[o] - k0, k1 - k0);
+                tangent(e, node, k0, k1, at[o], zo);
+                for (int c = 0; c < 3; c++) d[c] -= wo * zo[c];
+                part = 0.5;
+            }
+            spn__sym_mul(e->hs + 6 * (size_t)(e->adj[j] >> 1), d, hd);
+            energy += part * (d[0] * hd[0] + d[1] * hd[1] + d[2] * hd[2]);
+        }
+    }
+    return energy / norm;
+}
+
 spn__slide *spn__slide_build(const spn__eq *e, const spn__lines *L)
 {
     uint32_t count, total, nz = 0;
@@ -84,26 +134,34 @@ spn__slide *spn__slide_build(const spn__eq *e, const spn__lines *L)
     S->pstart = spn__big_calloc((size_t)e->n + 1, sizeof *S->pstart);
     S->pcol = spn__big_alloc((total ? total : 1) * sizeof *S->pcol);
     S->ptan = spn__big_alloc(3 * (size_t)(total ? total : 1) * sizeof *S->ptan);
-    uint32_t *fill = calloc(e->n ? e->n : 1, sizeof *fill);
-    if (!S->pstart || !S->pcol || !S->ptan || !fill) {
-        free(fill);
+    uint32_t *fill = calloc(e->n ? e->n : 1, sizeof *fill), *at = malloc((e->n ? e->n : 1) * sizeof *at);
+    if (!S->pstart || !S->pcol || !S->ptan || !fill || !at) {
+        free(fill), free(at);
         spn__slide_free(S);
         return NULL;
     }
+    for (uint32_t i = 0; i < e->n; i++) at[i] = UINT32_MAX;
     for (uint32_t l = 0; l < count; l++)
         if (start[l + 1] - start[l] >= 2)
             for (uint32_t k = start[l]; k < start[l + 1]; k++) S->pstart[node[k] + 1]++;
     for (uint32_t i = 0; i < e->n; i++) S->pstart[i + 1] += S->pstart[i];
     for (uint32_t l = 0; l < count; l++) {
-        if (start[l + 1] - start[l] < 2) continue;
-        for (uint32_t k = start[l]; k < start[l + 1]; k++) {
+        const uint32_t k0 = start[l], k1 = start[l + 1];
+        if (k1 - k0 < 2) continue;
+        for (uint32_t k = k0; k < k1; k++) at[node[k]] = k;
+        /* the shape that stretches the web less for its size */
+        const bool tent = slide_energy(e, node, at, k0, k1, true) < slide_energy(e, node, at, k0, k1, false);
+        for (uint32_t k = k0; k < k1; k++) at[node[k]] = UINT32_MAX;
+        for (uint32_t k = k0; k < k1; k++) {
             uint32_t q = S->pstart[node[k]] + fill[node[k]]++;
+            double w = slide_weight(tent, k - k0, k1 - k0), *t = S->ptan + 3 * (size_t)q;
             S->pcol[q] = nz;
-            tangent(e, node, start[l], start[l + 1], k, S->ptan + 3 * (size_t)q);
+            tangent(e, node, k0, k1, k, t);
+            for (int c = 0; c < 3; c++) t[c] *= w;
         }
         nz++;
     }
-    free(fill);
+    free(fill), free(at);
     S->nz = nz;
     if (nz > SLIDE_MAX || nz == 0) {
         spn__slide_free(S);
