@@ -93,34 +93,69 @@ static double slide_weight(bool tent, uint32_t t, uint32_t len)
     return x < 0.5 ? 2 * x : 2 * (1 - x);
 }
 
-/* z^T A z / z^T z for the slide z of line nodes [k0, k1) in the given
- * shape, from each spring at a line node: at[p] is particle p's node when it
- * is on the line, else UINT32_MAX (a spring between two of the line's nodes
- * is met from both ends and counted half each time). */
-static double slide_energy(const spn__eq *e, const uint32_t *node, const uint32_t *at, uint32_t k0, uint32_t k1,
-                           bool tent)
+/* True when the tent slide of line nodes [k0, k1) stretches the web less
+ * for its size (z^T A z / z^T z) than the uniform slide, both from each
+ * spring at a line node. tan: the line's unit tangents, 3 a node; at[p]:
+ * particle p's node when it is on the line, else UINT32_MAX (a spring
+ * between two of the line's nodes is met from both ends, half each time). */
+static bool tent_is_softer(const spn__eq *e, const uint32_t *node, const uint32_t *at, uint32_t k0, uint32_t k1,
+                           const double *tan)
 {
-    double energy = 0, norm = 0;
+    const uint32_t len = k1 - k0;
+    double energy[2] = {0, 0}, norm[2] = {0, 0}; /* uniform, tent */
     for (uint32_t k = k0; k < k1; k++) {
-        double z[3], w = slide_weight(tent, k - k0, k1 - k0);
-        tangent(e, node, k0, k1, k, z);
-        for (int c = 0; c < 3; c++) z[c] *= w;
-        norm += w * w;
+        const double *t = tan + 3 * (size_t)(k - k0), w = slide_weight(true, k - k0, len);
+        norm[0] += 1, norm[1] += w * w;
         const uint32_t i = node[k];
         for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++) {
             const int32_t o = e->adj_other[j];
-            double d[3] = {z[0], z[1], z[2]}, hd[3], part = 1;
+            const double *h = e->hs + 6 * (size_t)(e->adj[j] >> 1);
+            double du[3] = {t[0], t[1], t[2]}, dt[3] = {w * t[0], w * t[1], w * t[2]}, part = 1;
             if (o >= 0 && at[o] != UINT32_MAX) {
-                double zo[3], wo = slide_weight(tent, at[o] - k0, k1 - k0);
-                tangent(e, node, k0, k1, at[o], zo);
-                for (int c = 0; c < 3; c++) d[c] -= wo * zo[c];
+                const double *to = tan + 3 * (size_t)(at[o] - k0), wo = slide_weight(true, at[o] - k0, len);
+                for (int c = 0; c < 3; c++) du[c] -= to[c], dt[c] -= wo * to[c];
                 part = 0.5;
             }
-            spn__sym_mul(e->hs + 6 * (size_t)(e->adj[j] >> 1), d, hd);
-            energy += part * (d[0] * hd[0] + d[1] * hd[1] + d[2] * hd[2]);
+            double hu[3], ht[3];
+            spn__sym_mul(h, du, hu);
+            spn__sym_mul(h, dt, ht);
+            energy[0] += part * (du[0] * hu[0] + du[1] * hu[1] + du[2] * hu[2]);
+            energy[1] += part * (dt[0] * ht[0] + dt[1] * ht[1] + dt[2] * ht[2]);
         }
     }
-    return energy / norm;
+    return energy[1] * norm[0] < energy[0] * norm[1];
+}
+
+/* tent[l] for every line of two or more particles (tent_is_softer), the
+ * lines shared out over the team: each thread with its own scratch, each
+ * line's choice its own (the same on any team). False: out of memory. */
+static bool choose_shapes(const spn__eq *e, const uint32_t *start, const uint32_t *node, uint32_t count, bool *tent)
+{
+    uint32_t longest = 0;
+    for (uint32_t l = 0; l < count; l++)
+        if (start[l + 1] - start[l] > longest) longest = start[l + 1] - start[l];
+    int bad = 0;
+#pragma omp parallel num_threads(slide_team(e)) reduction(+ : bad)
+    {
+        uint32_t *at = malloc((e->n ? e->n : 1) * sizeof *at);
+        double *tan = malloc(3 * (size_t)(longest ? longest : 1) * sizeof *tan);
+        bad += !at || !tan;
+        for (uint32_t i = 0; at && i < e->n; i++) at[i] = UINT32_MAX;
+#pragma omp for schedule(dynamic, 16)
+        for (uint32_t l = 0; l < count; l++) {
+            const uint32_t k0 = start[l], k1 = start[l + 1];
+            tent[l] = false;
+            if (k1 - k0 < 2 || !at || !tan) continue;
+            for (uint32_t k = k0; k < k1; k++) {
+                at[node[k]] = k;
+                tangent(e, node, k0, k1, k, tan + 3 * (size_t)(k - k0));
+            }
+            tent[l] = tent_is_softer(e, node, at, k0, k1, tan);
+            for (uint32_t k = k0; k < k1; k++) at[node[k]] = UINT32_MAX;
+        }
+        free(at), free(tan);
+    }
+    return bad == 0;
 }
 
 spn__slide *spn__slide_build(const spn__eq *e, const spn__lines *L)
@@ -134,13 +169,13 @@ spn__slide *spn__slide_build(const spn__eq *e, const spn__lines *L)
     S->pstart = spn__big_calloc((size_t)e->n + 1, sizeof *S->pstart);
     S->pcol = spn__big_alloc((total ? total : 1) * sizeof *S->pcol);
     S->ptan = spn__big_alloc(3 * (size_t)(total ? total : 1) * sizeof *S->ptan);
-    uint32_t *fill = calloc(e->n ? e->n : 1, sizeof *fill), *at = malloc((e->n ? e->n : 1) * sizeof *at);
-    if (!S->pstart || !S->pcol || !S->ptan || !fill || !at) {
-        free(fill), free(at);
+    uint32_t *fill = calloc(e->n ? e->n : 1, sizeof *fill);
+    bool *tent = malloc((count ? count : 1) * sizeof *tent);
+    if (!S->pstart || !S->pcol || !S->ptan || !fill || !tent || !choose_shapes(e, start, node, count, tent)) {
+        free(fill), free(tent);
         spn__slide_free(S);
         return NULL;
     }
-    for (uint32_t i = 0; i < e->n; i++) at[i] = UINT32_MAX;
     for (uint32_t l = 0; l < count; l++)
         if (start[l + 1] - start[l] >= 2)
             for (uint32_t k = start[l]; k < start[l + 1]; k++) S->pstart[node[k] + 1]++;
@@ -148,20 +183,17 @@ spn__slide *spn__slide_build(const spn__eq *e, const spn__lines *L)
     for (uint32_t l = 0; l < count; l++) {
         const uint32_t k0 = start[l], k1 = start[l + 1];
         if (k1 - k0 < 2) continue;
-        for (uint32_t k = k0; k < k1; k++) at[node[k]] = k;
-        /* the shape that stretches the web less for its size */
-        const bool tent = slide_energy(e, node, at, k0, k1, true) < slide_energy(e, node, at, k0, k1, false);
-        for (uint32_t k = k0; k < k1; k++) at[node[k]] = UINT32_MAX;
         for (uint32_t k = k0; k < k1; k++) {
             uint32_t q = S->pstart[node[k]] + fill[node[k]]++;
-            double w = slide_weight(tent, k - k0, k1 - k0), *t = S->ptan + 3 * (size_t)q;
+            const double w = slide_weight(tent[l], k - k0, k1 - k0);
+            double *t = S->ptan + 3 * (size_t)q;
             S->pcol[q] = nz;
             tangent(e, node, k0, k1, k, t);
             for (int c = 0; c < 3; c++) t[c] *= w;
         }
         nz++;
     }
-    free(fill), free(at);
+    free(fill), free(tent);
     S->nz = nz;
     if (nz > SLIDE_MAX || nz == 0) {
         spn__slide_free(S);
