@@ -429,7 +429,7 @@ static void test_species_web_multigrid(void **state)
      * force scale F leaves it free by about 1e-6 F l / T. So the two
      * answers agree in energy and on the particles that a thread of
      * T >= 1e-4 F holds (to 5e-3 l, about 1e-2 of the largest move here);
-     * the rest may rest anywhere in their slack. Measured 2026-11-23, with
+     * the rest may rest anywhere in their slack. Measured 2026-11-22, with
      * the slides' tents: 11 particles held by no such thread, one of them
      * 0.67 mm from block Jacobi's answer; the held ones 19 um apart (3.6 um
      * before the tents, by the luck of the Newton path). */
