@@ -372,7 +372,8 @@ static uint32_t lane_line(const spn__lines *L, uint32_t c, uint32_t g, uint32_t 
 
 /* Steps of the lines laid side by side: group and step offsets first (a
  * group's steps: its longest line; a step's off blocks: the most any lane
- * has), then the particles and BSR entries of each lane. */
+ * has), then the particles of each lane and the adjacency entries of the
+ * springs whose blocks it reads. */
 static bool lay_out(spn__lines *L, const spn__eq *e, const spn__bsr *a0)
 {
     L->colour_group = spn__big_alloc(((size_t)L->colours + 1) * sizeof *L->colour_group);
