@@ -285,7 +285,7 @@ static void check_galerkin(uint32_t side, bool scrambled)
 static void test_galerkin_in_chunks(void **state)
 {
     (void)state;
-    check_galerkin(400, false); /* 40,000 coarse rows: ten chunks, and enough block products for a team */
+    check_galerkin(400, false); /* 40,000 coarse rows: ten chunks on one thread, sixteen on two (enough block products for a team) */
     check_galerkin(40, false);  /* one chunk */
 }
 

@@ -318,6 +318,20 @@ bool spn__bsr_galerkin(const spn__bsr *r, const spn__bsr *ap, spn__bsr *c, int t
  * are far apart in it). */
 #define GALERKIN_CHUNK 4096u
 #define WINDOW_SLACK 1.5
+/* On a team, chunks of fewer rows: at least CHUNKS_PER_THREAD a thread, of
+ * GALERKIN_CHUNK_MIN rows or more. With 4,096 rows the 1M web's level 2
+ * (5,326 coarse rows) made two chunks, of 4,096 and 1,230 rows, and level 3
+ * (646) one, so that one thread did most of those products alone. Each row
+ * of C is formed the same way whatever chunk holds it: the same bits. */
+#define CHUNKS_PER_THREAD 8u
+#define GALERKIN_CHUNK_MIN 64u
+
+static uint32_t galerkin_chunk(uint32_t rows, int threads)
+{
+    if (threads <= 1) return GALERKIN_CHUNK;
+    uint32_t c = rows / (CHUNKS_PER_THREAD * (uint32_t)threads);
+    return c < GALERKIN_CHUNK_MIN ? GALERKIN_CHUNK_MIN : c > GALERKIN_CHUNK ? GALERKIN_CHUNK : c;
+}
 
 /* Row i of C = A B when C's pattern is already in place. */
 static void row_known(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_t i, double *acc, uint32_t *pos)
@@ -335,9 +349,10 @@ static void row_known(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_
  * range is the chunk's own particles and a ring or so either side). */
 bool spn__bsr_galerkin_ap(const spn__bsr *a, const spn__bsr *p, const spn__bsr *r, spn__bsr *c, int threads)
 {
-    const uint32_t n = a->rows, nc = p->cols, rows = r->rows, chunks = (rows + GALERKIN_CHUNK - 1) / GALERKIN_CHUNK;
+    const uint32_t n = a->rows, nc = p->cols, rows = r->rows;
     const double products = (double)a->start[n] * p->start[p->rows] / (p->rows ? p->rows : 1);
     const int nt = products < PAR_MIN_PRODUCTS ? 1 : threads;
+    const uint32_t chunk = galerkin_chunk(rows, nt), chunks = (rows + chunk - 1) / chunk;
     const size_t per = nc ? nc : 1;
     spn__bsr ap = {.rows = n, .cols = nc};
     uint32_t *marks = malloc(2 * (size_t)nt * per * sizeof *marks), *range = malloc(2 * (size_t)(chunks + 1) * sizeof *range);
@@ -365,7 +380,7 @@ bool spn__bsr_galerkin_ap(const spn__bsr *a, const spn__bsr *p, const spn__bsr *
     size_t total = 0, wide_rows = 1, wide_nnz = 1;
     for (uint32_t ch = 0; ch < chunks; ch++) {
         uint32_t lo = UINT32_MAX, hi = 0;
-        const uint32_t i0 = ch * GALERKIN_CHUNK, i1 = i0 + GALERKIN_CHUNK < rows ? i0 + GALERKIN_CHUNK : rows;
+        const uint32_t i0 = ch * chunk, i1 = i0 + chunk < rows ? i0 + chunk : rows;
         for (uint32_t q = r->start[i0]; q < r->start[i1]; q++) {
             lo = r->col[q] < lo ? r->col[q] : lo;
             hi = r->col[q] > hi ? r->col[q] : hi;
@@ -427,7 +442,7 @@ bool spn__bsr_galerkin_ap(const spn__bsr *a, const spn__bsr *p, const spn__bsr *
             win.val = wval + t * 9 * wide_nnz;
             for (uint32_t k = lo; k <= hi; k++) row_known(a, p, &win, k, acc, pos);
         }
-        const uint32_t i0 = ch * GALERKIN_CHUNK, i1 = i0 + GALERKIN_CHUNK < rows ? i0 + GALERKIN_CHUNK : rows;
+        const uint32_t i0 = ch * chunk, i1 = i0 + chunk < rows ? i0 + chunk : rows;
         for (uint32_t i = i0; i < i1; i++) row_values(r, &win, c, i, true, true, acc, mark, pos);
     }
     mirror_lower(c, threads);
