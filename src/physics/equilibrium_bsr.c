@@ -59,18 +59,6 @@ void spn__bsr_round(spn__bsr *a)
     a->val = NULL;
 }
 
-/* Block p's nine numbers: from val, or from a transpose's source (tsrc,
- * tperm: spn__bsr_transpose) through tmp. */
-static inline const double *blk9(const spn__bsr *m, size_t p, double *tmp)
-{
-    if (m->val) return m->val + 9 * p;
-    const double *s = m->tsrc->val + 9 * (size_t)m->tperm[p];
-    tmp[0] = s[0], tmp[1] = s[3], tmp[2] = s[6];
-    tmp[3] = s[1], tmp[4] = s[4], tmp[5] = s[7];
-    tmp[6] = s[2], tmp[7] = s[5], tmp[8] = s[8];
-    return tmp;
-}
-
 /* The number of distinct columns of row i of A B (mark: per column, the
  * last row that saw it). */
 static uint32_t row_count(const spn__bsr *a, const spn__bsr *b, uint32_t i, bool diag_first, uint32_t *mark)
@@ -100,7 +88,7 @@ static void row_sums(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_t
 {
     double ta[9];
     for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) {
-        const double *ab = blk9(a, p, ta);
+        const double *ab = spn__bsr_block(a, p, ta);
         uint32_t k = a->col[p] - b->base;
         for (uint32_t q = b->start[k]; q < b->start[k + 1]; q++) {
             uint32_t j = b->col[q];
@@ -153,7 +141,7 @@ __attribute__((target("avx"))) static void row_sums_avx(const spn__bsr *a, const
     memset(acc, 0, ACC * (size_t)cnt * sizeof *acc);
     double ta[9];
     for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) {
-        const double *ab = blk9(a, p, ta);
+        const double *ab = spn__bsr_block(a, p, ta);
         __m256d av[9];
         for (int k = 0; k < 9; k++) av[k] = _mm256_broadcast_sd(ab + k);
         uint32_t k = a->col[p] - b->base;

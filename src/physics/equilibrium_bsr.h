@@ -39,7 +39,25 @@ typedef struct spn__bsr {
     /* a window onto rows [base, rows) of a larger matrix: row r is stored
      * as row r - base (0 for a whole matrix; spn__bsr_galerkin_ap) */
     uint32_t base;
+    /* or, with no val, fval or tsrc: block k formed on demand, blk(blk_ctx,
+     * k, tmp) (the finest level of a spring system, from its springs:
+     * equilibrium_mg.c) */
+    const double *(*blk)(const void *blk_ctx, size_t k, double *tmp);
+    const void *blk_ctx;
 } spn__bsr;
+
+/* Block p's nine numbers: from val, from blk, or from a transpose's source
+ * (tsrc, tperm: spn__bsr_transpose) through tmp. */
+static inline const double *spn__bsr_block(const spn__bsr *m, size_t p, double *tmp)
+{
+    if (m->val) return m->val + 9 * p;
+    if (m->blk) return m->blk(m->blk_ctx, p, tmp);
+    const double *s = m->tsrc->val + 9 * (size_t)m->tperm[p];
+    tmp[0] = s[0], tmp[1] = s[3], tmp[2] = s[6];
+    tmp[3] = s[1], tmp[4] = s[4], tmp[5] = s[7];
+    tmp[6] = s[2], tmp[7] = s[5], tmp[8] = s[8];
+    return tmp;
+}
 
 void spn__bsr_free(spn__bsr *a);
 /* Blocks from which a loop over a matrix's rows shares them out. */

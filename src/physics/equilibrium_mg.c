@@ -92,6 +92,11 @@ struct spn__mg {
     int nlevels;
     mg_level lv[MAX_LEVELS];
     uint32_t *map0;     /* per adjacency entry of the spring system: its level-0 block, or UINT32_MAX */
+    /* per level-0 block of a spring system while the hierarchy is built: its
+     * spring, or SRC_DIAG | its row (level0_block);
+     * NULL where level 0 keeps its values (see level0_pattern) */
+    uint32_t *src0;
+    const spn__eq *eq0; /* the system src0 reads */
     spn__slide *slide;  /* thread-slide correction on level 0 (spring systems only), or NULL */
     bool slide_ok;      /* its matrix factored (from the first system that allowed it; kept on small webs) */
     double *dense;      /* coarsest level's Cholesky factor */
@@ -107,6 +112,27 @@ static void sym_to_full(const double *h, double sign, double *m)
     m[6] += sign * h[4], m[7] += sign * h[5], m[8] += sign * h[2];
 }
 
+#define SRC_DIAG 0x80000000u
+
+/* Level-0 block p from the springs, summed as level0_values sums it (from
+ * zero, sym_to_full): the same bits. */
+static const double *level0_block(const void *ctx, size_t p, double *tmp)
+{
+    const spn__mg *mg = ctx;
+    const spn__eq *e = mg->eq0;
+    const uint32_t s = mg->src0[p];
+    double o[6];
+    for (int k = 0; k < 9; k++) tmp[k] = 0;
+    if (s & SRC_DIAG) {
+        sym_to_full(e->diag + 6 * (size_t)(s & ~SRC_DIAG), 1, tmp);
+    } else { /* -H_s, as spn__eq_offd gives it for two free ends */
+        const double *h = e->hs + 6 * (size_t)s;
+        for (int c = 0; c < 6; c++) o[c] = -1.0 * h[c];
+        sym_to_full(o, 1, tmp);
+    }
+    return tmp;
+}
+
 /* Pattern: per particle its diagonal, then each free neighbour once (parallel springs merged). */
 static bool level0_pattern(spn__mg *mg, const spn__eq *e)
 {
@@ -116,21 +142,46 @@ static bool level0_pattern(spn__mg *mg, const spn__eq *e)
     a->start = spn__big_alloc(((size_t)n + 1) * sizeof *a->start);
     a->col = spn__big_alloc(((size_t)n + nadj + 1) * sizeof *a->col);
     mg->map0 = spn__big_alloc((nadj ? nadj : 1) * sizeof *mg->map0);
-    if (!a->start || !a->col || !mg->map0) return false;
+    uint32_t *src = e->hs ? malloc(((size_t)n + nadj + 1) * sizeof *src) : NULL;
+    if (!a->start || !a->col || !mg->map0 || (e->hs && !src)) {
+        free(src);
+        return false;
+    }
     uint32_t nnz = 0;
+    bool merged = false;
     a->start[0] = 0;
     for (uint32_t i = 0; i < n; i++) {
+        if (src) src[nnz] = SRC_DIAG | i;
         a->col[nnz++] = i;
         for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++) {
             mg->map0[j] = UINT32_MAX;
             if (e->adj_other[j] < 0) continue;
             uint32_t c = (uint32_t)e->adj_other[j], p = a->start[i] + 1;
             while (p < nnz && a->col[p] != c) p++;
-            if (p == nnz) a->col[nnz++] = c;
+            if (p == nnz) {
+                if (src) src[nnz] = e->adj[j] >> 1;
+                a->col[nnz++] = c;
+            } else {
+                merged = true;
+            }
             mg->map0[j] = p;
         }
         a->start[i + 1] = nnz;
     }
+    /* A spring system's level 0 serves only to build the hierarchy (the
+     * cycle multiplies from the springs, spn__eq_matvec_mg): its blocks are
+     * read from the springs as the setup meets them (level0_block) instead of
+     * stored (360 MB on the 1M web, a tenth of the solve's page faults). A
+     * pair of particles joined by several springs sums them: such a web, and
+     * the implicit step's system (no spring blocks), keep the values. */
+    if (src && !merged && n < SRC_DIAG && e->m < SRC_DIAG) {
+        mg->src0 = src;
+        mg->eq0 = e;
+        a->blk = level0_block;
+        a->blk_ctx = mg;
+        return true;
+    }
+    free(src);
     a->val = spn__big_alloc(9 * (size_t)(nnz ? nnz : 1) * sizeof *a->val);
     return a->val != NULL;
 }
@@ -160,30 +211,38 @@ static double fro(const double *m)
     return sqrt(s);
 }
 
-static bool strong(const spn__bsr *a, const double *dn, uint32_t i, uint32_t p, double theta)
+/* Strength: bn[p] = |A_p|_F, dn[i] = |A_ii|_F. */
+static bool strong(const spn__bsr *a, const double *bn, const double *dn, uint32_t i, uint32_t p, double theta)
 {
     uint32_t c = a->col[p];
-    return c != i && fro(a->val + 9 * (size_t)p) >= theta * sqrt(dn[i] * dn[c]);
+    return c != i && bn[p] >= theta * sqrt(dn[i] * dn[c]);
 }
 
-/* Fills agg; returns the number of aggregates (0: out of memory). */
-static uint32_t aggregate(const spn__bsr *a, uint32_t *agg, double theta)
+/* Fills agg; returns the number of aggregates (0: out of memory). The
+ * blocks' norms are formed once, on the team (level 0 of a spring system
+ * forms its blocks from the springs; the greedy passes below meet most
+ * blocks two or three times). */
+static uint32_t aggregate(const spn__bsr *a, uint32_t *agg, double theta, int threads)
 {
     const uint32_t n = a->rows, NONE = UINT32_MAX;
-    double *dn = malloc((n ? n : 1) * sizeof *dn);
+    const size_t nnz = a->start[n];
+    double *dn = malloc((n ? n : 1) * sizeof *dn), *bn = malloc((nnz ? nnz : 1) * sizeof *bn);
     uint32_t *join = malloc((n ? n : 1) * sizeof *join), na = 0;
-    if (!dn || !join) {
-        free(dn), free(join);
+    if (!dn || !bn || !join) {
+        free(dn), free(bn), free(join);
         return 0;
     }
+#pragma omp parallel for schedule(static) num_threads(spn__bsr_team(a, threads))
     for (uint32_t i = 0; i < n; i++) {
+        double tmp[9];
+        for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++) bn[p] = fro(spn__bsr_block(a, p, tmp));
         agg[i] = NONE;
-        dn[i] = fro(a->val + 9 * (size_t)a->start[i]);
+        dn[i] = bn[a->start[i]];
     }
     for (uint32_t i = 0; i < n; i++) { /* roots whose strong neighbours are all free */
         bool free_all = agg[i] == NONE, any = false;
         for (uint32_t p = a->start[i]; p < a->start[i + 1] && free_all; p++)
-            if (strong(a, dn, i, p, theta)) {
+            if (strong(a, bn, dn, i, p, theta)) {
                 any = true;
                 if (agg[a->col[p]] != NONE) free_all = false;
             }
@@ -193,7 +252,7 @@ static uint32_t aggregate(const spn__bsr *a, uint32_t *agg, double theta)
         if (!free_all || !any) continue;
         agg[i] = na;
         for (uint32_t p = a->start[i]; p < a->start[i + 1]; p++)
-            if (strong(a, dn, i, p, theta)) agg[a->col[p]] = na;
+            if (strong(a, bn, dn, i, p, theta)) agg[a->col[p]] = na;
         na++;
     }
     for (uint32_t i = 0; i < n; i++) { /* the rest join their most strongly tied neighbour's aggregate */
@@ -202,12 +261,12 @@ static uint32_t aggregate(const spn__bsr *a, uint32_t *agg, double theta)
         double best = -1;
         for (uint32_t p = a->start[i] + 1; p < a->start[i + 1]; p++) {
             uint32_t c = a->col[p];
-            double s = fro(a->val + 9 * (size_t)p) / sqrt(dn[c]);
+            double s = bn[p] / sqrt(dn[c]);
             if (agg[c] != NONE && s > best) best = s, join[i] = agg[c];
         }
     }
     for (uint32_t i = 0; i < n; i++) agg[i] = join[i] != NONE ? join[i] : na++; /* isolated: alone */
-    free(dn), free(join);
+    free(dn), free(bn), free(join);
     return na;
 }
 
@@ -337,7 +396,8 @@ static bool smoothed_prolongator(mg_level *L, uint32_t nc, int threads)
             uint32_t c = A->col[p], g = L->agg[c];
             if (mark[g] != i) mark[g] = i, pos[g] = cnt, P->col[cnt++] = g;
             double *pv = P->val + 9 * (size_t)pos[g];
-            spn__blk_mul_add(di, A->val + 9 * (size_t)p, pv);
+            double tb[9];
+            spn__blk_mul_add(di, spn__bsr_block(A, p, tb), pv);
             if (c == i) pv[0] += 1, pv[4] += 1, pv[8] += 1;
         }
     }
@@ -354,7 +414,7 @@ static bool add_level(spn__mg *mg, int l)
     uint32_t *rperm = NULL;
     L->agg = spn__big_alloc((n ? n : 1) * sizeof *L->agg);
     if (!L->agg) return false;
-    uint32_t nc = aggregate(&L->A, L->agg, THETA);
+    uint32_t nc = aggregate(&L->A, L->agg, THETA, mg->threads);
     bool ok = nc > 0;
     /* smoothing widens the stencil a level at a time (5, 10, 22, 45 blocks a
      * row on the 100k web, 5, 10, 27, 63 on the 1M web): dense levels keep P0 */
@@ -420,6 +480,7 @@ void spn__mg_free(spn__mg *mg)
         if (l > 0) free(L->dinv);
     }
     free(mg->map0);
+    free(mg->src0);
     spn__slide_free(mg->slide);
     free(mg->dense);
     free(mg);
@@ -444,7 +505,7 @@ static spn_status build(spn__mg *mg, const spn__eq *e, const double *inv0)
     L0->r = spn__big_alloc(3 * (size_t)(e->n ? e->n : 1) * sizeof *L0->r);
     L0->x = spn__big_alloc(3 * (size_t)(e->n ? e->n : 1) * sizeof *L0->x);
     if (!L0->r || !L0->x || !level0_pattern(mg, e)) return SPN_ERR_NOMEM;
-    level0_values(mg, e);
+    if (L0->A.val) level0_values(mg, e);
     mg->nlevels = 1;
     while (mg->nlevels < MAX_LEVELS && mg->lv[mg->nlevels - 1].A.rows > COARSEST) {
         int l = mg->nlevels - 1;
@@ -473,7 +534,8 @@ static spn_status build(spn__mg *mg, const spn__eq *e, const double *inv0)
      * too: its values (360 MB on the 1M web) served the hierarchy only */
     if (e->hs) {
         free(L0->A.val);
-        L0->A.val = NULL;
+        free(mg->src0);
+        L0->A.val = NULL, mg->src0 = NULL, L0->A.blk = NULL;
     }
     /* The line smoother and the slides last: their arrays then take the
      * pages the setup's temporaries (each level's A P) and the rounding have
