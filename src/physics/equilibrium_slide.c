@@ -126,10 +126,14 @@ static bool tent_is_softer(const spn__eq *e, const uint32_t *node, const uint32_
     return energy[1] * norm[0] < energy[0] * norm[1];
 }
 
-/* tent[l] for every line of two or more particles (tent_is_softer), the
- * lines shared out over the team: each thread with its own scratch, each
- * line's choice its own (the same on any team). False: out of memory. */
-static bool choose_shapes(const spn__eq *e, const uint32_t *start, const uint32_t *node, uint32_t count, bool *tent)
+/* Each line of two or more particles: its shape (tent_is_softer), then its
+ * entries written, the shape's weight times the unit tangent at each node,
+ * into the places `slot` gives them in their particles' lists, with the
+ * line's coarse unknown `unknown[l]`. The lines are shared out over the
+ * team: each thread with its own scratch, each line's entries its own (the
+ * same on any team). False: out of memory. */
+static bool fill_slides(spn__slide *S, const spn__eq *e, const uint32_t *start, const uint32_t *node, uint32_t count,
+                        const uint32_t *slot, const uint32_t *unknown)
 {
     uint32_t longest = 0;
     for (uint32_t l = 0; l < count; l++)
@@ -144,14 +148,19 @@ static bool choose_shapes(const spn__eq *e, const uint32_t *start, const uint32_
 #pragma omp for schedule(dynamic, 16)
         for (uint32_t l = 0; l < count; l++) {
             const uint32_t k0 = start[l], k1 = start[l + 1];
-            tent[l] = false;
             if (k1 - k0 < 2 || !at || !tan) continue;
             for (uint32_t k = k0; k < k1; k++) {
                 at[node[k]] = k;
                 tangent(e, node, k0, k1, k, tan + 3 * (size_t)(k - k0));
             }
-            tent[l] = tent_is_softer(e, node, at, k0, k1, tan);
-            for (uint32_t k = k0; k < k1; k++) at[node[k]] = UINT32_MAX;
+            const bool tent = tent_is_softer(e, node, at, k0, k1, tan);
+            for (uint32_t k = k0; k < k1; k++) {
+                const double w = slide_weight(tent, k - k0, k1 - k0);
+                double *t = S->ptan + 3 * (size_t)slot[k];
+                for (int c = 0; c < 3; c++) t[c] = tan[3 * (size_t)(k - k0) + c] * w;
+                S->pcol[slot[k]] = unknown[l];
+                at[node[k]] = UINT32_MAX;
+            }
         }
         free(at), free(tan);
     }
@@ -169,33 +178,24 @@ spn__slide *spn__slide_build(const spn__eq *e, const spn__lines *L)
     S->pstart = spn__big_calloc((size_t)e->n + 1, sizeof *S->pstart);
     S->pcol = spn__big_alloc((total ? total : 1) * sizeof *S->pcol);
     S->ptan = spn__big_alloc(3 * (size_t)(total ? total : 1) * sizeof *S->ptan);
-    uint32_t *fill = calloc(e->n ? e->n : 1, sizeof *fill);
-    bool *tent = malloc((count ? count : 1) * sizeof *tent);
-    if (!S->pstart || !S->pcol || !S->ptan || !fill || !tent || !choose_shapes(e, start, node, count, tent)) {
-        free(fill), free(tent);
-        spn__slide_free(S);
-        return NULL;
-    }
-    for (uint32_t l = 0; l < count; l++)
+    uint32_t *fill = calloc(e->n ? e->n : 1, sizeof *fill), *slot = malloc((total ? total : 1) * sizeof *slot);
+    uint32_t *unknown = malloc((count ? count : 1) * sizeof *unknown);
+    bool ok = S->pstart && S->pcol && S->ptan && fill && slot && unknown;
+    /* a particle's entries in the order of its lines; a line's unknown its
+     * rank among the lines of two or more particles */
+    for (uint32_t l = 0; ok && l < count; l++)
         if (start[l + 1] - start[l] >= 2)
             for (uint32_t k = start[l]; k < start[l + 1]; k++) S->pstart[node[k] + 1]++;
-    for (uint32_t i = 0; i < e->n; i++) S->pstart[i + 1] += S->pstart[i];
-    for (uint32_t l = 0; l < count; l++) {
-        const uint32_t k0 = start[l], k1 = start[l + 1];
-        if (k1 - k0 < 2) continue;
-        for (uint32_t k = k0; k < k1; k++) {
-            uint32_t q = S->pstart[node[k]] + fill[node[k]]++;
-            const double w = slide_weight(tent[l], k - k0, k1 - k0);
-            double *t = S->ptan + 3 * (size_t)q;
-            S->pcol[q] = nz;
-            tangent(e, node, k0, k1, k, t);
-            for (int c = 0; c < 3; c++) t[c] *= w;
-        }
-        nz++;
+    for (uint32_t i = 0; ok && i < e->n; i++) S->pstart[i + 1] += S->pstart[i];
+    for (uint32_t l = 0; ok && l < count; l++) {
+        if (start[l + 1] - start[l] < 2) continue;
+        for (uint32_t k = start[l]; k < start[l + 1]; k++) slot[k] = S->pstart[node[k]] + fill[node[k]]++;
+        unknown[l] = nz++;
     }
-    free(fill), free(tent);
+    ok = ok && fill_slides(S, e, start, node, count, slot, unknown);
+    free(fill), free(slot), free(unknown);
     S->nz = nz;
-    if (nz > SLIDE_MAX || nz == 0) {
+    if (!ok || nz > SLIDE_MAX || nz == 0) {
         spn__slide_free(S);
         return NULL;
     }
