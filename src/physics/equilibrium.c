@@ -34,8 +34,11 @@
 #define ETA_MAX 0.5      /* the loosest CG tolerance */
 /* With multigrid a decade of the linear residual costs a few cycles, and a
  * Newton step (assembly, line factors) about as much as a cycle: tighter
- * solves, fewer Newton steps (100k web: 4 steps, 54 CG -> 3 steps, 44 CG). */
-#define ETA0_MG 0.01
+ * solves, fewer Newton steps (100k web: 4 steps, 54 CG -> 3 steps, 44 CG).
+ * 0.01 until 2026-11-22; with the hubs relaxed (relax_hub) 0.003 takes the
+ * standard web to 1e-6 T0 in one Newton step fewer: 100k 3 steps, 21 CG ->
+ * 2, 22; 1M 3, 37 -> 2, 34 (0.002: 5k 12 -> 16 CG). */
+#define ETA0_MG 0.003
 #define ETA_MAX_MG 0.1
 /* The multigrid hierarchy is built from the first Newton system and kept. A
  * shifted solve (slack or buckling threads) that needed more CG iterations
@@ -45,6 +48,13 @@
  * new hierarchy did not help (measured at 100k), so they keep it. */
 #define MG_REBUILD_CG 40
 #define STALL_LIMIT 5 /* iterations in a row that lower neither energy nor residual */
+/* Hubs: particles spring-joined to more than HUB_MIN_NEIGHBOURS others and to
+ * HUB_FACTOR times the mean (the standard web's hub, where every radial ends). Each accepted
+ * Newton step is followed by up to HUB_STEPS local Newton steps on each hub
+ * alone, its neighbours held (relax_hub). */
+#define HUB_MIN_NEIGHBOURS 64
+#define HUB_FACTOR 8.0
+#define HUB_STEPS 3
 
 static const char *const PRECOND_NAMES[SPN_PRECOND_COUNT] = {"jacobi", "block-jacobi", "multigrid", "sgs", "auto"};
 
@@ -138,6 +148,7 @@ typedef struct newton {
     spn__eq e;
     spn__precond pc;
     double *p, *work;
+    uint32_t *hubs, nhubs;
     double lambda, target, residual, eta, eta_max, energy_change;
     uint32_t worst;
     int max_cg, stalls;
@@ -165,6 +176,108 @@ static void swap_positions(spn__eq *e)
     double *t = e->x;
     e->x = e->xtrial;
     e->xtrial = t;
+}
+
+/* The particles spring-joined to particle i, each counted once (a pair
+ * joined by several springs is one). */
+static uint32_t neighbours(const spn__eq *e, uint32_t i)
+{
+    uint32_t count = 0;
+    for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++) {
+        const uint32_t s = e->adj[j] >> 1, o = e->sa[s] == i ? e->sb[s] : e->sa[s];
+        bool seen = false;
+        for (uint32_t k = e->adj_start[i]; k < j && !seen; k++) {
+            const uint32_t t = e->adj[k] >> 1;
+            seen = (e->sa[t] == i ? e->sb[t] : e->sa[t]) == o;
+        }
+        count += !seen;
+    }
+    return count;
+}
+
+/* The hubs (see HUB_MIN_NEIGHBOURS), in particle order; false: out of memory.
+ * Neighbours, not springs, count: a web with every thread doubled is the
+ * web with threads twice as stiff, and is solved the same way. */
+static bool find_hubs(newton *nt)
+{
+    const spn__eq *e = &nt->e;
+    uint32_t *count = malloc((e->n ? e->n : 1) * sizeof *count);
+    if (!count) return false;
+    uint64_t total = 0; /* an integer sum: the same in any order */
+#pragma omp parallel for schedule(static) reduction(+ : total) num_threads(e->n < 32768u ? 1 : e->threads)
+    for (uint32_t i = 0; i < e->n; i++) total += count[i] = neighbours(e, i);
+    const double least = fmax(HUB_MIN_NEIGHBOURS, HUB_FACTOR * (e->n ? (double)total / e->n : 0));
+    nt->nhubs = 0;
+    for (uint32_t i = 0; i < e->n; i++) nt->nhubs += count[i] > least;
+    if (nt->nhubs && !(nt->hubs = malloc(nt->nhubs * sizeof *nt->hubs))) {
+        free(count);
+        return false;
+    }
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < e->n; i++)
+        if (count[i] > least) nt->hubs[k++] = i;
+    free(count);
+    return true;
+}
+
+/* Particle i's net force at e->x and its stiffness (the projected blocks of
+ * its springs), its neighbours held. */
+static void hub_terms(const spn__eq *e, uint32_t i, double f[3], double h[6])
+{
+    for (int c = 0; c < 3; c++) f[c] = e->fext[3 * (size_t)i + c];
+    for (int c = 0; c < 6; c++) h[c] = 0;
+    for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++) {
+        double fs[3], hs[6];
+        spn__eq_spring_terms(e, e->adj[j] >> 1, fs, hs);
+        const double sign = (e->adj[j] & 1u) ? -1 : 1; /* the force on end a; i is end b */
+        for (int c = 0; c < 3; c++) f[c] += sign * fs[c];
+        for (int c = 0; c < 6; c++) h[c] += hs[c];
+    }
+}
+
+/* The energy change of moving particle i by dx, its neighbours held. */
+static double hub_energy_delta(const spn__eq *e, uint32_t i, const double dx[3])
+{
+    const double *xi = e->x + 3 * (size_t)i;
+    double de = 0;
+    for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++) {
+        const uint32_t s = e->adj[j] >> 1, o = e->sa[s] == i ? e->sb[s] : e->sa[s];
+        const double *xo = e->x + 3 * (size_t)o;
+        double l0 = 0, l1 = 0;
+        for (int c = 0; c < 3; c++) {
+            const double a = xi[c] - xo[c], b = a + dx[c];
+            l0 += a * a, l1 += b * b;
+        }
+        double d0 = sqrt(l0) - e->rest[s], d1 = sqrt(l1) - e->rest[s];
+        if (e->tonly[s]) d0 = fmax(d0, 0), d1 = fmax(d1, 0);
+        de += 0.5 * e->k[s] * (d1 - d0) * (d1 + d0);
+    }
+    for (int c = 0; c < 3; c++) de -= e->fext[3 * (size_t)i + c] * dx[c];
+    return de;
+}
+
+/* Local Newton steps on hub i, its neighbours held, each kept only if it
+ * lowers the energy; returns the energy change. Why: a Newton step's error
+ * is largest where many threads meet. The standard web's first segments
+ * of its 1,000 radials are 0.15 mm long, so the hub's step turns each of them
+ * and the turns' second-order stretch adds up there: after the first
+ * Newton step the hub's residual was 1.7e-3 T0, every other particle's at
+ * most 2.3e-4 (its linear residual), and that one particle cost the 1M and
+ * 100k webs a Newton step (docs/physics-equilibrium.md, eleventh session). */
+static double relax_hub(spn__eq *e, uint32_t i)
+{
+    double change = 0;
+    for (int step = 0; step < HUB_STEPS; step++) {
+        double f[3], h[6], inv[6], dx[3];
+        hub_terms(e, i, f, h);
+        if (!spn__sym_inverse(h, inv)) break;
+        spn__sym_mul(inv, f, dx);
+        const double de = hub_energy_delta(e, i, dx);
+        if (!(de < 0)) break;
+        for (int c = 0; c < 3; c++) e->x[3 * (size_t)i + c] += dx[c];
+        change += de;
+    }
+    return change;
 }
 
 /* One Newton iteration. Returns 1 to go on, 0 when stalled. */
@@ -218,6 +331,8 @@ static int newton_iteration(newton *nt)
     if (rho > 0.75) nt->lambda = nt->lambda > 1e-9 ? nt->lambda / 3 : 0;
     else if (rho < 0.25) nt->lambda = fmax(LAMBDA_FIRST, 2 * nt->lambda);
     swap_positions(e);
+    double relaxed = 0;
+    for (uint32_t k = 0; k < nt->nhubs; k++) relaxed += relax_hub(e, nt->hubs[k]);
     nt->residual = spn__eq_assemble(e, nt->lambda, &nt->worst);
     if (!armijo && !(nt->residual < previous)) { /* a step lost in rounding that did not help: undo */
         swap_positions(e);
@@ -225,7 +340,7 @@ static int newton_iteration(newton *nt)
         nt->residual = spn__eq_assemble(e, nt->lambda, &nt->worst);
         return ++nt->stalls < STALL_LIMIT;
     }
-    nt->energy_change += de;
+    nt->energy_change += de + relaxed;
     nt->stalls = 0;
     nt->eta = forcing(nt, previous);
     return 1;
@@ -306,6 +421,10 @@ spn_status spn_world_equilibrium(spn_world *w, const spn_equilibrium_def *def, s
     nt.pc.kind = d.preconditioner;
     st = spn__eq_init(&nt.e, w, &d);
     if (st != SPN_OK) return st;
+    if (!find_hubs(&nt)) {
+        spn__eq_free(&nt.e);
+        return spn_error(SPN_ERR_NOMEM, "equilibrium: out of memory");
+    }
     if (nt.pc.kind == SPN_PRECOND_AUTO) /* the crossover measured on the standard web (bench_equilibrium) */
         nt.pc.kind = nt.e.n < AUTO_MULTIGRID ? SPN_PRECOND_BLOCK_JACOBI : SPN_PRECOND_MULTIGRID;
     nt.rep.preconditioner = nt.pc.kind;
@@ -320,6 +439,7 @@ spn_status spn_world_equilibrium(spn_world *w, const spn_equilibrium_def *def, s
     }
     free(nt.p);
     free(nt.work);
+    free(nt.hubs);
     spn__precond_free(&nt.pc);
     spn__eq_free(&nt.e);
     return st;

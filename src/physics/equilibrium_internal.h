@@ -84,6 +84,10 @@ void spn__eq_free(spn__eq *e);
 /* Forces and Hessian blocks at e->x, diagonal shifted by lambda * kscale.
  * Returns the largest |f_i| and its local id in *worst. */
 double spn__eq_assemble(spn__eq *e, double lambda, uint32_t *worst);
+/* Spring s at e->x: its force on end a (fs, 3) and its projected Hessian
+ * block (h, 6), as spn__eq_assemble forms them; returns the scale of the
+ * rounding in its energy difference. */
+double spn__eq_spring_terms(const spn__eq *e, uint32_t s, double *fs, double *h);
 /* Energy change of moving the free particles from x to x + alpha p; the
  * trial positions are left in e->xtrial. */
 double spn__eq_energy_delta(spn__eq *e, const double *p, double alpha);

@@ -293,6 +293,11 @@ static double spring_terms(const spn__eq *e, uint32_t s, double *fs, double *h)
     return fabs(t) * (len + e->xmax);
 }
 
+double spn__eq_spring_terms(const spn__eq *e, uint32_t s, double *fs, double *h)
+{
+    return spring_terms(e, s, fs, h);
+}
+
 /* Net force and diagonal block of free particle i. */
 static void gather_particle(spn__eq *e, uint32_t i, double lambda)
 {
