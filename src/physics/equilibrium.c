@@ -19,6 +19,7 @@
  * Invariant: the world is written only at the end and only with finite values. */
 #include "core/big_alloc.h"
 #include "equilibrium_internal.h"
+#include "world_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -179,18 +180,15 @@ static void swap_positions(spn__eq *e)
 }
 
 /* The particles spring-joined to particle i, each counted once (a pair
- * joined by several springs is one). */
-static uint32_t neighbours(const spn__eq *e, uint32_t i)
+ * joined by several springs is one); mark: per local particle, the last
+ * particle that counted it. */
+static uint32_t neighbours(const spn__eq *e, uint32_t i, uint32_t *mark)
 {
     uint32_t count = 0;
     for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++) {
         const uint32_t s = e->adj[j] >> 1, o = e->sa[s] == i ? e->sb[s] : e->sa[s];
-        bool seen = false;
-        for (uint32_t k = e->adj_start[i]; k < j && !seen; k++) {
-            const uint32_t t = e->adj[k] >> 1;
-            seen = (e->sa[t] == i ? e->sb[t] : e->sa[t]) == o;
-        }
-        count += !seen;
+        count += mark[o] != i;
+        mark[o] = i;
     }
     return count;
 }
@@ -201,11 +199,19 @@ static uint32_t neighbours(const spn__eq *e, uint32_t i)
 static bool find_hubs(newton *nt)
 {
     const spn__eq *e = &nt->e;
-    uint32_t *count = malloc((e->n ? e->n : 1) * sizeof *count);
-    if (!count) return false;
+    const int team = e->n < 32768u ? 1 : e->threads;
+    const size_t nl = e->nl ? e->nl : 1;
+    uint32_t *count = malloc((e->n ? e->n : 1) * sizeof *count), *marks = malloc((size_t)team * nl * sizeof *marks);
+    if (!count || !marks) {
+        free(count), free(marks);
+        return false;
+    }
+    for (size_t k = 0; k < (size_t)team * nl; k++) marks[k] = UINT32_MAX;
     uint64_t total = 0; /* an integer sum: the same in any order */
-#pragma omp parallel for schedule(static) reduction(+ : total) num_threads(e->n < 32768u ? 1 : e->threads)
-    for (uint32_t i = 0; i < e->n; i++) total += count[i] = neighbours(e, i);
+    (void)team;
+#pragma omp parallel for schedule(static) reduction(+ : total) num_threads(team)
+    for (uint32_t i = 0; i < e->n; i++) total += count[i] = neighbours(e, i, marks + (size_t)spn__thread_num() * nl);
+    free(marks);
     const double least = fmax(HUB_MIN_NEIGHBOURS, HUB_FACTOR * (e->n ? (double)total / e->n : 0));
     nt->nhubs = 0;
     for (uint32_t i = 0; i < e->n; i++) nt->nhubs += count[i] > least;

@@ -142,8 +142,8 @@ static bool level0_pattern(spn__mg *mg, const spn__eq *e)
     a->start = spn__big_alloc(((size_t)n + 1) * sizeof *a->start);
     a->col = spn__big_alloc(((size_t)n + nadj + 1) * sizeof *a->col);
     mg->map0 = spn__big_alloc((nadj ? nadj : 1) * sizeof *mg->map0);
-    uint32_t *src = e->hs ? malloc(((size_t)n + nadj + 1) * sizeof *src) : NULL;
-    if (!a->start || !a->col || !mg->map0 || (e->hs && !src)) {
+    uint32_t *src = e->hs && !e->offd ? malloc(((size_t)n + nadj + 1) * sizeof *src) : NULL; /* offd: spn__eq_offd's blocks */
+    if (!a->start || !a->col || !mg->map0 || (e->hs && !e->offd && !src)) {
         free(src);
         return false;
     }
