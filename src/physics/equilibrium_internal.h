@@ -140,6 +140,13 @@ static inline void spn__sym_mul(const double *h, const double *v, double *out)
     out[1] = h[3] * v[0] + h[1] * v[1] + h[5] * v[2];
     out[2] = h[4] * v[0] + h[5] * v[1] + h[2] * v[2];
 }
+/* The full 3x3 (row by row) of a symmetric block's six numbers. */
+static inline void spn__sym_full(const double *h, double *m)
+{
+    m[0] = h[0], m[1] = h[3], m[2] = h[4];
+    m[3] = h[3], m[4] = h[1], m[5] = h[5];
+    m[6] = h[4], m[7] = h[5], m[8] = h[2];
+}
 /* Inverse of a symmetric 3x3 block; false when it is not positive definite. */
 bool spn__sym_inverse(const double *h, double *inv);
 

@@ -516,14 +516,6 @@ static void to_float6(const spn__lines *L, const spn__eq *e, uint32_t i, uint32_
     for (int q = 0; q < 6; q++) f[W * q] = (float)h[q];
 }
 
-/* The full 3x3 of a block's six entries, row by row */
-static void sym_full(const double h[6], double m[9])
-{
-    m[0] = h[0], m[1] = h[3], m[2] = h[4];
-    m[3] = h[3], m[4] = h[1], m[5] = h[5];
-    m[6] = h[4], m[7] = h[5], m[8] = h[2];
-}
-
 /* Block Thomas factorisation of group g's lines, all eight lanes at once:
  * each lane's pivots P_0 = D_0, P_s = D_s - U^T P_{s-1}^-1 U (U = U_{s-1})
  * in float64, each lane in the order of the line-by-line factorisation this
@@ -544,9 +536,9 @@ SPN__KERNEL static bool factor_group(spn__lines *L, const spn__eq *sys, uint32_t
             const uint32_t i = L->snode[W * s + q], up = first ? NONE : L->supos[W * (s - 1) + q];
             on[q] = i != NONE;
             double h[6], dd[9], uu[9];
-            if (on[q]) diag_block(sys, i, h), sym_full(h, dd);
+            if (on[q]) diag_block(sys, i, h), spn__sym_full(h, dd);
             else memcpy(dd, ident, sizeof dd);
-            if (up != NONE) spring_block(L, sys, L->snode[W * (s - 1) + q], up, h), sym_full(h, uu);
+            if (up != NONE) spring_block(L, sys, L->snode[W * (s - 1) + q], up, h), spn__sym_full(h, uu);
             else memcpy(uu, zero, sizeof uu);
             for (int f = 0; f < 9; f++) d[f][q] = dd[f], u[f][q] = uu[f];
         }

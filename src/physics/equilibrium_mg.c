@@ -105,31 +105,30 @@ struct spn__mg {
 
 /* ---- level 0 from the spring system --------------------------------------- */
 
-static void sym_to_full(const double *h, double sign, double *m)
+/* m += the full 3x3 of a symmetric block (several springs between one pair
+ * of particles sum into one block). */
+static void sym_full_add(const double *h, double *m)
 {
-    m[0] += sign * h[0], m[1] += sign * h[3], m[2] += sign * h[4];
-    m[3] += sign * h[3], m[4] += sign * h[1], m[5] += sign * h[5];
-    m[6] += sign * h[4], m[7] += sign * h[5], m[8] += sign * h[2];
+    m[0] += h[0], m[1] += h[3], m[2] += h[4];
+    m[3] += h[3], m[4] += h[1], m[5] += h[5];
+    m[6] += h[4], m[7] += h[5], m[8] += h[2];
 }
 
 #define SRC_DIAG 0x80000000u
 
 /* Level-0 block p from the springs, summed as level0_values sums it (from
- * zero, sym_to_full): the same bits. */
+ * zero): the same bits. */
 static const double *level0_block(const void *ctx, size_t p, double *tmp)
 {
     const spn__mg *mg = ctx;
     const spn__eq *e = mg->eq0;
     const uint32_t s = mg->src0[p];
+    /* the diagonal block, or -H_s as spn__eq_offd gives it for two free ends */
+    const double *h = s & SRC_DIAG ? e->diag + 6 * (size_t)(s & ~SRC_DIAG) : e->hs + 6 * (size_t)s;
+    const double sign = s & SRC_DIAG ? 1 : -1;
     double o[6];
-    for (int k = 0; k < 9; k++) tmp[k] = 0;
-    if (s & SRC_DIAG) {
-        sym_to_full(e->diag + 6 * (size_t)(s & ~SRC_DIAG), 1, tmp);
-    } else { /* -H_s, as spn__eq_offd gives it for two free ends */
-        const double *h = e->hs + 6 * (size_t)s;
-        for (int c = 0; c < 6; c++) o[c] = -1.0 * h[c];
-        sym_to_full(o, 1, tmp);
-    }
+    for (int c = 0; c < 6; c++) o[c] = 0.0 + sign * h[c];
+    spn__sym_full(o, tmp);
     return tmp;
 }
 
@@ -194,10 +193,10 @@ static void level0_values(spn__mg *mg, const spn__eq *e)
     for (uint32_t i = 0; i < n; i++) {
         double *row = a->val + 9 * (size_t)a->start[i];
         memset(row, 0, 9 * (size_t)(a->start[i + 1] - a->start[i]) * sizeof *row);
-        sym_to_full(e->diag + 6 * (size_t)i, 1, row);
+        sym_full_add(e->diag + 6 * (size_t)i, row);
         for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++) {
             double o[6];
-            if (mg->map0[j] != UINT32_MAX) sym_to_full(spn__eq_offd(e, j, o), 1, a->val + 9 * (size_t)mg->map0[j]);
+            if (mg->map0[j] != UINT32_MAX) sym_full_add(spn__eq_offd(e, j, o), a->val + 9 * (size_t)mg->map0[j]);
         }
     }
 }
