@@ -12,7 +12,13 @@
  * The Galerkin product from A and P in chunks (spn__bsr_galerkin_ap): the
  * same bits as forming A P whole and multiplying by R = P^T, with chunks
  * whose windows of A P are local and with a numbering that makes it fall
- * back to A P whole, on one and two threads. */
+ * back to A P whole, on one and two threads.
+ *
+ * The Galerkin product formed again into a kept pattern
+ * (spn__bsr_galerkin_refresh), with P and R in float32 as the built
+ * hierarchy holds them: the same floats as rounding the product above of
+ * the same P, on one and two threads, both numberings, and after A's values
+ * change (what it is for). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -282,6 +288,54 @@ static void check_galerkin(uint32_t side, bool scrambled)
     free_grid(&g);
 }
 
+static void check_refresh(uint32_t side, bool scrambled)
+{
+    grid g = make_grid(side);
+    spn__bsr p = make_p(side, scrambled), r;
+    const size_t np = 9 * (size_t)p.start[p.rows];
+    for (size_t k = 0; k < np; k++) p.val[k] = (float)p.val[k]; /* P as its float32 copy will read */
+    uint32_t *perm;
+    assert_true(spn__bsr_transpose(&p, &r, &perm));
+    for (int change = 0; change < 2; change++) {
+        if (change) /* new values in A's pattern: every third diagonal block stiffer (still symmetric) */
+            for (uint32_t i = 0; i < g.a.rows; i += 3)
+                for (int d = 0; d < 3; d++) g.a.val[9 * (size_t)g.a.start[i] + 4 * d] += 0.5;
+        spn__bsr ref;
+        assert_true(spn__bsr_galerkin_ap(&g.a, &p, &r, &ref, 1));
+        const size_t nc = 9 * (size_t)ref.start[ref.rows];
+        spn__bsr c = {.rows = ref.rows, .cols = ref.cols, .start = ref.start, .col = ref.col};
+        c.fval = malloc((nc + 1) * sizeof *c.fval);
+        assert_non_null(c.fval);
+        /* the hierarchy's forms: R and P in float32 (R's rounded from P while P is float64) */
+        if (change == 0) assert_true(spn__bsr_transpose_round(&r, 1));
+        spn__bsr pf = p;
+        pf.val = NULL;
+        pf.fval = malloc((np + 1) * sizeof *pf.fval);
+        assert_non_null(pf.fval);
+        for (size_t k = 0; k < np; k++) pf.fval[k] = (float)p.val[k];
+        pf.fval[np] = 0;
+        for (int t = 1; t <= 2; t++) {
+            memset(c.fval, 0xff, (nc + 1) * sizeof *c.fval); /* NaN: every block must be written */
+            assert_true(spn__bsr_galerkin_refresh(&g.a, &pf, &r, &c, t));
+            for (size_t k = 0; k < nc; k++) assert_true(c.fval[k] == (float)ref.val[k]);
+        }
+        free(pf.fval);
+        free(c.fval);
+        spn__bsr_free(&ref);
+    }
+    spn__bsr_free(&r), spn__bsr_free(&p);
+    free(perm);
+    free_grid(&g);
+}
+
+static void test_galerkin_refresh(void **state)
+{
+    (void)state;
+    check_refresh(400, false); /* chunks with their own windows */
+    check_refresh(400, true);  /* windows across the whole matrix */
+    check_refresh(40, false);
+}
+
 static void test_galerkin_in_chunks(void **state)
 {
     (void)state;
@@ -304,6 +358,7 @@ int main(void)
         cmocka_unit_test(test_parted_sweeps_solve),
         cmocka_unit_test(test_galerkin_in_chunks),
         cmocka_unit_test(test_galerkin_scrambled_falls_back),
+        cmocka_unit_test(test_galerkin_refresh),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

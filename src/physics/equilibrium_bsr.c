@@ -97,6 +97,10 @@ static void row_sums(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_t
     }
 }
 
+/* Numbers a block of the AVX paths' sums takes (three rows of four lanes;
+ * defined in every build, since the scalar fallbacks share their sizes). */
+enum { ACC = 12 };
+
 #if SPN__AVX
 /* acc += a b on 256-bit vectors, a given as its nine numbers broadcast and
  * the sums of a block of C kept as three rows of four lanes (ACC doubles,
@@ -109,26 +113,31 @@ static void row_sums(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_t
  * own nine numbers, rows overlapping by a lane: each load then needed two
  * stores, could not be forwarded and waited for them to reach the cache;
  * 60 ns a product on the 1M web's level 0.) */
-enum { ACC = 12 };
+/* acc += a b with b's three rows already in vectors (a macro: vectors passed
+ * to a function would depend on the clone's instruction set, -Wpsabi). */
+#define BLK_MUL_ADD_ROWS(a, b0, b1, b2, acc)                                                                           \
+    do {                                                                                                             \
+        __m256d c0 = _mm256_load_pd(acc), c1 = _mm256_load_pd((acc) + 4), c2 = _mm256_load_pd((acc) + 8);          \
+        c0 = _mm256_add_pd(c0, _mm256_mul_pd((a)[0], b0));                                                           \
+        c1 = _mm256_add_pd(c1, _mm256_mul_pd((a)[3], b0));                                                           \
+        c2 = _mm256_add_pd(c2, _mm256_mul_pd((a)[6], b0));                                                           \
+        c0 = _mm256_add_pd(c0, _mm256_mul_pd((a)[1], b1));                                                           \
+        c1 = _mm256_add_pd(c1, _mm256_mul_pd((a)[4], b1));                                                           \
+        c2 = _mm256_add_pd(c2, _mm256_mul_pd((a)[7], b1));                                                           \
+        c0 = _mm256_add_pd(c0, _mm256_mul_pd((a)[2], b2));                                                           \
+        c1 = _mm256_add_pd(c1, _mm256_mul_pd((a)[5], b2));                                                           \
+        c2 = _mm256_add_pd(c2, _mm256_mul_pd((a)[8], b2));                                                           \
+        _mm256_store_pd(acc, c0);                                                                                    \
+        _mm256_store_pd((acc) + 4, c1);                                                                              \
+        _mm256_store_pd((acc) + 8, c2);                                                                              \
+    } while (0)
 
 __attribute__((target("avx"))) static inline void blk_mul_add_avx(const __m256d *a, const double *restrict b,
                                                                    double *restrict acc)
 {
     __m256d b0 = _mm256_loadu_pd(b), b1 = _mm256_loadu_pd(b + 3);
     __m256d b2 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(b + 6)), _mm_load_sd(b + 8), 1);
-    __m256d c0 = _mm256_load_pd(acc), c1 = _mm256_load_pd(acc + 4), c2 = _mm256_load_pd(acc + 8);
-    c0 = _mm256_add_pd(c0, _mm256_mul_pd(a[0], b0));
-    c1 = _mm256_add_pd(c1, _mm256_mul_pd(a[3], b0));
-    c2 = _mm256_add_pd(c2, _mm256_mul_pd(a[6], b0));
-    c0 = _mm256_add_pd(c0, _mm256_mul_pd(a[1], b1));
-    c1 = _mm256_add_pd(c1, _mm256_mul_pd(a[4], b1));
-    c2 = _mm256_add_pd(c2, _mm256_mul_pd(a[7], b1));
-    c0 = _mm256_add_pd(c0, _mm256_mul_pd(a[2], b2));
-    c1 = _mm256_add_pd(c1, _mm256_mul_pd(a[5], b2));
-    c2 = _mm256_add_pd(c2, _mm256_mul_pd(a[8], b2));
-    _mm256_store_pd(acc, c0);
-    _mm256_store_pd(acc + 4, c1);
-    _mm256_store_pd(acc + 8, c2);
+    BLK_MUL_ADD_ROWS(a, b0, b1, b2, acc);
 }
 
 /* row_sums with blk_mul_add_avx (a block of A broadcast once for the row
@@ -205,8 +214,14 @@ static void row_values(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32
     row_sums_of(a, b, c, i, upper, acc, pos);
 }
 
+/* d = s^T for 3x3 blocks of either precision */
+#define TRANSPOSE_INTO(d, s)                                                                                           \
+    ((d)[0] = (s)[0], (d)[1] = (s)[3], (d)[2] = (s)[6], (d)[3] = (s)[1], (d)[4] = (s)[4], (d)[5] = (s)[7],        \
+     (d)[6] = (s)[2], (d)[7] = (s)[5], (d)[8] = (s)[8])
+
 /* The blocks below the diagonal of a structurally symmetric C from those
- * above it: C_ij = C_ji^T (row j found by a scan: rows are short). */
+ * above it: C_ij = C_ji^T (row j found by a scan: rows are short), in its
+ * float64 values or, once rounded, its float32 ones. */
 static void mirror_lower(spn__bsr *c, int threads)
 {
 #pragma omp parallel for schedule(static) num_threads(spn__bsr_team(c, threads))
@@ -215,11 +230,8 @@ static void mirror_lower(spn__bsr *c, int threads)
             uint32_t j = c->col[q], t = c->start[j];
             if (j >= i) continue;
             while (c->col[t] != i) t++;
-            const double *s = c->val + 9 * (size_t)t;
-            double *d = c->val + 9 * (size_t)q;
-            d[0] = s[0], d[1] = s[3], d[2] = s[6];
-            d[3] = s[1], d[4] = s[4], d[5] = s[7];
-            d[6] = s[2], d[7] = s[5], d[8] = s[8];
+            if (c->val) TRANSPOSE_INTO(c->val + 9 * (size_t)q, c->val + 9 * (size_t)t);
+            else TRANSPOSE_INTO(c->fval + 9 * (size_t)q, c->fval + 9 * (size_t)t);
         }
 }
 
@@ -321,6 +333,17 @@ static uint32_t galerkin_chunk(uint32_t rows, int threads)
     return c < GALERKIN_CHUNK_MIN ? GALERKIN_CHUNK_MIN : c > GALERKIN_CHUNK ? GALERKIN_CHUNK : c;
 }
 
+/* The rows of A P that rows [i0, i1) of R read: [*lo, *hi], or lo > hi
+ * when those rows are empty. */
+static void window_of(const spn__bsr *r, uint32_t i0, uint32_t i1, uint32_t *lo, uint32_t *hi)
+{
+    *lo = UINT32_MAX, *hi = 0;
+    for (uint32_t q = r->start[i0]; q < r->start[i1]; q++) {
+        *lo = r->col[q] < *lo ? r->col[q] : *lo;
+        *hi = r->col[q] > *hi ? r->col[q] : *hi;
+    }
+}
+
 /* Row i of C = A B when C's pattern is already in place. */
 static void row_known(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32_t i, double *acc, uint32_t *pos)
 {
@@ -367,12 +390,9 @@ bool spn__bsr_galerkin_ap(const spn__bsr *a, const spn__bsr *p, const spn__bsr *
     /* each chunk's range of A P's rows [lo, hi] */
     size_t total = 0, wide_rows = 1, wide_nnz = 1;
     for (uint32_t ch = 0; ch < chunks; ch++) {
-        uint32_t lo = UINT32_MAX, hi = 0;
+        uint32_t lo, hi;
         const uint32_t i0 = ch * chunk, i1 = i0 + chunk < rows ? i0 + chunk : rows;
-        for (uint32_t q = r->start[i0]; q < r->start[i1]; q++) {
-            lo = r->col[q] < lo ? r->col[q] : lo;
-            hi = r->col[q] > hi ? r->col[q] : hi;
-        }
+        window_of(r, i0, i1, &lo, &hi);
         if (lo > hi) lo = 1, hi = 0; /* no entries: an empty window */
         range[2 * ch] = lo, range[2 * ch + 1] = hi;
         if (lo > hi) continue;
@@ -440,6 +460,242 @@ done:
     spn__bsr_free(&ap);
     free(marks), free(range), free(wstart), free(wval), free(accs);
     return ok;
+}
+
+/* Scratch of one thread of spn__bsr_galerkin_refresh: the window of A P's
+ * rows a chunk of C reads (wstart, wcol, wval; grown as needed), the
+ * positions of a row's columns (pos, stamped by seen), and a row of C's sums. */
+typedef struct refresh_scratch {
+    uint32_t *seen, *pos, stamp;
+    uint32_t *wstart, *wcol;
+    double *wval, *acc; /* blocks of `stride` numbers, 32-byte aligned */
+    size_t wcap, vcap, acap, stride;
+} refresh_scratch;
+
+/* p with room for need elements of size bytes (cap: its room), or NULL
+ * (p is then unchanged and still owned by the caller). */
+static void *grown(void *p, size_t *cap, size_t need, size_t size)
+{
+    if (need <= *cap) return p;
+    size_t c = *cap ? *cap : 1024;
+    while (c < need) c *= 2;
+    void *q = realloc(p, c * size);
+    if (q) *cap = c;
+    return q;
+}
+
+/* The same for blocks of doubles kept 32-byte aligned (the AVX sums load
+ * them whole); the old contents are copied. */
+static double *grown_blocks(double *p, size_t *cap, size_t need, size_t stride)
+{
+    if (need <= *cap) return p;
+    size_t c = *cap ? *cap : 1024;
+    while (c < need) c *= 2;
+    double *q = aligned_alloc(32, c * stride * sizeof *q); /* stride * 8 bytes: a multiple of 32 when stride is ACC */
+    if (!q) return NULL;
+    if (p) memcpy(q, p, *cap * stride * sizeof *q);
+    free(p);
+    *cap = c;
+    return q;
+}
+
+/* Room in s's window for need blocks. */
+static bool window_room(refresh_scratch *s, size_t need)
+{
+    uint32_t *wcol = grown(s->wcol, &s->wcap, need, sizeof *s->wcol);
+    if (!wcol) return false;
+    s->wcol = wcol;
+    double *wval = grown_blocks(s->wval, &s->vcap, need, s->stride);
+    if (!wval) return false;
+    s->wval = wval;
+    return true;
+}
+
+/* Row k of A P into s's window from block wn on: its columns in the order
+ * met, a new column's block zeroed (pos: where it went). Returns the blocks
+ * it took, or UINT32_MAX out of memory. */
+static uint32_t window_cols(const spn__bsr *a, const spn__bsr *p, uint32_t k, size_t wn, refresh_scratch *s)
+{
+    size_t bound = 0;
+    for (uint32_t q = a->start[k]; q < a->start[k + 1]; q++) bound += p->start[a->col[q] + 1] - p->start[a->col[q]];
+    if (!window_room(s, wn + bound)) return UINT32_MAX;
+    const uint32_t stamp = ++s->stamp;
+    size_t w = wn;
+    for (uint32_t q = a->start[k]; q < a->start[k + 1]; q++)
+        for (uint32_t t = p->start[a->col[q]]; t < p->start[a->col[q] + 1]; t++) {
+            const uint32_t J = p->col[t];
+            if (s->seen[J] == stamp) continue;
+            s->seen[J] = stamp;
+            s->pos[J] = (uint32_t)w;
+            s->wcol[w] = J;
+            memset(s->wval + s->stride * w, 0, s->stride * sizeof *s->wval);
+            w++;
+        }
+    return (uint32_t)(w - wn);
+}
+
+/* Rows [lo, hi] of A P into s's window, each block summed over A's then
+ * P's entries in their order (spn__blk_mul_add). */
+static bool refresh_window(const spn__bsr *a, const spn__bsr *p, uint32_t lo, uint32_t hi, refresh_scratch *s)
+{
+    size_t wn = 0;
+    for (uint32_t k = lo; k <= hi; k++) {
+        s->wstart[k - lo] = (uint32_t)wn;
+        const uint32_t cnt = window_cols(a, p, k, wn, s);
+        if (cnt == UINT32_MAX) return false;
+        double ta[9], tp[9];
+        for (uint32_t q = a->start[k]; q < a->start[k + 1]; q++) {
+            const double *ab = spn__bsr_block(a, q, ta);
+            for (uint32_t t = p->start[a->col[q]]; t < p->start[a->col[q] + 1]; t++)
+                spn__blk_mul_add(ab, spn__bsr_block(p, t, tp), s->wval + 9 * (size_t)s->pos[p->col[t]]);
+        }
+        wn += cnt;
+    }
+    s->wstart[hi + 1 - lo] = (uint32_t)wn;
+    return true;
+}
+
+/* Row I of C's sums (the blocks on and above the diagonal) from the window,
+ * then rounded into C. */
+static bool refresh_row(const spn__bsr *r, spn__bsr *c, uint32_t I, uint32_t lo, refresh_scratch *s)
+{
+    const uint32_t q0 = c->start[I], q1 = c->start[I + 1];
+    double *acc = grown_blocks(s->acc, &s->acap, (size_t)(q1 - q0), s->stride);
+    if (!acc) return false;
+    s->acc = acc;
+    for (uint32_t q = q0; q < q1; q++) s->pos[c->col[q]] = q - q0;
+    memset(acc, 0, 9 * (size_t)(q1 - q0) * sizeof *acc);
+    double tr[9];
+    for (uint32_t q = r->start[I]; q < r->start[I + 1]; q++) {
+        const double *rb = spn__bsr_block(r, q, tr);
+        const uint32_t i = r->col[q] - lo;
+        for (uint32_t t = s->wstart[i]; t < s->wstart[i + 1]; t++)
+            if (s->wcol[t] >= I) spn__blk_mul_add(rb, s->wval + 9 * (size_t)t, acc + 9 * (size_t)s->pos[s->wcol[t]]);
+    }
+    for (uint32_t q = q0; q < q1; q++)
+        if (c->col[q] >= I)
+            for (int k = 0; k < 9; k++) c->fval[9 * (size_t)q + k] = (float)acc[9 * (size_t)(q - q0) + k];
+    return true;
+}
+
+#if SPN__AVX
+/* blk_mul_add_avx with b a float32 block (its rows read four floats wide:
+ * the fourth lane meets the spare lane of acc; a float block's last row
+ * reads the spare float that ends every fval). */
+__attribute__((target("avx"))) static inline void blk_mul_add_avx_f(const __m256d *a, const float *restrict b,
+                                                                     double *restrict acc)
+{
+    __m256d b0 = _mm256_cvtps_pd(_mm_loadu_ps(b)), b1 = _mm256_cvtps_pd(_mm_loadu_ps(b + 3));
+    __m256d b2 = _mm256_cvtps_pd(_mm_loadu_ps(b + 6));
+    BLK_MUL_ADD_ROWS(a, b0, b1, b2, acc);
+}
+
+/* blk_mul_add_avx with b in the sums' own layout (ACC numbers, rows four wide). */
+__attribute__((target("avx"))) static inline void blk_mul_add_avx_acc(const __m256d *a, const double *restrict b,
+                                                                       double *restrict acc)
+{
+    __m256d b0 = _mm256_load_pd(b), b1 = _mm256_load_pd(b + 4), b2 = _mm256_load_pd(b + 8);
+    BLK_MUL_ADD_ROWS(a, b0, b1, b2, acc);
+}
+
+/* refresh_window on 256-bit vectors, the window's blocks in ACC layout (P
+ * in float32, as the built hierarchy keeps it; the same order of sums). */
+__attribute__((target("avx"))) static bool refresh_window_avx(const spn__bsr *a, const spn__bsr *p, uint32_t lo,
+                                                              uint32_t hi, refresh_scratch *s)
+{
+    size_t wn = 0;
+    for (uint32_t k = lo; k <= hi; k++) {
+        s->wstart[k - lo] = (uint32_t)wn;
+        const uint32_t cnt = window_cols(a, p, k, wn, s);
+        if (cnt == UINT32_MAX) return false;
+        double ta[9];
+        for (uint32_t q = a->start[k]; q < a->start[k + 1]; q++) {
+            const double *ab = spn__bsr_block(a, q, ta);
+            __m256d av[9];
+            for (int m = 0; m < 9; m++) av[m] = _mm256_broadcast_sd(ab + m);
+            for (uint32_t t = p->start[a->col[q]]; t < p->start[a->col[q] + 1]; t++)
+                blk_mul_add_avx_f(av, p->fval + 9 * (size_t)t, s->wval + ACC * (size_t)s->pos[p->col[t]]);
+        }
+        wn += cnt;
+    }
+    s->wstart[hi + 1 - lo] = (uint32_t)wn;
+    return true;
+}
+
+__attribute__((target("avx"))) static bool refresh_row_avx(const spn__bsr *r, spn__bsr *c, uint32_t I, uint32_t lo,
+                                                           refresh_scratch *s)
+{
+    const uint32_t q0 = c->start[I], q1 = c->start[I + 1];
+    double *acc = grown_blocks(s->acc, &s->acap, (size_t)(q1 - q0), ACC);
+    if (!acc) return false;
+    s->acc = acc;
+    for (uint32_t q = q0; q < q1; q++) s->pos[c->col[q]] = q - q0;
+    memset(acc, 0, ACC * (size_t)(q1 - q0) * sizeof *acc);
+    double tr[9];
+    for (uint32_t q = r->start[I]; q < r->start[I + 1]; q++) {
+        const double *rb = spn__bsr_block(r, q, tr);
+        __m256d av[9];
+        for (int m = 0; m < 9; m++) av[m] = _mm256_broadcast_sd(rb + m);
+        const uint32_t i = r->col[q] - lo;
+        for (uint32_t t = s->wstart[i]; t < s->wstart[i + 1]; t++)
+            if (s->wcol[t] >= I) blk_mul_add_avx_acc(av, s->wval + ACC * (size_t)t, acc + ACC * (size_t)s->pos[s->wcol[t]]);
+    }
+    for (uint32_t q = q0; q < q1; q++)
+        if (c->col[q] >= I)
+            for (int m = 0; m < 9; m++) c->fval[9 * (size_t)q + m] = (float)acc[ACC * (size_t)(q - q0) + 4 * (m / 3) + m % 3];
+    return true;
+}
+#endif
+
+bool spn__bsr_galerkin_refresh(const spn__bsr *a, const spn__bsr *p, const spn__bsr *r, spn__bsr *c, int threads)
+{
+    const uint32_t nc = p->cols, rows = r->rows;
+    const double products = (double)a->start[a->rows] * p->start[p->rows] / (p->rows ? p->rows : 1);
+    const int nt = products < PAR_MIN_PRODUCTS ? 1 : threads;
+    const uint32_t chunk = galerkin_chunk(rows, nt), chunks = (rows + chunk - 1) / chunk;
+    /* the vector path reads P's float32 blocks straight (the hierarchy's P once built) */
+    const bool avx = SPN__AVX && spn__have_avx() && p->fval != NULL;
+    uint32_t widest = 0; /* the most rows a chunk's window has */
+    for (uint32_t ch = 0; ch < chunks; ch++) {
+        const uint32_t i0 = ch * chunk, i1 = i0 + chunk < rows ? i0 + chunk : rows;
+        uint32_t lo, hi;
+        window_of(r, i0, i1, &lo, &hi);
+        if (lo <= hi && hi - lo + 1 > widest) widest = hi - lo + 1;
+    }
+    int bad = 0;
+#pragma omp parallel num_threads(nt) reduction(+ : bad)
+    {
+        refresh_scratch s = {0};
+        s.stride = avx ? ACC : 9;
+        s.seen = malloc((nc ? nc : 1) * sizeof *s.seen);
+        s.pos = malloc((nc ? nc : 1) * sizeof *s.pos);
+        s.wstart = malloc(((size_t)widest + 2) * sizeof *s.wstart);
+        bool ok = s.seen && s.pos && s.wstart;
+        for (uint32_t k = 0; ok && k < nc; k++) s.seen[k] = 0;
+#pragma omp for schedule(dynamic, 1)
+        for (uint32_t ch = 0; ch < chunks; ch++) {
+            const uint32_t i0 = ch * chunk, i1 = i0 + chunk < rows ? i0 + chunk : rows;
+            uint32_t lo, hi;
+            window_of(r, i0, i1, &lo, &hi);
+            if (!ok) continue;
+#if SPN__AVX
+            if (avx) {
+                if (lo <= hi) ok = refresh_window_avx(a, p, lo, hi, &s);
+                else lo = 0; /* no entries: rows of zeros */
+                for (uint32_t I = i0; ok && I < i1; I++) ok = refresh_row_avx(r, c, I, lo, &s);
+                continue;
+            }
+#endif
+            if (lo <= hi) ok = refresh_window(a, p, lo, hi, &s);
+            else lo = 0; /* no entries: rows of zeros */
+            for (uint32_t I = i0; ok && I < i1; I++) ok = refresh_row(r, c, I, lo, &s);
+        }
+        bad += !ok;
+        free(s.seen), free(s.pos), free(s.wstart), free(s.wcol), free(s.wval), free(s.acc);
+    }
+    if (bad) return false;
+    mirror_lower(c, threads);
+    return true;
 }
 
 bool spn__bsr_transpose(const spn__bsr *a, spn__bsr *t, uint32_t **perm_out)

@@ -46,12 +46,16 @@ typedef struct spn__bsr {
     const void *blk_ctx;
 } spn__bsr;
 
-/* Block p's nine numbers: from val, from blk, or from a transpose's source
- * (tsrc, tperm: spn__bsr_transpose) through tmp. */
+/* Block p's nine numbers: from val, from blk, from fval, or from a
+ * transpose's source (tsrc, tperm: spn__bsr_transpose) through tmp. */
 static inline const double *spn__bsr_block(const spn__bsr *m, size_t p, double *tmp)
 {
     if (m->val) return m->val + 9 * p;
     if (m->blk) return m->blk(m->blk_ctx, p, tmp);
+    if (m->fval) {
+        for (int k = 0; k < 9; k++) tmp[k] = m->fval[9 * p + k];
+        return tmp;
+    }
     const double *s = m->tsrc->val + 9 * (size_t)m->tperm[p];
     tmp[0] = s[0], tmp[1] = s[3], tmp[2] = s[6];
     tmp[3] = s[1], tmp[4] = s[4], tmp[5] = s[7];
@@ -82,6 +86,13 @@ bool spn__bsr_galerkin(const spn__bsr *r, const spn__bsr *ap, spn__bsr *c, int t
  * whole and calling spn__bsr_galerkin, which it falls back to when the
  * windows would overlap too much). */
 bool spn__bsr_galerkin_ap(const spn__bsr *a, const spn__bsr *p, const spn__bsr *r, spn__bsr *c, int threads);
+/* C's values again from A's current ones, C = R (A P) with the patterns of
+ * C, P and R kept (the hierarchy of a later Newton step): C's blocks are
+ * written as float32 (fval; C must have been rounded), the blocks of A, P
+ * and R read in whatever form they have (spn__bsr_block). Each row of C is
+ * summed in a fixed order: the same bits on any team. false on out of
+ * memory. */
+bool spn__bsr_galerkin_refresh(const spn__bsr *a, const spn__bsr *p, const spn__bsr *r, spn__bsr *c, int threads);
 /* T = A^T (A in float64): its pattern, and perm[k], the entry of A that
  * T's entry k comes from. T's values are read from A through perm (no copy:
  * the Galerkin product is the only reader of R = P^T in float64) until

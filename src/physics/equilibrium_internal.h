@@ -154,6 +154,10 @@ bool spn__sym_inverse(const double *h, double *inv);
 spn_status spn__mg_setup(spn__mg **mg, const spn__eq *e, const double *inv0);
 void spn__mg_apply(const spn__mg *mg, const spn__eq *e, const double *r, double *z);
 void spn__mg_free(spn__mg *mg);
+/* Free particles from which a later Newton step forms the multigrid's coarse
+ * levels again (200,000; equilibrium_mg.c); returns the old value. For the
+ * tests, which cannot afford such webs; not to be changed during a solve. */
+uint32_t spn__mg_set_refresh_min(uint32_t free_particles);
 /* Level l of a built hierarchy: its rows, its blocks and its longest row's
  * blocks (for tests and diagnostics); false when there is no level l. */
 bool spn__mg_level(const spn__mg *mg, int l, uint32_t *rows, uint32_t *blocks, uint32_t *longest);

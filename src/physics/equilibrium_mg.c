@@ -38,12 +38,15 @@
  * Newton path of today); with the thread slides 12 (100k web: 54 -> 24).
  *
  * Newton steps: the hierarchy is built from the first Newton system and
- * kept; each later step refreshes only the finest level and the line
- * factors (and, on webs above SLIDE_REFRESH_N, the slide matrix). The Hessian of a taut web changes little between steps, and a
- * stale coarse operator is still symmetric positive definite (measured: 22
- * CG instead of 23 at 5k, 65 instead of 60 at 100k, for a setup a quarter
- * the cost). If the first system cannot be factored (a singular web), the
- * hierarchy is dropped and built again from the next, shifted, system.
+ * kept; each later step refreshes the finest level and the line factors
+ * (and, on webs above SLIDE_REFRESH_N, the slide matrix; from
+ * GALERKIN_REFRESH_N, the coarse levels' values: refresh()). The Hessian of
+ * a taut web changes little between steps, and a stale coarse operator is
+ * still symmetric positive definite (measured: 22 CG instead of 23 at 5k,
+ * 65 instead of 60 at 100k, for a setup a quarter the cost; on the 1M web
+ * the stale coarse levels cost 6 of 34 CG, see refresh()). If the first
+ * system cannot be factored (a singular web), the hierarchy is dropped and
+ * built again from the next, shifted, system.
  * Every product writes its own rows in a fixed order: the same bits for any
  * thread count. */
 #include "core/big_alloc.h"
@@ -75,6 +78,18 @@
 /* Free particles above which the slide matrix is factored again at every
  * Newton step instead of kept from the first (see spn__mg_setup). */
 #define SLIDE_REFRESH_N 50000u
+/* Free particles from which a later Newton step forms the coarse levels
+ * again from its own system (spn__bsr_galerkin_refresh: the aggregates and
+ * prolongators kept, only R A P's values). */
+#define GALERKIN_REFRESH_N 200000u
+static uint32_t galerkin_refresh_n = GALERKIN_REFRESH_N;
+
+uint32_t spn__mg_set_refresh_min(uint32_t free_particles)
+{
+    const uint32_t old = galerkin_refresh_n;
+    galerkin_refresh_n = free_particles;
+    return old;
+}
 
 typedef struct mg_level {
     spn__bsr A;         /* the level's matrix, diagonal block first in each row; level 0 of a
@@ -101,6 +116,7 @@ struct spn__mg {
     bool slide_ok;      /* its matrix factored (from the first system that allowed it; kept on small webs) */
     double *dense;      /* coarsest level's Cholesky factor */
     int threads;
+    bool refresh;       /* later systems form the coarse levels again (GALERKIN_REFRESH_N); src0 kept */
 };
 
 /* ---- level 0 from the spring system --------------------------------------- */
@@ -275,7 +291,8 @@ static bool level_inverse(const mg_level *L)
 {
     int bad = 0;
     for (uint32_t i = 0; i < L->A.rows; i++) {
-        const double *v = L->A.val + 9 * (size_t)L->A.start[i];
+        double t[9];
+        const double *v = spn__bsr_block(&L->A, L->A.start[i], t);
         double h[6] = {v[0], v[4], v[8], 0.5 * (v[1] + v[3]), 0.5 * (v[2] + v[6]), 0.5 * (v[5] + v[7])};
         if (!spn__sym_inverse(h, L->dinv + 6 * (size_t)i)) bad++;
     }
@@ -455,9 +472,12 @@ static bool dense_factor(spn__mg *mg)
     double *f = mg->dense;
     memset(f, 0, N * N * sizeof *f);
     for (uint32_t I = 0; I < a->rows; I++)
-        for (uint32_t p = a->start[I]; p < a->start[I + 1]; p++)
+        for (uint32_t p = a->start[I]; p < a->start[I + 1]; p++) {
+            double t[9];
+            const double *v = spn__bsr_block(a, p, t);
             for (int r = 0; r < 3; r++)
-                for (int c = 0; c < 3; c++) f[(3 * I + r) * N + 3 * a->col[p] + c] += a->val[9 * (size_t)p + 3 * r + c];
+                for (int c = 0; c < 3; c++) f[(3 * I + r) * N + 3 * a->col[p] + c] += v[3 * r + c];
+        }
     return spn__dense_cholesky(f, N, 1);
 }
 
@@ -531,7 +551,8 @@ static spn_status build(spn__mg *mg, const spn__eq *e, const double *inv0)
     /* A spring system's level 0 is multiplied from its springs
      * (spn__eq_matvec_mg) and the line factors read their blocks from there
      * too: its values (360 MB on the 1M web) served the hierarchy only */
-    if (e->hs) {
+    mg->refresh = e->hs && mg->src0 && e->n >= galerkin_refresh_n;
+    if (e->hs && !mg->refresh) {
         free(L0->A.val);
         free(mg->src0);
         L0->A.val = NULL, mg->src0 = NULL, L0->A.blk = NULL;
@@ -544,6 +565,33 @@ static spn_status build(spn__mg *mg, const spn__eq *e, const double *inv0)
     if (!(L0->lines = spn__lines_build(e, &L0->A))) return SPN_ERR_NOMEM;
     /* NULL: too many lines, or no memory; the cycle goes without */
     if (e->hs) mg->slide = spn__slide_build(e, L0->lines);
+    return SPN_OK;
+}
+
+/* The coarse levels formed again from the current finest level, top down,
+ * with the aggregates, prolongators and patterns of the first system.
+ * Why: the hierarchy fits the system it was built from, and a web's thread
+ * tensions move between Newton steps (the standard web starts at T0 in
+ * every thread; at rest its radials carry 0.43-1.75 T0, and a thread's
+ * out-of-plane stiffness is its tension over its length). Measured on the
+ * 1M web (2026-11-23): the second Newton solve took 23 CG with the first
+ * system's coarse levels, 17 with them formed again (16 with the whole
+ * hierarchy built again, aggregates and all, at three times the cost; the
+ * same 17 with the prolongators smoothed again too); 34 -> 28 CG in all, 67
+ * -> 51 to 1e-9 T0. The largest Ritz values of the preconditioned system
+ * fell from 1.52 to 1.0: the stale levels over-corrected. Forming them
+ * again costs 0.55-0.65 s there (two threads) against about 0.85 s of CG
+ * saved; on the 100k web (22 -> 20 CG) the two balance, hence the
+ * threshold. Every level down to the coarsest is needed: only level 1
+ * formed again gave 32 CG, levels 1-2 30, 1-3 28. */
+static spn_status refresh(spn__mg *mg)
+{
+    for (int l = 0; l + 1 < mg->nlevels; l++) {
+        mg_level *L = &mg->lv[l], *C = &mg->lv[l + 1];
+        if (!spn__bsr_galerkin_refresh(&L->A, &L->P, &L->R, &C->A, mg->threads)) return SPN_ERR_NOMEM;
+        if (!level_inverse(C)) return SPN_ERR_UNSTABLE;
+    }
+    if (mg->dense && !dense_factor(mg)) return SPN_ERR_UNSTABLE;
     return SPN_OK;
 }
 
@@ -562,6 +610,8 @@ spn_status spn__mg_setup(spn__mg **out, const spn__eq *e, const double *inv0)
     } else {
         mg->lv[0].dinv = (double *)inv0;
         if (!e->hs) level0_values(mg, e);
+        spn_status st = mg->refresh ? refresh(mg) : SPN_OK;
+        if (st != SPN_OK) return st == SPN_ERR_NOMEM ? spn_error(st, "equilibrium: out of memory (multigrid)") : st;
     }
     /* Like the hierarchy, the slide matrix of the first system is kept on a
      * small web: the later ones needed the same CG iterations (5k: 12, 100k:
