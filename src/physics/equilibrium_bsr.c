@@ -751,6 +751,24 @@ bool spn__bsr_transpose_round(spn__bsr *t, int threads)
     return true;
 }
 
+/* Row j's blocks and columns asked into the cache ahead of a backward
+ * Gauss-Seidel sweep. The sweep reads each row's blocks upward but the rows
+ * downward, and the hardware's prefetcher, which follows the forward sweep
+ * from row to row, starts again at every row: measured on the 1M web (35
+ * V-cycles, two threads) the backward sweeps of levels 1-3 took 0.18, 0.14
+ * and 0.03 s against 0.12, 0.05 and 0.015 s forward; with row i - 1 asked
+ * for while row i is summed, 0.13-0.14, 0.10 and 0.03 s (two or four rows
+ * ahead: no better). The same bits: a prefetch changes no value. */
+static inline void prefetch_row(const spn__bsr *a, uint32_t j)
+{
+    const size_t size = a->val ? 9 * sizeof(double) : 9 * sizeof(float);
+    const char *v = a->val ? (const char *)a->val : (const char *)a->fval;
+    if (!v) return;
+    const char *p0 = v + size * a->start[j], *p1 = v + size * a->start[j + 1];
+    for (const char *q = p0; q < p1; q += 64) __builtin_prefetch(q);
+    __builtin_prefetch(a->col + a->start[j]);
+}
+
 /* Block rows times a vector: s = sum over the row's blocks from entry p0 of
  * A_ij x_j. Each of the nine products of a block has its own running sums
  * over the row (lane sums, as a 256-bit register holds them), two of them,
@@ -867,6 +885,7 @@ __attribute__((target("avx"))) static void gauss_seidel_part_avx(const spn__bsr 
     for (uint32_t k = lo; k < hi; k++) {
         uint32_t i = forward ? k : hi - 1 - (k - lo);
         double s[3];
+        if (!forward && i > lo) prefetch_row(a, i - 1);
         row_sum_split_avx(a, i, a->start[i] + 1, x, xo, lo, hi - lo, s); /* the diagonal is first */
         s[0] = b[3 * i] - s[0], s[1] = b[3 * i + 1] - s[1], s[2] = b[3 * i + 2] - s[2];
         spn__sym_mul(dinv + 6 * (size_t)i, s, x + 3 * (size_t)i);
@@ -914,6 +933,7 @@ static void gauss_seidel_part(const spn__bsr *a, const double *dinv, const doubl
     for (uint32_t k = lo; k < hi; k++) {
         uint32_t i = forward ? k : hi - 1 - (k - lo);
         double s[3];
+        if (!forward && i > lo) prefetch_row(a, i - 1);
         row_sum_split(a, i, a->start[i] + 1, x, xo, lo, hi - lo, s); /* the diagonal is first */
         s[0] = b[3 * i] - s[0], s[1] = b[3 * i + 1] - s[1], s[2] = b[3 * i + 2] - s[2];
         spn__sym_mul(dinv + 6 * (size_t)i, s, x + 3 * (size_t)i);
