@@ -214,11 +214,6 @@ static void row_values(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32
     row_sums_of(a, b, c, i, upper, acc, pos);
 }
 
-/* d = s^T for 3x3 blocks of either precision */
-#define TRANSPOSE_INTO(d, s)                                                                                           \
-    ((d)[0] = (s)[0], (d)[1] = (s)[3], (d)[2] = (s)[6], (d)[3] = (s)[1], (d)[4] = (s)[4], (d)[5] = (s)[7],        \
-     (d)[6] = (s)[2], (d)[7] = (s)[5], (d)[8] = (s)[8])
-
 /* The blocks below the diagonal of a structurally symmetric C from those
  * above it: C_ij = C_ji^T (row j found by a scan: rows are short), in its
  * float64 values or, once rounded, its float32 ones. */
@@ -230,8 +225,8 @@ static void mirror_lower(spn__bsr *c, int threads)
             uint32_t j = c->col[q], t = c->start[j];
             if (j >= i) continue;
             while (c->col[t] != i) t++;
-            if (c->val) TRANSPOSE_INTO(c->val + 9 * (size_t)q, c->val + 9 * (size_t)t);
-            else TRANSPOSE_INTO(c->fval + 9 * (size_t)q, c->fval + 9 * (size_t)t);
+            if (c->val) SPN__BLK_TRANSPOSE(c->val + 9 * (size_t)q, c->val + 9 * (size_t)t);
+            else SPN__BLK_TRANSPOSE(c->fval + 9 * (size_t)q, c->fval + 9 * (size_t)t);
         }
 }
 

@@ -46,6 +46,11 @@ typedef struct spn__bsr {
     const void *blk_ctx;
 } spn__bsr;
 
+/* d = s^T for 3x3 blocks (nine numbers, row-major) of either precision */
+#define SPN__BLK_TRANSPOSE(d, s)                                                                                     \
+    ((d)[0] = (s)[0], (d)[1] = (s)[3], (d)[2] = (s)[6], (d)[3] = (s)[1], (d)[4] = (s)[4], (d)[5] = (s)[7],        \
+     (d)[6] = (s)[2], (d)[7] = (s)[5], (d)[8] = (s)[8])
+
 /* Block p's nine numbers: from val, from blk, from fval, or from a
  * transpose's source (tsrc, tperm: spn__bsr_transpose) through tmp. */
 static inline const double *spn__bsr_block(const spn__bsr *m, size_t p, double *tmp)
@@ -57,9 +62,7 @@ static inline const double *spn__bsr_block(const spn__bsr *m, size_t p, double *
         return tmp;
     }
     const double *s = m->tsrc->val + 9 * (size_t)m->tperm[p];
-    tmp[0] = s[0], tmp[1] = s[3], tmp[2] = s[6];
-    tmp[3] = s[1], tmp[4] = s[4], tmp[5] = s[7];
-    tmp[6] = s[2], tmp[7] = s[5], tmp[8] = s[8];
+    SPN__BLK_TRANSPOSE(tmp, s);
     return tmp;
 }
 
