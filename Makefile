@@ -3,7 +3,7 @@
 #   make deps     install missing Debian packages
 #   make          build (build/)
 #   make test     build, run the suite, then run it again under ASan+UBSan (build-asan/)
-#   make demo     build and write the showcase into out/
+#   make demo     build and write the showcase into out/ (also installs imagemagick, for its contact sheets)
 #   make bench    run the benchmarks, write bench/results/<machine>.json
 #   make fuzz     run every libFuzzer harness FUZZ_SECONDS each (default 60; build-fuzz/)
 #   make test-valgrind  the suite under valgrind memcheck (build/; not in CI: see docs/hostile-input.md)
@@ -20,8 +20,10 @@ WERROR ?= ON
 DEPS := cmake pkg-config gcc make libcmocka-dev libcairo2-dev libcjson-dev fonts-dejavu-core \
         libassimp-dev libglfw3-dev libgl-dev libgl1-mesa-dri xvfb xauth ffmpeg povray clang libclang-rt-14-dev
 BENCH_DEPS := libbullet-dev g++ libsuitesparse-dev
+# the showcase's contact sheets and onion skins (montage, convert)
+DEMO_DEPS := imagemagick
 
-.PHONY: all deps deps-bench build test test-fast test-asan fuzz fuzz-build demo bench install clean \
+.PHONY: all deps deps-bench deps-demo build test test-fast test-asan fuzz fuzz-build demo bench install clean \
         test-valgrind soak determinism
 
 FUZZ_SECONDS ?= 60
@@ -33,6 +35,9 @@ deps:
 
 deps-bench:
 	@scripts/install-deps.sh $(DEPS) $(BENCH_DEPS)
+
+deps-demo:
+	@scripts/install-deps.sh $(DEPS) $(DEMO_DEPS)
 
 build/CMakeCache.txt:
 	cmake -S . -B build -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) -DSPN_WERROR=$(WERROR) $(CMAKE_FLAGS)
@@ -74,7 +79,7 @@ determinism: build build-asan/CMakeCache.txt
 	cmake --build build-asan -j $(JOBS)
 	scripts/determinism.sh build build-asan
 
-demo: build
+demo: deps-demo build
 	@scripts/demo.sh build/spinneret out
 
 bench: deps-bench

@@ -32,7 +32,7 @@ for i in 0 1 2; do
 done
 montage -label "${labels[0]}" "$tmp/onion0.png" -label "${labels[1]}" "$tmp/onion1.png" \
   -label "${labels[2]}" "$tmp/onion2.png" -tile 3x1 -geometry +2+2 -background black -fill white \
-  -pointsize 16 "$out/thwip-side-by-side-onion.png"
+  -font "$font" -pointsize 16 "$out/thwip-side-by-side-onion.png"
 if command -v ffmpeg > /dev/null; then
   ffmpeg -loglevel error -y -framerate 30 -i "$tmp/v0/frame_%05d.png" -framerate 30 -i "$tmp/v1/frame_%05d.png" \
     -framerate 30 -i "$tmp/v2/frame_%05d.png" -filter_complex \
