@@ -179,6 +179,12 @@ static void swap_positions(spn__eq *e)
     e->xtrial = t;
 }
 
+/* The local particle (free or fixed) at the other end of spring s from i. */
+static inline uint32_t other_end(const spn__eq *e, uint32_t s, uint32_t i)
+{
+    return e->sa[s] == i ? e->sb[s] : e->sa[s];
+}
+
 /* The particles spring-joined to particle i, each counted once (a pair
  * joined by several springs is one); mark: per local particle, the last
  * particle that counted it. */
@@ -186,7 +192,7 @@ static uint32_t neighbours(const spn__eq *e, uint32_t i, uint32_t *mark)
 {
     uint32_t count = 0;
     for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++) {
-        const uint32_t s = e->adj[j] >> 1, o = e->sa[s] == i ? e->sb[s] : e->sa[s];
+        const uint32_t s = e->adj[j] >> 1, o = other_end(e, s, i);
         count += mark[o] != i;
         mark[o] = i;
     }
@@ -247,16 +253,14 @@ static double hub_energy_delta(const spn__eq *e, uint32_t i, const double dx[3])
     const double *xi = e->x + 3 * (size_t)i;
     double de = 0;
     for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++) {
-        const uint32_t s = e->adj[j] >> 1, o = e->sa[s] == i ? e->sb[s] : e->sa[s];
-        const double *xo = e->x + 3 * (size_t)o;
+        const uint32_t s = e->adj[j] >> 1;
+        const double *xo = e->x + 3 * (size_t)other_end(e, s, i);
         double l0 = 0, l1 = 0;
         for (int c = 0; c < 3; c++) {
             const double a = xi[c] - xo[c], b = a + dx[c];
             l0 += a * a, l1 += b * b;
         }
-        double d0 = sqrt(l0) - e->rest[s], d1 = sqrt(l1) - e->rest[s];
-        if (e->tonly[s]) d0 = fmax(d0, 0), d1 = fmax(d1, 0);
-        de += 0.5 * e->k[s] * (d1 - d0) * (d1 + d0);
+        de += spn__eq_length_energy(e, s, sqrt(l0), sqrt(l1));
     }
     for (int c = 0; c < 3; c++) de -= e->fext[3 * (size_t)i + c] * dx[c];
     return de;

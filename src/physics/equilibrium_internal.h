@@ -88,6 +88,9 @@ double spn__eq_assemble(spn__eq *e, double lambda, uint32_t *worst);
  * block (h, 6), as spn__eq_assemble forms them; returns the scale of the
  * rounding in its energy difference. */
 double spn__eq_spring_terms(const spn__eq *e, uint32_t s, double *fs, double *h);
+/* Energy change of spring s from length l0 to l1 (a tension-only spring
+ * holds none while slack). */
+double spn__eq_length_energy(const spn__eq *e, uint32_t s, double l0, double l1);
 /* Energy change of moving the free particles from x to x + alpha p; the
  * trial positions are left in e->xtrial. */
 double spn__eq_energy_delta(spn__eq *e, const double *p, double alpha);

@@ -384,6 +384,17 @@ double spn__eq_slack_limit(const spn__eq *e, const double *p, double cap)
     return alpha;
 }
 
+double spn__eq_length_energy(const spn__eq *e, uint32_t s, double l0, double l1)
+{
+    double d0 = l0 - e->rest[s], d1 = l1 - e->rest[s];
+    if (e->tonly[s]) {
+        d0 = d0 > 0 ? d0 : 0;
+        d1 = d1 > 0 ? d1 : 0;
+    }
+    /* (d1^2 - d0^2) as a product, so a small move is not lost to cancellation */
+    return 0.5 * e->k[s] * (d1 - d0) * (d1 + d0);
+}
+
 static double spring_energy_delta(const spn__eq *e, uint32_t s)
 {
     const double *xa = e->x + 3 * (size_t)e->sa[s], *xb = e->x + 3 * (size_t)e->sb[s];
@@ -392,13 +403,7 @@ static double spring_energy_delta(const spn__eq *e, uint32_t s)
                      (xa[2] - xb[2]) * (xa[2] - xb[2]));
     double l1 = sqrt((ya[0] - yb[0]) * (ya[0] - yb[0]) + (ya[1] - yb[1]) * (ya[1] - yb[1]) +
                      (ya[2] - yb[2]) * (ya[2] - yb[2]));
-    double d0 = l0 - e->rest[s], d1 = l1 - e->rest[s];
-    if (e->tonly[s]) {
-        d0 = d0 > 0 ? d0 : 0;
-        d1 = d1 > 0 ? d1 : 0;
-    }
-    /* (d1^2 - d0^2) as a product, so a small move is not lost to cancellation */
-    return 0.5 * e->k[s] * (d1 - d0) * (d1 + d0);
+    return spn__eq_length_energy(e, s, l0, l1);
 }
 
 double spn__eq_energy_delta(spn__eq *e, const double *p, double alpha)
