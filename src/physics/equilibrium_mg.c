@@ -107,9 +107,10 @@ struct spn__mg {
     int nlevels;
     mg_level lv[MAX_LEVELS];
     uint32_t *map0;     /* per adjacency entry of the spring system: its level-0 block, or UINT32_MAX */
-    /* per level-0 block of a spring system while the hierarchy is built: its
-     * spring, or SRC_DIAG | its row (level0_block);
-     * NULL where level 0 keeps its values (see level0_pattern) */
+    /* per level-0 block of a spring system while the hierarchy is built
+     * (and after, when later systems refresh it): its spring, or SRC_DIAG |
+     * its row (level0_block); NULL where level 0 keeps its values (see
+     * level0_pattern) */
     uint32_t *src0;
     const spn__eq *eq0; /* the system src0 reads */
     spn__slide *slide;  /* thread-slide correction on level 0 (spring systems only), or NULL */
