@@ -36,6 +36,11 @@ KNOWN = {
         ("equal_accuracy_bullet_refine", "Bullet step divisor tried"),
         ("equal_accuracy_bullet_strain_error", "its strain error"),
         ("equal_accuracy_cpu_ratio", "CPU ratio at that divisor")]),
+    "mg_rates": ("Equilibrium preconditioners as stationary iterations: energy-norm contraction per cycle, "
+                 "the rate of cycles 25-32 (bench/bench_mg_rates.c; the same on any machine)", [
+        ("scene", "scene"), ("system", "Newton system"), ("precond", "preconditioner"),
+        ("component", "error"), ("contraction", "contraction"), ("worst_cycle", "largest factor"),
+        ("setup_seconds", "setup wall s")]),
     "bandwidth": ("Memory bandwidth (bench/bench_bandwidth.c, STREAM-style)", [
         ("kernel", "kernel"), ("threads", "threads"), ("gb_per_s", "GB/s")]),
 }

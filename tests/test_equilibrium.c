@@ -515,17 +515,25 @@ static void test_species_web_multigrid(void **state)
  * a 400-radial hub, its hierarchy built through the internal setup: level 1
  * measured 71,565 blocks, 53.8 a row, with the hub's row smoothed, and
  * 20,215, 15.2 a row, with the rule (2026-11-22). */
+/* The first Newton system of a loaded web and its preconditioner, built
+ * through the internal setup as spn_world_equilibrium builds them. */
+static void first_system(spn_world *w, spn_precond kind, spn__eq *e, spn__precond *pc)
+{
+    spn_equilibrium_def d = loaded_def(w, kind);
+    assert_int_equal(spn__eq_init(e, w, &d), SPN_OK);
+    uint32_t worst = 0;
+    assert_true(isfinite(spn__eq_assemble(e, 0, &worst)));
+    *pc = (spn__precond){.kind = kind};
+    assert_int_equal(spn__precond_setup(pc, e), SPN_OK);
+}
+
 static void test_hub_row_makes_no_dense_level(void **state)
 {
     (void)state;
     spn_world *w = small_orb(12, 400, 0.02, 1);
-    spn_equilibrium_def d = loaded_def(w, SPN_PRECOND_MULTIGRID);
     spn__eq e;
-    assert_int_equal(spn__eq_init(&e, w, &d), SPN_OK);
-    uint32_t worst = 0;
-    assert_true(isfinite(spn__eq_assemble(&e, 0, &worst)));
-    spn__precond pc = {.kind = SPN_PRECOND_MULTIGRID};
-    assert_int_equal(spn__precond_setup(&pc, &e), SPN_OK);
+    spn__precond pc;
+    first_system(w, SPN_PRECOND_MULTIGRID, &e, &pc);
     uint32_t rows0, blocks0, longest0, rows1, blocks1, longest1;
     assert_true(spn__mg_level(pc.mg, 0, &rows0, &blocks0, &longest0));
     assert_true(spn__mg_level(pc.mg, 1, &rows1, &blocks1, &longest1));
@@ -535,6 +543,47 @@ static void test_hub_row_makes_no_dense_level(void **state)
     assert_true((double)blocks1 / rows1 < 25);
     spn__precond_free(&pc);
     spn__eq_free(&e);
+    spn_world_destroy(w);
+}
+
+/* The rates of one preconditioner on the first Newton system of a loaded
+ * standard web: an in-plane error (x, y) and an out-of-plane one (z),
+ * 32 stationary cycles each (spn__precond_contraction). */
+static void contraction_rates(spn_world *w, spn_precond kind, double rate[2], double worst[2])
+{
+    spn__eq e;
+    spn__precond pc;
+    first_system(w, kind, &e, &pc);
+    double *work = malloc(9 * (size_t)e.n * sizeof *work);
+    assert_non_null(work);
+    rate[0] = spn__precond_contraction(&pc, &e, 3u, 32, &worst[0], work);
+    rate[1] = spn__precond_contraction(&pc, &e, 4u, 32, &worst[1], work);
+    free(work);
+    spn__precond_free(&pc);
+    spn__eq_free(&e);
+}
+
+/* The multigrid as a stationary iteration, e <- e - M^-1 A e: every V-cycle
+ * shrinks the energy norm of the error, in the web's plane and out of it,
+ * and at rates far from block Jacobi's. Measured on this 2,401-particle web
+ * (2026-11-23): multigrid 0.519 in plane, 0.478 out of plane (the largest
+ * single factors the same to 0.001); block Jacobi 0.986 and 0.978. The bounds leave
+ * 0.1: a multigrid that lost its coarse correction, its thread slides or its
+ * line smoother, or whose cycle stopped being a convergent symmetric one
+ * (a factor of 1 or more), fails here before any CG count moves. */
+static void test_multigrid_contracts_every_component(void **state)
+{
+    (void)state;
+    spn_world *w = small_orb(40, 60, 0.02, 1);
+    double mg[2], mg_worst[2], bj[2], bj_worst[2];
+    contraction_rates(w, SPN_PRECOND_MULTIGRID, mg, mg_worst);
+    contraction_rates(w, SPN_PRECOND_BLOCK_JACOBI, bj, bj_worst);
+    const double measured[2] = {0.519, 0.478};
+    for (int k = 0; k < 2; k++) {
+        assert_true(mg[k] > 0 && mg[k] <= measured[k] + 0.1);
+        assert_true(mg_worst[k] < 1);
+        assert_true(bj[k] > 0.95 && bj_worst[k] < 1);
+    }
     spn_world_destroy(w);
 }
 
@@ -686,6 +735,7 @@ int main(void)
         cmocka_unit_test(test_refreshed_coarse_levels),
         cmocka_unit_test(test_species_web_multigrid),
         cmocka_unit_test(test_hub_row_makes_no_dense_level),
+        cmocka_unit_test(test_multigrid_contracts_every_component),
         cmocka_unit_test(test_hub_web_settles_as_block_jacobi_does),
         cmocka_unit_test(test_doubled_threads_settle_as_twice_as_stiff),
         cmocka_unit_test(test_energy_change_is_what_the_web_released),

@@ -130,6 +130,21 @@ void spn__precond_free(spn__precond *pc);
 /* Symmetric block Gauss-Seidel with the inverted diagonal blocks inv. */
 void spn__sgs_apply(const spn__eq *e, const double *inv, const double *r, double *z);
 
+/* The preconditioner M as a stationary iteration, e <- e - M^-1 A e, from a
+ * fixed pseudo-random error on the chosen components (bit 0 x, bit 1 y,
+ * bit 2 z; the others zero): how much each cycle shrinks the error's energy
+ * norm |e|_A. Returns the geometric mean of the factors of the last
+ * cycles / 4 cycles (the asymptotic rate, which the slowest modes set: for
+ * a symmetric V-cycle the smallest eigenvalue of M^-1 A is about 1 minus
+ * it, and CG's iterations grow as its inverse square root), and in *worst
+ * the largest single factor (below 1 for every cycle when M
+ * is a convergent symmetric smoother-based cycle). A measure of the
+ * preconditioner that does not depend on the machine, nor on the Newton
+ * path that a CG count also reflects (bench/bench_mg_rates.c,
+ * docs/physics-equilibrium.md). work: 3 x 3n doubles. cycles >= 1. */
+double spn__precond_contraction(const spn__precond *pc, const spn__eq *e, unsigned components, int cycles,
+                                double *worst, double *work);
+
 /* Solve A p = f until |A p - f|_2 <= eta |f|_2 or every particle's
  * |(A p - f)_i| <= floor, p the first guess.
  * Returns the iterations used, or -1 when A showed non-positive curvature. */

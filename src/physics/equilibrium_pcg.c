@@ -105,6 +105,31 @@ void spn__precond_free(spn__precond *pc)
     pc->mg = NULL;
 }
 
+double spn__precond_contraction(const spn__precond *pc, const spn__eq *e, unsigned components, int cycles,
+                                double *worst, double *work)
+{
+    const size_t n3 = 3 * (size_t)e->n;
+    double *x = work, *y = work + n3, *z = work + 2 * n3;
+    uint64_t s = 0x9E3779B97F4A7C15ull; /* xorshift64: the same start on every machine */
+    for (size_t i = 0; i < n3; i++) {
+        s ^= s << 13, s ^= s >> 7, s ^= s << 17;
+        x[i] = (components >> (i % 3)) & 1u ? (double)(s >> 11) / 9007199254740992.0 - 0.5 : 0;
+    }
+    const int tail = cycles / 4 > 0 ? cycles / 4 : 1;
+    double energy = spn__eq_matvec_dot(e, x, y), log_sum = 0;
+    *worst = 0;
+    for (int c = 0; c < cycles; c++) {
+        spn__precond_apply(pc, e, y, z); /* y = A x from the last energy */
+        for (size_t i = 0; i < n3; i++) x[i] -= z[i];
+        const double next = spn__eq_matvec_dot(e, x, y);
+        const double factor = energy > 0 ? sqrt(fmax(next, 0) / energy) : 0;
+        *worst = fmax(*worst, factor);
+        if (c >= cycles - tail) log_sum += log(fmax(factor, 1e-300));
+        energy = next;
+    }
+    return exp(log_sum / tail);
+}
+
 /* z = M^-1 r; returns r . z (block preconditioners fused in one pass). */
 static double precond_dot(const spn__precond *pc, const spn__eq *e, const double *r, double *z)
 {
