@@ -507,14 +507,6 @@ static void test_species_web_multigrid(void **state)
     spn_world_destroy(mg), spn_world_destroy(bj), spn_world_destroy(two);
 }
 
-/* A hub joins every radial. Smoothed like any other row, its prolongator
- * row reaches all the aggregates around it, and the Galerkin product R A P
- * makes every one of them a neighbour of every other on the next level (on
- * the 1M web, 88% of level 1's block products). The setup keeps such a row
- * (8 times its level's mean and more than 64 blocks) tentative. A web with
- * a 400-radial hub, its hierarchy built through the internal setup: level 1
- * measured 71,565 blocks, 53.8 a row, with the hub's row smoothed, and
- * 20,215, 15.2 a row, with the rule (2026-11-22). */
 /* The first Newton system of a loaded web and its preconditioner, built
  * through the internal setup as spn_world_equilibrium builds them. */
 static void first_system(spn_world *w, spn_precond kind, spn__eq *e, spn__precond *pc)
@@ -527,6 +519,14 @@ static void first_system(spn_world *w, spn_precond kind, spn__eq *e, spn__precon
     assert_int_equal(spn__precond_setup(pc, e), SPN_OK);
 }
 
+/* A hub joins every radial. Smoothed like any other row, its prolongator
+ * row reaches all the aggregates around it, and the Galerkin product R A P
+ * makes every one of them a neighbour of every other on the next level (on
+ * the 1M web, 88% of level 1's block products). The setup keeps such a row
+ * (8 times its level's mean and more than 64 blocks) tentative. A web with
+ * a 400-radial hub, its hierarchy built through the internal setup: level 1
+ * measured 71,565 blocks, 53.8 a row, with the hub's row smoothed, and
+ * 20,215, 15.2 a row, with the rule (2026-11-22). */
 static void test_hub_row_makes_no_dense_level(void **state)
 {
     (void)state;
@@ -567,10 +567,11 @@ static void contraction_rates(spn_world *w, spn_precond kind, double rate[2], do
  * shrinks the energy norm of the error, in the web's plane and out of it,
  * and at rates far from block Jacobi's. Measured on this 2,401-particle web
  * (2026-11-23): multigrid 0.519 in plane, 0.478 out of plane (the largest
- * single factors the same to 0.001); block Jacobi 0.986 and 0.978. The bounds leave
- * 0.1: a multigrid that lost its coarse correction, its thread slides or its
- * line smoother, or whose cycle stopped being a convergent symmetric one
- * (a factor of 1 or more), fails here before any CG count moves. */
+ * single factors the same to 0.001); block Jacobi 0.986 and 0.978. The
+ * bounds leave 0.1: a multigrid that lost its coarse correction, its thread
+ * slides or its line smoother, or whose cycle stopped being a convergent
+ * symmetric one (a factor of 1 or more), fails here before any CG count
+ * moves (checked: without the slides it fails). */
 static void test_multigrid_contracts_every_component(void **state)
 {
     (void)state;

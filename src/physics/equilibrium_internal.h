@@ -137,11 +137,11 @@ void spn__sgs_apply(const spn__eq *e, const double *inv, const double *r, double
  * cycles / 4 cycles (the asymptotic rate, which the slowest modes set: for
  * a symmetric V-cycle the smallest eigenvalue of M^-1 A is about 1 minus
  * it, and CG's iterations grow as its inverse square root), and in *worst
- * the largest single factor (below 1 for every cycle when M
- * is a convergent symmetric smoother-based cycle). A measure of the
- * preconditioner that does not depend on the machine, nor on the Newton
+ * the largest single factor (below 1 for every cycle when M is a
+ * convergent symmetric smoother-based cycle). A measure of the
+ * preconditioner that depends neither on the machine nor on the Newton
  * path that a CG count also reflects (bench/bench_mg_rates.c,
- * docs/physics-equilibrium.md). work: 3 x 3n doubles. cycles >= 1. */
+ * docs/physics-equilibrium.md). work: 3 x 3n doubles; cycles >= 1. */
 double spn__precond_contraction(const spn__precond *pc, const spn__eq *e, unsigned components, int cycles,
                                 double *worst, double *work);
 
