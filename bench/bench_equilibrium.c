@@ -40,13 +40,6 @@
 #include "cholmod_reference.inc"
 #endif
 
-static uint32_t free_count(const spn_world *w)
-{
-    uint32_t n = 0;
-    for (uint32_t i = 0; i < spn_world_particle_count(w); i++) n += !spn_world_is_fixed(w, i);
-    return n;
-}
-
 #define RUNS 10 /* repeats of a small solve */
 
 typedef struct figure {
@@ -122,10 +115,9 @@ static spn_world *make_orb(int threads) { return bench_orb(orb_size, threads); }
 
 static void orb(const bench_orb_size *size, bool reference, const figure *figs, int nfigs)
 {
-    spn_orb_scene_def od = spn_orb_scene_def_default();
-    double t0 = od.ea * od.prestrain, sag_ref = 0;
+    double t0 = 0, sag_ref = 0;
     spn_world *w = bench_orb(size, 1);
-    spn_vec3 load = spn_v3(0, 0, t0 / free_count(w));
+    spn_vec3 load = bench_orb_load(w, &t0);
     if (reference) {
         double s0 = bench_now(), c0 = bench_cpu_now();
         int it = bench_reference_newton(w, load, 1e-11 * t0, 30);

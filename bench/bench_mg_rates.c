@@ -42,14 +42,9 @@ static void die(const char *what)
 
 static spn_equilibrium_def definition(const spn_world *w)
 {
-    spn_orb_scene_def od = spn_orb_scene_def_default();
-    const double t0 = od.ea * od.prestrain;
-    uint32_t nf = 0;
-    for (uint32_t i = 0; i < spn_world_particle_count(w); i++) nf += !spn_world_is_fixed(w, i);
     spn_equilibrium_def d = spn_equilibrium_def_default();
     d.threads = THREADS;
-    d.force_scale = t0;
-    d.load = spn_v3(0, 0, t0 / (nf ? nf : 1));
+    d.load = bench_orb_load(w, &d.force_scale);
     return d;
 }
 

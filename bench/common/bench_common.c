@@ -29,6 +29,16 @@ spn_world *bench_orb(const bench_orb_size *size, int threads)
     return or_die(st, w);
 }
 
+spn_vec3 bench_orb_load(const spn_world *w, double *t0)
+{
+    spn_orb_scene_def od = spn_orb_scene_def_default();
+    const double tension = od.ea * od.prestrain;
+    uint32_t nf = 0;
+    for (uint32_t i = 0; i < spn_world_particle_count(w); i++) nf += !spn_world_is_fixed(w, i);
+    if (t0) *t0 = tension;
+    return spn_v3(0, 0, tension / (nf ? nf : 1));
+}
+
 spn_world *bench_cloth(int threads)
 {
     spn_world_def wd = spn_world_def_default();

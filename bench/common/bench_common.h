@@ -17,6 +17,10 @@ extern const bench_orb_size BENCH_ORB_SIZES[3];
 
 /// The standard orb web with silk values (spn_orb_scene_def_default), `threads` threads.
 spn_world *bench_orb(const bench_orb_size *size, int threads);
+/// The standard web's out-of-plane load: its pretension T0 (EA times the
+/// pre-strain of spn_orb_scene_def_default) spread evenly over the free
+/// particles of `w`, per particle; T0 into *t0 when not NULL.
+spn_vec3 bench_orb_load(const spn_world *w, double *t0);
 /// A 64 x 64 cloth, 1 m, 0.1 kg, k 500 N/m, pinned at its four corners (a hammock).
 spn_world *bench_cloth(int threads);
 /// A chain of 200 segments between anchors 1 m apart, 1.2 m long, 0.1 kg.
