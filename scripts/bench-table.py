@@ -21,7 +21,7 @@ BEGIN, END = "<!-- bench-table:begin -->", "<!-- bench-table:end -->"
 KNOWN = {
     "equilibrium": ("Static equilibrium (`spn_world_equilibrium`, bench/bench_equilibrium.c)", [
         ("scene", "scene"), ("precond", "preconditioner"), ("threads", "threads"),
-        ("tolerance", "tol / T0"), ("seconds", "wall s"), ("cpu_seconds", "CPU s"),
+        ("tolerance", "tol / T0"), ("cold", "cold"), ("seconds", "wall s"), ("cpu_seconds", "CPU s"),
         ("newton", "Newton"), ("cg", "CG"), ("residual_over_t0", "checked residual / T0"),
         ("sag_rel_error", "sag vs direct")]),
     "equilibrium_reference": ("Reference: Newton with a direct banded Cholesky solve", [
