@@ -32,8 +32,20 @@
  * and with the lattice forbidden ("path":"general", the spring-record loops
  * any world takes). Symplectic Euler and RK4 run a third time on the float32
  * lattice step ("precision":"float32", spn_world_set_precision; every other
- * row is "float64"). */
+ * row is "float64").
+ *
+ * Bandwidth: a lattice row also gives the memory traffic its steps cannot
+ * avoid (spn__lattice_step_bytes: every pass reads the state, masses and
+ * spring slots once and writes the state once; a model, this VM has no
+ * memory counters), per spring-step, and what that is per second of wall
+ * time: scripts/step-table.py sets it against bench_bandwidth's triad on as
+ * many threads, the share of the machine's bandwidth the step reaches
+ * (issue 10). "pass_mib" is what one pass streams: a web whose pass fits in
+ * the caches (the 5k web's 0.6 MB) runs from them, and its share of the
+ * memory's bandwidth says only how little it asks of it. */
 #include "common/bench_common.h"
+
+#include "physics/world_internal.h" /* spn__lattice_step_bytes */
 
 #include <spinneret/spinneret.h>
 
@@ -111,6 +123,11 @@ static int bench_one(const size_case *c, spn_integrator integ, int threads, bool
            ns_spring_step, cpu * per, bench_load_average(), spn_world_step_path(w),
            prec == SPN_PRECISION_FLOAT32 ? "float32" : "float64");
     if (blocked) printf(",\"blocked_steps\":%ld", blocked);
+    const double bytes = spn__lattice_step_bytes(w, steps, (int)blocked); /* per step */
+    if (bytes > 0)
+        printf(",\"model_bytes_per_spring_step\":%.1f,\"model_gb_per_s\":%.2f,\"pass_mib\":%.2f",
+               bytes / spn_world_spring_count(w), bytes * steps / sec * 1e-9,
+               spn__lattice_step_bytes(w, 1, 1) / 1048576.0); /* one step, one pass: the pass's own bytes */
     if (integ == SPN_INTEGRATOR_ADAPTIVE)
         printf(",\"substeps_per_step\":%.1f,\"ns_per_spring_substep\":%.3f", (double)substeps / steps,
                ns_spring_step * steps / (double)substeps);

@@ -5,7 +5,8 @@
  * to the general path when a spring breaks (by hand or at its break length)
  * with the trajectories still identical, follows stiffness and rest-length
  * changes, and gives the same bits on 1 and 2 threads; big webs' blocked
- * passes give the bits of single steps, in float64 and in float32. */
+ * passes give the bits of single steps, in float64 and in float32; the
+ * benchmark's traffic model counts what docs/physics-lattice.md says. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -18,6 +19,8 @@
 #include <string.h>
 
 #include <spinneret/spinneret.h>
+
+#include "physics/world_internal.h" /* spn__lattice_step_bytes */
 
 /* The standard web with a disturbed state: random velocities (seeded), one
  * free particle pinned mid-web, viscous drag, so damping, slack tension-only
@@ -387,6 +390,40 @@ static void test_not_a_lattice(void **state)
     spn_world_destroy(w);
 }
 
+/* spn__lattice_step_bytes on a 4 x 8 web (33 particles, 32 slots of each
+ * kind), counted by hand from its definition: a pass reads the state (6
+ * values a particle), the masses (2) and the slots (k, kd, rest of both
+ * kinds: 6 a slot; float32 also 6 reference differences) and writes the
+ * state; a blocked pass takes up to 4 explicit steps or one RK4 step; an RK4
+ * step taken stage by stage moves 17 states and reads masses and slots 4
+ * times. */
+static void test_traffic_model(void **state)
+{
+    (void)state;
+    spn_world_def def = spn_world_def_default();
+    def.integrator = SPN_INTEGRATOR_SYMPLECTIC;
+    spn_orb_scene_def od = spn_orb_scene_def_default();
+    od.rings = 4;
+    od.radials = 8;
+    spn_world *w;
+    assert_int_equal(spn_scene_orb(&def, &od, &w), SPN_OK);
+    assert_int_equal(spn_world_compile(w), SPN_OK);
+    assert_string_equal(spn_world_step_path(w), "lattice");
+    const double st = 6 * 33 * 8, fixed = (2 * 33 + 6 * 32) * 8, pass = fixed + 2 * st; /* 1584, 2064, 5232 */
+    assert_true(spn__lattice_step_bytes(w, 10, 0) == pass);
+    assert_true(spn__lattice_step_bytes(w, 10, 8) == (2 * pass + 2 * pass) / 10); /* 8 steps in 2 passes */
+    assert_true(spn__lattice_step_bytes(w, 3, 3) == pass / 3);                   /* a pass of 3 */
+    assert_true(spn__lattice_step_bytes(w, 10, 11) == 0);                         /* not a count */
+    spn_world_set_integrator(w, SPN_INTEGRATOR_RK4);
+    assert_true(spn__lattice_step_bytes(w, 2, 0) == 4 * fixed + 17 * st);
+    assert_true(spn__lattice_step_bytes(w, 2, 2) == pass);
+    spn_world_set_precision(w, SPN_PRECISION_FLOAT32);
+    assert_true(spn__lattice_step_bytes(w, 1, 1) == (2 * 33 + 12 * 32) * 4 + 2 * 6 * 33 * 4);
+    spn_world_set_lattice(w, false);
+    assert_true(spn__lattice_step_bytes(w, 1, 0) == 0);
+    spn_world_destroy(w);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -397,6 +434,7 @@ int main(void)
         cmocka_unit_test(test_changes_and_break),
         cmocka_unit_test(test_hand_built_and_breakage),
         cmocka_unit_test(test_not_a_lattice),
+        cmocka_unit_test(test_traffic_model),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

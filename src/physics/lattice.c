@@ -393,6 +393,39 @@ const char *spn_world_step_path(const spn_world *w)
 
 void spn_world_set_lattice(spn_world *w, bool allow) { w->lattice_off = !allow; }
 
+/* Bytes per step of the memory traffic the lattice steps of one
+ * spn_world_advance call cannot avoid: each pass over the web reads the
+ * state it starts from, the masses and the spring slots once and writes the
+ * state once (the float32 step also reads its slots' reference differences).
+ * A blocked pass (lattice_block_t.h) keeps the rows in flight in the cache,
+ * so its up to SPN__LAT_BLOCK_MAX explicit steps, or its RK4 step's four
+ * stages, cost one such pass; an RK4 step taken stage by stage also reads
+ * and writes its trial state and its stage sums: stage 0 reads the state and
+ * writes a trial state and the sums, stages 1 and 2 read the trial state,
+ * the state and the sums and write a trial state and the sums, stage 3
+ * reads the same and writes the state: 17 state-sized arrays and four passes
+ * over masses and slots. Not counted: the call's load and write-back of the
+ * state, the float32 step's rebase every 64 steps, the hub, the bands'
+ * cut rows. A model, not a measurement (this VM has no memory counters):
+ * bench_step divides it by the time of a step for the share of the
+ * machine's bandwidth the step reaches. 0 when the world's steps do not
+ * take the lattice. */
+double spn__lattice_step_bytes(const spn_world *w, int steps, int blocked)
+{
+    const spn_integrator in = w->def.integrator;
+    const bool rk4 = in == SPN_INTEGRATOR_RK4;
+    if (steps < 1 || blocked < 0 || blocked > steps || strcmp(spn_world_step_path(w), "lattice") != 0) return 0;
+    const bool f32 = w->precision == SPN_PRECISION_FLOAT32;
+    const double size = f32 ? sizeof(float) : sizeof(double), np = w->np,
+                 slots = (double)w->lat->rings * w->lat->radials;
+    const double state = 6 * np * size,                              /* x and v by component */
+        fixed = (2 * np + (f32 ? 12 : 6) * slots) * size,            /* masses; k, kd, rest (and f32 differences) */
+        pass = fixed + 2 * state,                                    /* read once, the state written once */
+        single = rk4 ? 4 * fixed + 17 * state : pass;                /* a step taken without blocking */
+    const int passes = rk4 ? blocked : (blocked + SPN__LAT_BLOCK_MAX - 1) / SPN__LAT_BLOCK_MAX;
+    return (passes * pass + (steps - blocked) * single) / steps;
+}
+
 /* Threads for this world's bands, and the bands ready; 0 when the lattice
  * path does not apply. */
 static int ready(spn_world *w)

@@ -332,6 +332,11 @@ bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r);
  * done (0: take single steps), results in r[]. */
 #define SPN__LAT_BLOCK_MAX 4
 int spn__lattice_block_steps(spn_world *w, double dt, int k, spn__step_result *r);
+/* The memory traffic a lattice step cannot avoid, in bytes per step, over
+ * an spn_world_advance call of `steps` steps of which `blocked` were taken in
+ * blocked passes (spn_step_report.blocked); a model (lattice.c). 0 when the
+ * world's steps do not take the lattice. */
+double spn__lattice_step_bytes(const spn_world *w, int steps, int blocked);
 /* The float32 lattice step (lattice_f32.c) keeps its own state during an
  * spn_world_advance call; w->x and w->v are behind it until this writes them
  * back (a no-op when it holds nothing). Called at the end of every call. */
