@@ -38,7 +38,7 @@
  * avoid (spn__lattice_step_bytes: every pass reads the state, masses and
  * spring slots once and writes the state once; a model, this VM has no
  * memory counters), per spring-step, and what that is per second of wall
- * time: scripts/step-table.py sets it against bench_bandwidth's triad on as
+ * time: scripts/bench-table.py sets it against bench_bandwidth's triad on as
  * many threads, the share of the machine's bandwidth the step reaches
  * (issue 10). "pass_mib" is what one pass streams: a web whose pass fits in
  * the caches (the 5k web's 0.6 MB) runs from them, and its share of the

@@ -46,6 +46,82 @@ KNOWN = {
 }
 
 
+# Issue 10's targets: (figure, target, limit, unit, how to pick the figure's
+# line and its value, the lines shown beside it). Each target is read off
+# this run's lines, never typed in.
+def _step(integ, particles, threads, precision="float64"):
+    return lambda r: (r.get("bench") == "step" and r.get("integrator") == integ and r.get("particles") == particles
+                      and r.get("threads") == threads and r.get("path") == "lattice"
+                      and r.get("precision") == precision)
+
+
+def _equilibrium(scene, threads, cold=None):
+    return lambda r: (r.get("bench") == "equilibrium" and r.get("scene") == scene and r.get("precond") == "multigrid"
+                      and r.get("threads") == threads and r.get("tolerance") == 1e-6
+                      and (cold is None or r.get("cold") == cold))
+
+
+TARGETS = [
+    ("explicit (symplectic) step, 5k web, float64, ns per spring-step", 1.2, _step("symplectic", 5001, 1),
+     "ns_per_spring_step", [("float32", _step("symplectic", 5001, 1, "float32"), "ns_per_spring_step"),
+                            ("two threads", _step("symplectic", 5001, 2), "ns_per_spring_step")]),
+    ("explicit step, 1M web, float64, 2 threads, ns per spring-step (wall)", 3.5, _step("symplectic", 1000001, 2),
+     "ns_per_spring_step", [("one thread", _step("symplectic", 1000001, 1), "ns_per_spring_step"),
+                            ("float32", _step("symplectic", 1000001, 2, "float32"), "ns_per_spring_step")]),
+    ("RK4 step, 5k web, ns per spring-step", 5, _step("rk4", 5001, 1), "ns_per_spring_step",
+     [("float32", _step("rk4", 5001, 1, "float32"), "ns_per_spring_step")]),
+    ("RK4 step, 1M web, 2 threads, ns per spring-step (wall)", 12, _step("rk4", 1000001, 2), "ns_per_spring_step",
+     [("one thread", _step("rk4", 1000001, 1), "ns_per_spring_step"),
+      ("float32", _step("rk4", 1000001, 2, "float32"), "ns_per_spring_step")]),
+    ("static equilibrium, 5k web, 1e-6 T0, s (fastest of ten solves)", 0.020, _equilibrium("orb-5k", 1), "seconds",
+     [("first solve in the process, CPU", _equilibrium("orb-5k", 1), "cpu_first_seconds")]),
+    ("static equilibrium, 1M web, 1e-6 T0, 2 threads, s (wall; the process's first solve)", 5,
+     _equilibrium("orb-1M", 2, cold=True), "seconds",
+     [("the same after another 1M solve", _equilibrium("orb-1M", 2, cold=False), "seconds"),
+      ("one thread", _equilibrium("orb-1M", 1), "seconds")]),
+]
+
+
+def targets(lines):
+    """Issue 10's table against this run: each figure, its target and
+    whether this run met it, with the figures beside it (other precisions,
+    thread counts, a cold or warm process)."""
+    def pick(rule, key):
+        hits = [l[key] for l in lines if rule(l) and key in l]
+        return hits[0] if hits else None
+    out = ["**Issue 10's targets against this run**", "",
+           "| figure | target | this run | beside it | met |", "|---|---:|---:|---|---|"]
+    for name, limit, rule, key, beside in TARGETS:
+        v = pick(rule, key)
+        if v is None:
+            continue
+        side = "; ".join(f"{label} {cell(b)}" for label, r2, k2 in beside for b in [pick(r2, k2)] if b is not None)
+        out.append(f"| {name} | ≤ {cell(limit)} | {cell(v)} | {side} | {'yes' if v <= limit else 'no'} |")
+    return "\n".join(out) + "\n" if len(out) > 4 else ""
+
+
+def bandwidth_table(rows):
+    """Each lattice step's unavoidable traffic (bench_step's model: a pass
+    reads the state, masses and spring slots once and writes the state once)
+    per second of wall time, against bench_bandwidth's triad on as many
+    threads in the same run."""
+    triad = {r["threads"]: r["gb_per_s"] for r in rows
+             if r.get("bench") == "bandwidth" and r.get("kernel") == "triad"}
+    steps = [r for r in rows if r.get("bench") == "step" and "model_gb_per_s" in r]
+    if not steps or not triad:
+        return ""
+    out = ["| integrator | particles | threads | bytes per spring-step | one pass, MiB | GB/s | triad GB/s | share |",
+           "|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in steps:
+        t = triad.get(r["threads"])
+        name = r["integrator"] + (" float32" if r.get("precision") == "float32" else "")
+        share = f"{r['model_gb_per_s'] / t:.0%}" if t else "–"
+        out.append(f"| {name} | {r['particles']:,} | {r['threads']} | {r['model_bytes_per_spring_step']:.1f} | "
+                   f"{r['pass_mib']:.1f} | {r['model_gb_per_s']:.1f} | {t if t else '–'} | {share} |")
+    return "**The share of the machine's bandwidth the lattice steps reach (bench/bench_step.c)**\n\n" + \
+        "\n".join(out) + "\n"
+
+
 def cell(v):
     if v is None:
         return ""
@@ -75,6 +151,9 @@ def render(path):
     out = [f"Measured by `make bench` on `{machine.get('machine', '?')}`: {machine.get('cpu', '?')}, "
            f"{machine.get('cores', '?')} cores, {machine.get('date', '?')} "
            f"(results: `{os.path.relpath(path)}`; tables made by `scripts/bench-table.py`).", ""]
+    for extra in (targets(lines), bandwidth_table(lines)):
+        if extra:
+            out.append(extra)
     for name in list(KNOWN) + sorted(set(groups) - set(KNOWN)):
         if name not in groups:
             continue

@@ -1,8 +1,7 @@
 #!/usr/bin/env python3
 """Compact tables for README's Speed section from a bench results file
 (JSON lines, as written by scripts/bench.sh): bench_step per integrator and
-size, the share of the machine's bandwidth its lattice steps reach, and the
-Bullet peer.
+size, and the Bullet peer.
 
     scripts/step-table.py bench/results/<machine>.json
 """
@@ -53,27 +52,6 @@ def step_table(rows):
     return "\n".join(out)
 
 
-def bandwidth_table(rows):
-    """Each lattice step's unavoidable traffic (bench_step's model: a pass
-    reads the state, masses and spring slots once and writes the state once)
-    per second of wall time, against bench_bandwidth's triad on as many
-    threads in the same run."""
-    triad = {r["threads"]: r["gb_per_s"] for r in rows
-             if r.get("bench") == "bandwidth" and r.get("kernel") == "triad"}
-    steps = [r for r in rows if r.get("bench") == "step" and "model_gb_per_s" in r]
-    if not steps or not triad:
-        return ""
-    out = ["| integrator | particles | threads | bytes per spring-step | one pass, MiB | GB/s | triad GB/s | share |",
-           "|---|---:|---:|---:|---:|---:|---:|---:|"]
-    for r in steps:
-        t = triad.get(r["threads"])
-        name = r["integrator"] + (" float32" if r.get("precision") == "float32" else "")
-        share = f"{r['model_gb_per_s'] / t:.0%}" if t else "–"
-        out.append(f"| {name} | {r['particles']:,} | {r['threads']} | {r['model_bytes_per_spring_step']:.1f} | "
-                   f"{r['pass_mib']:.1f} | {r['model_gb_per_s']:.1f} | {t if t else '–'} | {share} |")
-    return "\n".join(out)
-
-
 def equal_accuracy(r):
     """Bullet's cost over ours once its strain error matches ours (the peer
     shrinks Bullet's step until it does, or gives up)."""
@@ -107,8 +85,6 @@ def main():
         sys.exit("usage: step-table.py RESULTS.json")
     rows = load(sys.argv[1])
     print(step_table(rows))
-    print()
-    print(bandwidth_table(rows))
     print()
     print(peer_table(rows))
 
