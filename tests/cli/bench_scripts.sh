@@ -1,0 +1,80 @@
+#!/usr/bin/env bash
+# make bench's scripts on fake benchmark programs: scripts/bench.sh runs every
+# build/bench_* (the equilibrium and rates programs with --full, so the 1M
+# figures come from the same run), writes bench/results/<machine>.json and
+# the README's generated tables; scripts/bench-table.py reads issue 10's
+# targets off the run's own lines (the 1M equilibrium figure from the
+# process's first solve, not the warm one) and each lattice step's share of
+# the triad on as many threads. A failing program fails the run and leaves
+# no results file and no scratch file behind.
+. "$(dirname "$0")/lib/common.sh" "$@"
+SRC=${SPN_SOURCE_DIR:?SPN_SOURCE_DIR must name the source tree}
+machine=$(hostname -s 2>/dev/null || echo machine)
+
+# A project folder with the scripts, a README with the markers and a build
+# folder of fake programs (each prints JSON lines, as the real ones do).
+project() {
+    rm -rf "$T/p" && mkdir -p "$T/p/scripts" "$T/p/b"
+    cp "$SRC/scripts/bench.sh" "$SRC/scripts/bench-table.py" "$T/p/scripts/"
+    printf 'intro\n<!-- bench-table:begin -->\nold\n<!-- bench-table:end -->\nafter\n' >"$T/p/README.md"
+    cat >"$T/p/b/bench_bandwidth" <<'EOF'
+#!/bin/sh
+echo '{"bench":"bandwidth","kernel":"triad","threads":1,"gb_per_s":20.0}'
+echo '{"bench":"bandwidth","kernel":"triad","threads":2,"gb_per_s":40.0}'
+EOF
+    cat >"$T/p/b/bench_equilibrium" <<'EOF'
+#!/bin/sh
+echo "$*" >"$(dirname "$0")/equilibrium.args"
+echo '{"bench":"equilibrium","scene":"orb-1M","precond":"multigrid","threads":2,"tolerance":1e-06,"seconds":6.0,"cold":true}'
+echo '{"bench":"equilibrium","scene":"orb-1M","precond":"multigrid","threads":2,"tolerance":1e-06,"seconds":4.0,"cold":false}'
+EOF
+    cat >"$T/p/b/bench_mg_rates" <<'EOF'
+#!/bin/sh
+echo "$*" >"$(dirname "$0")/rates.args"
+EOF
+    cat >"$T/p/b/bench_step" <<'EOF'
+#!/bin/sh
+echo '{"bench":"step","integrator":"symplectic","particles":5001,"threads":1,"path":"lattice","precision":"float64","ns_per_spring_step":1.0,"model_bytes_per_spring_step":80.0,"model_gb_per_s":10.0,"pass_mib":0.8}'
+echo '{"bench":"step","integrator":"symplectic","particles":1000001,"threads":2,"path":"lattice","precision":"float64","ns_per_spring_step":4.0,"model_bytes_per_spring_step":20.0,"model_gb_per_s":10.0,"pass_mib":150.0}'
+EOF
+    chmod +x "$T/p/b/"bench_*
+}
+
+project
+(cd "$T/p" && scripts/bench.sh b >"$T/out" 2>"$T/err") || fail "bench.sh exited $?: $(cat "$T/err")"
+res="$T/p/bench/results/$machine.json"
+[ -f "$res" ] || fail "no results file $res"
+[ "$(cat "$T/p/b/equilibrium.args")" = "--full" ] || fail "bench_equilibrium not run with --full"
+[ "$(cat "$T/p/b/rates.args")" = "--full" ] || fail "bench_mg_rates not run with --full"
+[ "$(grep -c '"bench"' "$res")" -eq 6 ] || fail "results should hold the six lines: $(cat "$res")"
+head -1 "$res" | grep -q '"machine"' || fail "results should start with the machine"
+ls -a "$T/p/bench/results" | grep -q '^\.tmp' && fail "scratch file left behind"
+python3 - "$T/p/README.md" <<'PY' || fail "README tables: $(cat "$T/p/README.md")"
+import re, sys
+doc = open(sys.argv[1]).read()
+assert doc.startswith("intro\n") and doc.endswith("after\n") and "old" not in doc.splitlines()
+def row(prefix):
+    rows = [l for l in doc.splitlines() if l.startswith("| " + prefix)]
+    assert len(rows) == 1, (prefix, rows)
+    return [c.strip() for c in rows[0].strip("|").split("|")]
+r = row("explicit (symplectic) step, 5k")
+assert r[1] == "≤ 1.2" and r[2] == "1" and r[4] == "yes", r
+r = row("explicit step, 1M")
+assert r[2] == "4" and r[4] == "no", r
+r = row("static equilibrium, 1M")   # the cold solve, the warm one beside it
+assert r[2] == "6" and r[4] == "no" and "4" in r[3], r
+shares = [l for l in doc.splitlines() if l.startswith("| symplectic |") and l.endswith("% |")]
+assert len(shares) == 2, shares
+assert shares[0].split("|")[-2].strip() == "50%", shares   # 10 of 20 GB/s on one thread
+assert shares[1].split("|")[-2].strip() == "25%", shares   # 10 of 40 on two
+PY
+
+# A program that fails: the run fails, the last results and the README stay.
+project
+mkdir -p "$T/p/bench/results" && echo keep >"$T/p/bench/results/$machine.json"
+printf '#!/bin/sh\necho "{\\"bench\\":\\"x\\"}"\nexit 3\n' >"$T/p/b/bench_zz_broken" && chmod +x "$T/p/b/bench_zz_broken"
+(cd "$T/p" && scripts/bench.sh b >"$T/out" 2>"$T/err") && fail "a failing benchmark should fail the run"
+[ "$(cat "$T/p/bench/results/$machine.json")" = keep ] || fail "the last results were replaced"
+grep -q '^old$' "$T/p/README.md" || fail "the README was rewritten after a failed run"
+ls -a "$T/p/bench/results" | grep -q '^\.tmp' && fail "scratch file left behind after a failure"
+exit 0
