@@ -3,16 +3,45 @@
  * doubles (256 MiB each) are far larger than any cache; bytes counted as
  * STREAM does (copy: 16 B per element, triad: 24 B; write-allocate traffic
  * not counted). Best of several repetitions, for 1 thread and for all.
- * One JSON line per figure. */
+ * One JSON line per figure; first the sizes of the caches a pass may stay in
+ * (Linux: the L2 of one core and the last level, as sysfs gives them; what a
+ * figure measures depends on whether its pass fits). */
 #include "common/bench_common.h"
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #ifdef _OPENMP
 #include <omp.h>
 #endif
 
 #define N (32u << 20)
+
+/* KiB of cpu0's unified cache of `level` (sysfs), or 0 when unknown. */
+static long cache_kib(int level)
+{
+    for (int i = 0; i < 8; i++) {
+        char path[96], type[32] = "";
+        long lv = 0, kib = 0;
+        snprintf(path, sizeof path, "/sys/devices/system/cpu/cpu0/cache/index%d/level", i);
+        FILE *f = fopen(path, "r");
+        if (!f) break;
+        int ok = fscanf(f, "%ld", &lv) == 1;
+        fclose(f);
+        snprintf(path, sizeof path, "/sys/devices/system/cpu/cpu0/cache/index%d/type", i);
+        if (ok && lv == level && (f = fopen(path, "r"))) {
+            ok = fscanf(f, "%31s", type) == 1;
+            fclose(f);
+            snprintf(path, sizeof path, "/sys/devices/system/cpu/cpu0/cache/index%d/size", i);
+            if (ok && strcmp(type, "Unified") == 0 && (f = fopen(path, "r"))) {
+                ok = fscanf(f, "%ldK", &kib) == 1;
+                fclose(f);
+                return ok ? kib : 0;
+            }
+        }
+    }
+    return 0;
+}
 #define REPEAT 6
 
 static double best_of(int kernel, int threads, double *a, const double *b, const double *c)
@@ -49,6 +78,7 @@ int main(int argc, char **argv)
     /* first touch in parallel, so pages land where the threads run */
 #pragma omp parallel for schedule(static) num_threads(max_threads)
     for (uint32_t i = 0; i < N; i++) a[i] = 0, b[i] = 1, c[i] = 2;
+    printf("{\"bench\":\"caches\",\"l2_kib_per_core\":%ld,\"l3_kib\":%ld}\n", cache_kib(2), cache_kib(3));
     const char *names[2] = {"copy", "triad"};
     const double bytes[2] = {16.0 * N, 24.0 * N};
     int counts[2] = {1, max_threads};

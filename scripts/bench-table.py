@@ -104,22 +104,36 @@ def bandwidth_table(rows):
     """Each lattice step's unavoidable traffic (bench_step's model: a pass
     reads the state, masses and spring slots once and writes the state once)
     per second of wall time, against bench_bandwidth's triad on as many
-    threads in the same run."""
+    threads in the same run, and where one pass fits (bench_bandwidth's
+    cache sizes: a thread's share of the pass in its core's L2, the pass in
+    the L3, or neither): a pass that fits in a cache streams from it, and its
+    share of the memory's triad only says how little memory it needs."""
     triad = {r["threads"]: r["gb_per_s"] for r in rows
              if r.get("bench") == "bandwidth" and r.get("kernel") == "triad"}
+    caches = next((r for r in rows if r.get("bench") == "caches"), {})
     steps = [r for r in rows if r.get("bench") == "step" and "model_gb_per_s" in r]
     if not steps or not triad:
         return ""
-    out = ["| integrator | particles | threads | bytes per spring-step | one pass, MiB | GB/s | triad GB/s | share |",
-           "|---|---:|---:|---:|---:|---:|---:|---:|"]
+
+    def fits(r):
+        kib = r["pass_mib"] * 1024
+        if caches.get("l2_kib_per_core") and kib / r["threads"] <= caches["l2_kib_per_core"]:
+            return "L2"
+        if caches.get("l3_kib") and kib <= caches["l3_kib"]:
+            return "L3"
+        return "memory" if caches else "?"
+    out = ["**The share of the machine's memory bandwidth the lattice steps reach (bench/bench_step.c; "
+           "the traffic a model, docs/physics-lattice.md)**", "",
+           "| integrator | particles | threads | bytes per spring-step | one pass, MiB | pass fits in | GB/s "
+           "| triad GB/s | share of the triad |",
+           "|---|---:|---:|---:|---:|---|---:|---:|---:|"]
     for r in steps:
         t = triad.get(r["threads"])
         name = r["integrator"] + (" float32" if r.get("precision") == "float32" else "")
         share = f"{r['model_gb_per_s'] / t:.0%}" if t else "–"
         out.append(f"| {name} | {r['particles']:,} | {r['threads']} | {r['model_bytes_per_spring_step']:.1f} | "
-                   f"{r['pass_mib']:.1f} | {r['model_gb_per_s']:.1f} | {t if t else '–'} | {share} |")
-    return "**The share of the machine's bandwidth the lattice steps reach (bench/bench_step.c)**\n\n" + \
-        "\n".join(out) + "\n"
+                   f"{r['pass_mib']:.1f} | {fits(r)} | {r['model_gb_per_s']:.1f} | {t if t else '–'} | {share} |")
+    return "\n".join(out) + "\n"
 
 
 def cell(v):

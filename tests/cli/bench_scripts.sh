@@ -5,7 +5,7 @@
 # the README's generated tables; scripts/bench-table.py reads issue 10's
 # targets off the run's own lines (the 1M equilibrium figure from the
 # process's first solve, not the warm one) and each lattice step's share of
-# the triad on as many threads. A failing program fails the run and leaves
+# the triad on as many threads, with the cache a pass fits in. A failing program fails the run and leaves
 # no results file and no scratch file behind.
 . "$(dirname "$0")/lib/common.sh" "$@"
 SRC=${SPN_SOURCE_DIR:?SPN_SOURCE_DIR must name the source tree}
@@ -19,6 +19,7 @@ project() {
     printf 'intro\n<!-- bench-table:begin -->\nold\n<!-- bench-table:end -->\nafter\n' >"$T/p/README.md"
     cat >"$T/p/b/bench_bandwidth" <<'EOF'
 #!/bin/sh
+echo '{"bench":"caches","l2_kib_per_core":1024,"l3_kib":32768}'
 echo '{"bench":"bandwidth","kernel":"triad","threads":1,"gb_per_s":20.0}'
 echo '{"bench":"bandwidth","kernel":"triad","threads":2,"gb_per_s":40.0}'
 EOF
@@ -46,7 +47,7 @@ res="$T/p/bench/results/$machine.json"
 [ -f "$res" ] || fail "no results file $res"
 [ "$(cat "$T/p/b/equilibrium.args")" = "--full" ] || fail "bench_equilibrium not run with --full"
 [ "$(cat "$T/p/b/rates.args")" = "--full" ] || fail "bench_mg_rates not run with --full"
-[ "$(grep -c '"bench"' "$res")" -eq 6 ] || fail "results should hold the six lines: $(cat "$res")"
+[ "$(grep -c '"bench"' "$res")" -eq 7 ] || fail "results should hold the seven lines: $(cat "$res")"
 head -1 "$res" | grep -q '"machine"' || fail "results should start with the machine"
 ls -a "$T/p/bench/results" | grep -q '^\.tmp' && fail "scratch file left behind"
 python3 - "$T/p/README.md" <<'PY' || fail "README tables: $(cat "$T/p/README.md")"
@@ -65,8 +66,9 @@ r = row("static equilibrium, 1M")   # the cold solve, the warm one beside it
 assert r[2] == "6" and r[4] == "no" and "4" in r[3], r
 shares = [l for l in doc.splitlines() if l.startswith("| symplectic |") and l.endswith("% |")]
 assert len(shares) == 2, shares
-assert shares[0].split("|")[-2].strip() == "50%", shares   # 10 of 20 GB/s on one thread
-assert shares[1].split("|")[-2].strip() == "25%", shares   # 10 of 40 on two
+cells = [[c.strip() for c in l.strip("|").split("|")] for l in shares]
+assert cells[0][5] == "L2" and cells[0][-1] == "50%", cells       # 0.8 MiB; 10 of 20 GB/s on one thread
+assert cells[1][5] == "memory" and cells[1][-1] == "25%", cells   # 150 MiB; 10 of 40 on two
 PY
 
 # A program that fails: the run fails, the last results and the README stay.
