@@ -8,6 +8,7 @@
  * figure measures depends on whether its pass fits). */
 #include "common/bench_common.h"
 
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,33 +17,29 @@
 #endif
 
 #define N (32u << 20)
+#define REPEAT 6
 
-/* KiB of cpu0's unified cache of `level` (sysfs), or 0 when unknown. */
+/* cpu0's cache `index`'s sysfs `field` (its first line) into buf; false when absent. */
+static bool cache_field(int index, const char *field, char *buf, int size)
+{
+    char path[96];
+    snprintf(path, sizeof path, "/sys/devices/system/cpu/cpu0/cache/index%d/%s", index, field);
+    FILE *f = fopen(path, "r");
+    bool ok = f && fgets(buf, size, f) != NULL;
+    if (f) fclose(f);
+    return ok;
+}
+
+/* KiB of cpu0's unified cache of `level` ("1024K" in sysfs), or 0 when unknown. */
 static long cache_kib(int level)
 {
-    for (int i = 0; i < 8; i++) {
-        char path[96], type[32] = "";
-        long lv = 0, kib = 0;
-        snprintf(path, sizeof path, "/sys/devices/system/cpu/cpu0/cache/index%d/level", i);
-        FILE *f = fopen(path, "r");
-        if (!f) break;
-        int ok = fscanf(f, "%ld", &lv) == 1;
-        fclose(f);
-        snprintf(path, sizeof path, "/sys/devices/system/cpu/cpu0/cache/index%d/type", i);
-        if (ok && lv == level && (f = fopen(path, "r"))) {
-            ok = fscanf(f, "%31s", type) == 1;
-            fclose(f);
-            snprintf(path, sizeof path, "/sys/devices/system/cpu/cpu0/cache/index%d/size", i);
-            if (ok && strcmp(type, "Unified") == 0 && (f = fopen(path, "r"))) {
-                ok = fscanf(f, "%ldK", &kib) == 1;
-                fclose(f);
-                return ok ? kib : 0;
-            }
-        }
-    }
+    char lv[16], type[32], size[32];
+    for (int i = 0; cache_field(i, "level", lv, sizeof lv); i++)
+        if (atoi(lv) == level && cache_field(i, "type", type, sizeof type) && strncmp(type, "Unified", 7) == 0 &&
+            cache_field(i, "size", size, sizeof size))
+            return atol(size);
     return 0;
 }
-#define REPEAT 6
 
 static double best_of(int kernel, int threads, double *a, const double *b, const double *c)
 {

@@ -41,7 +41,7 @@
  * time: scripts/bench-table.py sets it against bench_bandwidth's triad on as
  * many threads, the share of the machine's bandwidth the step reaches
  * (issue 10). "pass_mib" is what one pass streams: a web whose pass fits in
- * the caches (the 5k web's 0.6 MB) runs from them, and its share of the
+ * the caches (the 5k web's 0.8 MiB) runs from them, and its share of the
  * memory's bandwidth says only how little it asks of it. */
 #include "common/bench_common.h"
 

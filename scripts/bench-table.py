@@ -46,9 +46,9 @@ KNOWN = {
 }
 
 
-# Issue 10's targets: (figure, target, limit, unit, how to pick the figure's
-# line and its value, the lines shown beside it). Each target is read off
-# this run's lines, never typed in.
+# Issue 10's targets: (the figure, its limit, the rule that picks its line,
+# the key of its value, and (label, rule, key) of the values shown beside
+# it). Each is read off the run's own lines, never typed in.
 def _step(integ, particles, threads, precision="float64"):
     return lambda r: (r.get("bench") == "step" and r.get("integrator") == integ and r.get("particles") == particles
                       and r.get("threads") == threads and r.get("path") == "lattice"

@@ -5,8 +5,9 @@
 # the README's generated tables; scripts/bench-table.py reads issue 10's
 # targets off the run's own lines (the 1M equilibrium figure from the
 # process's first solve, not the warm one) and each lattice step's share of
-# the triad on as many threads, with the cache a pass fits in. A failing program fails the run and leaves
-# no results file and no scratch file behind.
+# the triad on as many threads, with the cache a pass fits in. A failing
+# program fails the run and leaves no results file and no scratch file
+# behind.
 . "$(dirname "$0")/lib/common.sh" "$@"
 SRC=${SPN_SOURCE_DIR:?SPN_SOURCE_DIR must name the source tree}
 machine=$(hostname -s 2>/dev/null || echo machine)
