@@ -28,7 +28,7 @@ static void usage(FILE *out)
             "  --frames DIR                    write PNG frames of the construction into DIR\n"
             "  --frame-count N                 frames of the construction (default 60)\n"
             "  --png FILE                      also render the finished web (PNG, SVG or PDF)\n"
-            "  -o, --output FILE               the web file to write\n\n"
+            "  -o, --output FILE               the web file to write (.spnw: binary, else JSON)\n\n"
             "physical (thesis values; 1 thesis unit = 1 mm):\n"
             "  --move-outer M (0.06)  --outer-placement M (0.005)  --outer-rest M (0.002)\n"
             "  --frame-placement M (0.020)  --frame-rest M (0.015)  --spoke-placement M (0.007)\n"

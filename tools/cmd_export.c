@@ -1,5 +1,5 @@
 /* spinneret export FILE... -o OUT | --frames DIR: write a web as OBJ, PLY,
- * a POV-Ray scene or a web file (.json), or one POV scene per input file
+ * a POV-Ray scene or a web file (.json or binary .spnw), or one POV scene per input file
  * (DIR/frame_%05d.pov, all framed alike: the film maker's output form). */
 #include "render_options.h"
 
@@ -20,6 +20,7 @@ static void usage(FILE *out)
             "  .ply  ASCII PLY: threads as edges with a 'kind' property (the thread tag)\n"
             "  .pov  a complete POV-Ray 3.7 scene: povray +W800 +H800 OUT.pov renders it\n"
             "  .json a web file\n"
+            "  .spnw a binary web file (the same content; fast for big webs)\n"
             "With --frames DIR, each FILE becomes DIR/frame_%%05d.pov, all framed by the\n"
             "bounding box of every FILE, ready to render into a film.\n\n"
             "  -o, --output OUT           the exported file\n"
@@ -73,8 +74,8 @@ static int check_output(const export_options *o)
     if (o->frames) return *o->frames ? -1 : cli_usage(CMD, "--frames: the folder is empty");
     if (!o->out || !*o->out) return cli_usage(CMD, "-o/--output (or --frames DIR) is required");
     const char *ext = cli_extension(o->out);
-    if (strcmp(ext, "obj") && strcmp(ext, "ply") && strcmp(ext, "pov") && strcmp(ext, "json"))
-        return cli_usage(CMD, "%s: unknown export type '.%s' (use .obj, .ply, .pov or .json)", o->out, ext);
+    if (strcmp(ext, "obj") && strcmp(ext, "ply") && strcmp(ext, "pov") && strcmp(ext, "json") && strcmp(ext, "spnw"))
+        return cli_usage(CMD, "%s: unknown export type '.%s' (use .obj, .ply, .pov, .json or .spnw)", o->out, ext);
     return -1;
 }
 
@@ -107,8 +108,9 @@ static int export_one(export_options *o, const char *in)
         return code;
     }
     o->def.render = o->ro.def;
-    spn_status st = strcmp(cli_extension(o->out), "json") == 0 ? spn_web_save(w, o->out)
-                                                               : spn_export_file(w, &o->def, o->out);
+    const char *ext = cli_extension(o->out);
+    spn_status st = strcmp(ext, "json") == 0 || strcmp(ext, "spnw") == 0 ? spn_web_save(w, o->out)
+                                                                         : spn_export_file(w, &o->def, o->out);
     spn_world_destroy(w);
     return st == SPN_OK ? 0 : cli_fail_status(CMD, st);
 }

@@ -39,7 +39,7 @@ static void usage(FILE *out)
             "      --max-time S       simulated time allowed per settle [s]; default 60\n"
             "      --no-settle        edit the web as it is, without settling\n"
             "output\n"
-            "  -o, --output OUT       the inscribed web file (required)\n"
+            "  -o, --output OUT       the inscribed web file (required; .spnw: binary, else JSON)\n"
             "      --render PNG       also render the result (default render settings)\n"
             "      --overlay PNG      the dilated target over the web before inscription (figs. 6.3, 6.10)\n"
             "  -h, --help             this text\n");

@@ -5,6 +5,9 @@
 
 #include "spinneret/io.h"
 
+#include <stdint.h>
+#include <string.h>
+
 #define SPN__WEB_FORMAT_NAME "spinneret-web"
 /* Integers up to 2^53 survive a JSON number (a double) exactly. */
 #define SPN__MAX_EXACT_INT 9007199254740992ull
@@ -15,6 +18,36 @@
 
 /* `v` with the fewest digits (15, 16 or 17) that read back to the same bits. */
 void spn__format_double(char out[40], double v);
+/* The web document without its columns: the binary file's header. */
+spn_status spn__web_write_header(const spn_world *w, spn_sink *sink);
+/* The binary file (web_binary.c): `data` starts with its magic. */
+spn_status spn__web_parse_binary(const unsigned char *data, size_t size, const char *name, spn_world **out);
+/* Does data[0..size) start with the binary file's magic? */
+bool spn__web_is_binary(const void *data, size_t size);
+/* Bytes of a binary file's columns for np particles and ns springs, and
+ * where the column named `path` ("particles.mass") starts in them. */
+uint64_t spn__web_binary_size(size_t np, size_t ns);
+size_t spn__web_binary_offset(const char *path, size_t np, size_t ns);
+/* Little-endian numbers, whatever the host's byte order. */
+static inline double spn__get_f64(const unsigned char *p)
+{
+    uint64_t u = 0;
+    for (int i = 7; i >= 0; i--) u = u << 8 | p[i];
+    double v;
+    memcpy(&v, &u, sizeof v);
+    return v;
+}
+static inline uint32_t spn__get_u32(const unsigned char *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+/* A parsed document (web_read.c): its header checked, then read into a world;
+ * `payload` NULL for a JSON file, or the binary file's columns. */
+struct cJSON;
+spn_status spn__web_read_root(const char *name, const struct cJSON *root, const unsigned char *payload,
+                              size_t payload_size, spn_world **out);
+
 /* Put "prefix: " before the last error message; returns `status`. */
 spn_status spn__error_prefix(spn_status status, const char *prefix);
 

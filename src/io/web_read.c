@@ -1,6 +1,8 @@
 /* Reading the web file (docs/web-format.md). The text is parsed by cJSON, then
  * every field is checked before it reaches the world, and the first bad value
- * is reported as "FILE: FIELD[INDEX]: what is wrong".
+ * is reported as "FILE: FIELD[INDEX]: what is wrong". A binary file
+ * (web_binary.c) has the same document as its header and its columns as raw
+ * numbers; they pass the same checks here, read by the same column calls.
  *
  * Invariants: on any failure *out is NULL and everything built is freed (never
  * a half-built world). Array lengths are checked against the declared counts
@@ -20,7 +22,9 @@
 #include <string.h>
 
 typedef struct reader {
-    const char *name; /* the file, for messages */
+    const char *name;              /* the file, for messages */
+    const unsigned char *payload;  /* a binary file's columns (web_binary.c); NULL for JSON */
+    size_t particles, springs;     /* the counts, for the columns' offsets in the payload */
 } reader;
 
 static spn_status bad(const reader *r, const char *fmt, ...) SPN_PRINTF(2, 3);
@@ -95,10 +99,11 @@ static spn_status whole_number(const reader *r, const cJSON *j, const char *fiel
  * entry; `width` entries per item (3 for vectors). */
 
 typedef struct column {
-    const cJSON *next; /* entry to read next; NULL for a missing optional column */
-    char path[64];     /* "particles.mass" */
-    uint32_t index;    /* entry index of `next` */
-    int width;         /* entries per item: 3 for vectors */
+    const cJSON *next;        /* entry to read next; NULL for a missing optional column */
+    const unsigned char *bin; /* a binary file's column, its first entry; NULL for JSON */
+    char path[64];            /* "particles.mass" */
+    uint32_t index;           /* entry index of `next` */
+    int width;                /* entries per item: 3 for vectors */
 } column;
 
 static spn_status column_open(const reader *r, const cJSON *section, const char *sect, const char *key,
@@ -106,8 +111,13 @@ static spn_status column_open(const reader *r, const cJSON *section, const char 
 {
     snprintf(col->path, sizeof col->path, "%s.%s", sect, key);
     col->next = NULL;
+    col->bin = NULL;
     col->index = 0;
     col->width = width;
+    if (r->payload) { /* every column is there, its length checked with the file's */
+        col->bin = r->payload + spn__web_binary_offset(col->path, r->particles, r->springs);
+        return SPN_OK;
+    }
     const cJSON *arr = cJSON_GetObjectItemCaseSensitive(section, key);
     if (!arr) return required ? bad(r, "missing field '%s'", col->path) : SPN_OK;
     if (!cJSON_IsArray(arr)) return bad(r, "%s: expected an array, got %s", col->path, type_name(arr));
@@ -123,19 +133,25 @@ static spn_status column_open(const reader *r, const cJSON *section, const char 
 /* The next entry as a finite number, or `dflt` for a missing column. */
 static spn_status col_number(const reader *r, column *col, double dflt, double *out)
 {
-    if (!col->next) {
+    if (!col->next && !col->bin) {
         *out = dflt;
         return SPN_OK;
     }
+    const cJSON *j = col->next;
+    const double v = j ? j->valuedouble : spn__get_f64(col->bin + 8 * (size_t)col->index);
+    if (j) col->next = j->next;
+    col->index++;
+    if ((!j || cJSON_IsNumber(j)) && isfinite(v)) { /* the field's name is only made for a message */
+        *out = v;
+        return SPN_OK;
+    }
+    const uint32_t i = col->index - 1;
     char field[96];
     if (col->width == 3)
-        snprintf(field, sizeof field, "%s[%u] (particle %u, %c)", col->path, col->index, col->index / 3,
-                 "xyz"[col->index % 3]);
-    else snprintf(field, sizeof field, "%s[%u]", col->path, col->index);
-    spn_status st = finite_number(r, col->next, field, out);
-    col->next = col->next->next;
-    col->index++;
-    return st;
+        snprintf(field, sizeof field, "%s[%u] (particle %u, %c)", col->path, i, i / 3, "xyz"[i % 3]);
+    else snprintf(field, sizeof field, "%s[%u]", col->path, i);
+    if (!j) return bad(r, "%s: %s is not allowed", field, isnan(v) ? "NaN" : "an infinity");
+    return finite_number(r, j, field, out);
 }
 
 /* The next entry as a number that is finite and not negative. */
@@ -149,16 +165,26 @@ static spn_status col_nonneg(const reader *r, column *col, double dflt, const ch
 
 static spn_status col_uint32(const reader *r, column *col, uint32_t *out)
 {
+    if (col->bin) {
+        *out = spn__get_u32(col->bin + 4 * (size_t)col->index++);
+        return SPN_OK;
+    }
     if (!col->next) {
         *out = 0;
         return SPN_OK;
     }
-    char field[96];
-    snprintf(field, sizeof field, "%s[%u]", col->path, col->index);
-    double v = 0;
-    spn_status st = whole_number(r, col->next, field, 4294967295.0, &v);
-    col->next = col->next->next;
+    const cJSON *j = col->next;
+    col->next = j->next;
     col->index++;
+    const double u = j->valuedouble;
+    if (cJSON_IsNumber(j) && u >= 0 && u <= 4294967295.0 && floor(u) == u) {
+        *out = (uint32_t)u;
+        return SPN_OK;
+    }
+    char field[96];
+    snprintf(field, sizeof field, "%s[%u]", col->path, col->index - 1);
+    double v = 0;
+    spn_status st = whole_number(r, j, field, 4294967295.0, &v);
     *out = (uint32_t)v;
     return st;
 }
@@ -167,6 +193,13 @@ static spn_status col_uint32(const reader *r, column *col, uint32_t *out)
 static spn_status col_flag(const reader *r, column *col, bool *out)
 {
     *out = false;
+    if (col->bin) {
+        const uint32_t i = col->index++;
+        const unsigned v = col->bin[i];
+        if (v > 1) return bad(r, "%s[%u]: expected 0 or 1, got %u", col->path, i, v);
+        *out = v == 1;
+        return SPN_OK;
+    }
     if (!col->next) return SPN_OK;
     const cJSON *j = col->next;
     uint32_t i = col->index;
@@ -182,6 +215,11 @@ static spn_status col_flag(const reader *r, column *col, bool *out)
 /* break_max: a length, or null for "never". */
 static spn_status col_break_max(const reader *r, column *col, double *out)
 {
+    if (col->bin && spn__get_f64(col->bin + 8 * (size_t)col->index) == INFINITY) { /* "never", as null in JSON */
+        col->index++;
+        *out = INFINITY;
+        return SPN_OK;
+    }
     if (col->next && cJSON_IsNull(col->next)) {
         col->next = col->next->next;
         col->index++;
@@ -223,7 +261,8 @@ typedef struct particle_columns {
 static spn_status open_particles(const reader *r, const cJSON *sec, size_t n, particle_columns *pc)
 {
     static const char *const keys[] = {"count", "position", "velocity", "mass", "fixed", "tag", NULL};
-    spn_status st = check_keys(r, sec, "particles", keys);
+    static const char *const binary_keys[] = {"count", NULL};
+    spn_status st = check_keys(r, sec, "particles", r->payload ? binary_keys : keys);
     if (st == SPN_OK) st = column_open(r, sec, "particles", "position", true, n, 3, &pc->position);
     if (st == SPN_OK) st = column_open(r, sec, "particles", "velocity", false, n, 3, &pc->velocity);
     if (st == SPN_OK) st = column_open(r, sec, "particles", "mass", true, n, 1, &pc->mass);
@@ -271,7 +310,8 @@ static spn_status open_springs(const reader *r, const cJSON *sec, size_t n, spri
                 {"tag", false, &sc->tag},
                 {"stage", false, &sc->stage},
                 {"order", false, &sc->order}};
-    spn_status st = check_keys(r, sec, "springs", keys);
+    static const char *const binary_keys[] = {"count", NULL};
+    spn_status st = check_keys(r, sec, "springs", r->payload ? binary_keys : keys);
     for (size_t i = 0; i < sizeof cols / sizeof cols[0] && st == SPN_OK; i++)
         st = column_open(r, sec, "springs", cols[i].key, cols[i].required, n, 1, cols[i].col);
     return st;
@@ -423,8 +463,10 @@ static spn_status read_settings(const reader *r, const cJSON *sec, spn_world_def
 }
 
 /* The whole document, once parsed: header, settings, then the two sections,
- * all columns opened (lengths checked) before the world is created. */
-static spn_status read_document(const reader *r, const cJSON *root, spn_world **out)
+ * all columns opened (lengths checked) before the world is created. A binary
+ * file's payload (r->payload, `payload_size` bytes) must hold exactly the
+ * columns its counts call for. */
+static spn_status read_document(reader *r, const cJSON *root, size_t payload_size, spn_world **out)
 {
     static const char *const keys[] = {"format", "version", "units", "metadata", "world",
                                        "thread_kinds", "particles", "springs", NULL};
@@ -443,8 +485,13 @@ static spn_status read_document(const reader *r, const cJSON *root, spn_world **
     if (st == SPN_OK) st = read_settings(r, settings, &def, &time);
     if (st == SPN_OK) st = read_count(r, ps, "particles", &np);
     if (st == SPN_OK) st = read_count(r, ss, "springs", &ns);
+    r->particles = np, r->springs = ns; /* a binary file's columns' offsets */
     if (st == SPN_OK) st = open_particles(r, ps, np, &pc);
     if (st == SPN_OK) st = open_springs(r, ss, ns, &sc);
+    const uint64_t want = r->payload ? spn__web_binary_size(np, ns) : 0;
+    if (st == SPN_OK && r->payload && (uint64_t)payload_size != want) /* before any column is read */
+        st = bad(r, "the columns take %zu bytes, expected %llu for %zu particles and %zu springs%s", payload_size,
+                 (unsigned long long)want, np, ns, payload_size < want ? " (a truncated file?)" : "");
     if (st == SPN_OK) st = spn_check_counts(r->name, np, ns); /* before the world grows */
     if (st != SPN_OK) return st;
 
@@ -523,9 +570,11 @@ static bool non_number(const char *p, size_t n)
 
 spn_status spn_web_parse(const char *text, size_t size, const char *name, spn_world **out)
 {
-    reader r = {name ? name : "web file"};
+    reader r = {name ? name : "web file", NULL, 0, 0};
     if (!out) return spn_error(SPN_ERR_INVALID, "spn_web_parse: out is NULL");
     *out = NULL;
+    if (text && spn__web_is_binary(text, size))
+        return spn__web_parse_binary((const unsigned char *)text, size, r.name, out);
     if (!text || blank(text, size)) return bad(&r, "empty file");
     const char *nul = memchr(text, '\0', size);
     if (nul) return bad(&r, "not JSON: NUL byte at offset %zu", (size_t)(nul - text));
@@ -542,10 +591,17 @@ spn_status spn_web_parse(const char *text, size_t size, const char *name, spn_wo
         locate(text, offset, &line, &col);
         return bad(&r, "not JSON: text after the end of the document at line %zu, column %zu", line, col);
     }
-    spn_status st = check_header(&r, root);
-    if (st == SPN_OK) st = read_document(&r, root, out);
+    spn_status st = spn__web_read_root(r.name, root, NULL, 0, out);
     cJSON_Delete(root);
     return st;
+}
+
+spn_status spn__web_read_root(const char *name, const cJSON *root, const unsigned char *payload, size_t payload_size,
+                              spn_world **out)
+{
+    reader r = {name, payload, 0, 0};
+    spn_status st = check_header(&r, root);
+    return st == SPN_OK ? read_document(&r, root, payload_size, out) : st;
 }
 
 spn_status spn_web_load(const char *path, spn_world **out)
@@ -555,7 +611,14 @@ spn_status spn_web_load(const char *path, spn_world **out)
     if (!path || !*path) return spn_error(SPN_ERR_INVALID, "web file: the path is empty");
     FILE *fp = fopen(path, "rb");
     if (!fp) return spn_error(SPN_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    /* A regular file is read into one buffer of its size (no copies as it
+     * grows: a million-particle web is hundreds of MB); a pipe grows one. */
     size_t cap = 1 << 16, size = 0;
+    if (fseek(fp, 0, SEEK_END) == 0) {
+        const long end = ftell(fp);
+        if (end > 0) cap = (size_t)end < SPN__WEB_MAX_BYTES ? (size_t)end + 1 : SPN__WEB_MAX_BYTES;
+    }
+    rewind(fp);
     char *buf = malloc(cap);
     spn_status st = buf ? SPN_OK : spn_error(SPN_ERR_NOMEM, "%s: out of memory", path);
     while (st == SPN_OK) {
@@ -565,11 +628,12 @@ spn_status spn_web_load(const char *path, spn_world **out)
         else if (cap >= SPN__WEB_MAX_BYTES)
             st = spn_error(SPN_ERR_NOMEM, "%s: file larger than %zu bytes", path, SPN__WEB_MAX_BYTES);
         else {
-            char *bigger = realloc(buf, cap * 2);
+            const size_t next = cap < SPN__WEB_MAX_BYTES / 2 ? cap * 2 : SPN__WEB_MAX_BYTES;
+            char *bigger = realloc(buf, next);
             if (!bigger) st = spn_error(SPN_ERR_NOMEM, "%s: out of memory", path);
             else {
                 buf = bigger;
-                cap *= 2;
+                cap = next;
             }
         }
     }

@@ -1,6 +1,7 @@
 /* Writing the web file (docs/web-format.md): a JSON object streamed through a
  * sink, columnar arrays on one line each, no tree built in memory, so saving a
- * large web costs no more than the text itself.
+ * large web costs no more than the text itself. The binary file's header is
+ * the same document without its columns (web_binary.c writes the rest).
  *
  * Invariants: every float is written with the fewest digits (15, 16 or 17)
  * that strtod reads back to the same bits, so save -> load is exact, -0.0
@@ -205,11 +206,15 @@ static double p_mass(const spn_world *w, uint32_t i) { return spn_world_mass(w, 
 static unsigned long long p_fixed(const spn_world *w, uint32_t i) { return spn_world_is_fixed(w, i); }
 static unsigned long long p_tag(const spn_world *w, uint32_t i) { return spn_world_particle_tag(w, i); }
 
-static void put_particles(writer *wr, const spn_world *w)
+static void put_particles(writer *wr, const spn_world *w, bool columns)
 {
     uint32_t n = spn_world_particle_count(w);
     put(wr, "  \"particles\": {\n    \"count\": ");
     put_u64(wr, n);
+    if (!columns) {
+        put(wr, "\n  },\n");
+        return;
+    }
     put_vec3_column(wr, w, "position", spn_world_positions(w));
     put_vec3_column(wr, w, "velocity", spn_world_velocities(w));
     put_double_column(wr, w, "mass", n, p_mass, false, "particle");
@@ -231,11 +236,15 @@ static unsigned long long s_tag(const spn_world *w, uint32_t s) { return spn_wor
 static unsigned long long s_stage(const spn_world *w, uint32_t s) { return spn_world_spring(w, s).stage; }
 static unsigned long long s_order(const spn_world *w, uint32_t s) { return spn_world_spring(w, s).order; }
 
-static void put_springs(writer *wr, const spn_world *w)
+static void put_springs(writer *wr, const spn_world *w, bool columns)
 {
     uint32_t n = spn_world_spring_count(w);
     put(wr, "  \"springs\": {\n    \"count\": ");
     put_u64(wr, n);
+    if (!columns) {
+        put(wr, "\n  }\n");
+        return;
+    }
     put_int_column(wr, w, "a", n, s_a);
     put_int_column(wr, w, "b", n, s_b);
     put_double_column(wr, w, "k", n, s_k, false, "spring");
@@ -251,9 +260,9 @@ static void put_springs(writer *wr, const spn_world *w)
     put(wr, "\n  }\n");
 }
 
-spn_status spn_web_write(const spn_world *w, spn_sink *sink)
+/* The document; without its columns it is the binary file's header. */
+static spn_status write_document(const spn_world *w, spn_sink *sink, bool columns)
 {
-    if (!w || !sink) return spn_error(SPN_ERR_INVALID, "spn_web_write: world and sink are required");
     writer wr = {sink, SPN_OK};
     put(&wr, "{\n  \"format\": \"" SPN__WEB_FORMAT_NAME "\",\n  \"version\": ");
     put_u64(&wr, SPN_WEB_FORMAT_VERSION);
@@ -261,10 +270,24 @@ spn_status spn_web_write(const spn_world *w, spn_sink *sink)
     put_metadata(&wr, w);
     put_settings(&wr, w);
     put_thread_kinds(&wr);
-    put_particles(&wr, w);
-    put_springs(&wr, w);
+    put_particles(&wr, w, columns);
+    put_springs(&wr, w, columns);
     put(&wr, "}\n");
     return wr.st;
+}
+
+spn_status spn_web_write(const spn_world *w, spn_sink *sink)
+{
+    if (!w || !sink) return spn_error(SPN_ERR_INVALID, "spn_web_write: world and sink are required");
+    return write_document(w, sink, true);
+}
+
+spn_status spn__web_write_header(const spn_world *w, spn_sink *sink) { return write_document(w, sink, false); }
+
+bool spn_web_path_is_binary(const char *path)
+{
+    size_t n = path ? strlen(path) : 0, e = strlen(SPN_WEB_BINARY_EXTENSION);
+    return n > e && strcmp(path + n - e, SPN_WEB_BINARY_EXTENSION) == 0;
 }
 
 spn_status spn_web_save(const spn_world *w, const char *path)
@@ -273,7 +296,7 @@ spn_status spn_web_save(const spn_world *w, const char *path)
     spn_status st = spn_atomic_open(&f, path, true);
     if (st != SPN_OK) return st;
     spn_sink sink = spn_sink_file(f.fp);
-    st = spn_web_write(w, &sink);
+    st = spn_web_path_is_binary(path) ? spn_web_write_binary(w, &sink) : spn_web_write(w, &sink);
     if (st != SPN_OK) {
         spn__error_prefix(st, path);
         spn_atomic_abort(&f);
