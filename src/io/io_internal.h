@@ -16,8 +16,11 @@
 #define SPN__WEB_MAX_COUNT 100000000u
 #define SPN__WEB_MAX_BYTES ((size_t)1 << 30)
 
-/* `v` with the fewest digits (15, 16 or 17) that read back to the same bits. */
+/* `v` with the fewest digits (15, 16 or 17) that read back to the same bits,
+ * as %.{15,16,17}g print it (shortest.c): by integer arithmetic where it
+ * can, else by spn__format_double_printf, which prints and reads back each. */
 void spn__format_double(char out[40], double v);
+void spn__format_double_printf(char out[40], double v);
 /* The web document without its columns: the binary file's header. */
 spn_status spn__web_write_header(const spn_world *w, spn_sink *sink);
 /* The binary file (web_binary.c): `data` starts with its magic. */
