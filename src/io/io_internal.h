@@ -21,6 +21,21 @@
  * can, else by spn__format_double_printf, which prints and reads back each. */
 void spn__format_double(char out[40], double v);
 void spn__format_double_printf(char out[40], double v);
+/* Output to a sink in pieces of up to 16 KiB (out.c). After a failed write,
+ * or once a writer sets `st` to an error, nothing more reaches the sink. */
+typedef struct spn__out {
+    spn_sink *sink;
+    spn_status st;
+    size_t used;
+    char buf[1 << 14];
+} spn__out;
+void spn__out_init(spn__out *o, spn_sink *sink);
+void spn__out_put(spn__out *o, const void *data, size_t n);
+/* n bytes (n <= 16 KiB) to fill in place, in order with the other output */
+unsigned char *spn__out_room(spn__out *o, size_t n);
+/* Everything written; the first error, if any. */
+spn_status spn__out_finish(spn__out *o);
+
 /* The web document without its columns: the binary file's header. */
 spn_status spn__web_write_header(const spn_world *w, spn_sink *sink);
 /* The binary file (web_binary.c): `data` starts with its magic. */

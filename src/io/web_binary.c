@@ -84,66 +84,43 @@ static void put_f64(unsigned char *p, double v)
     for (int i = 0; i < 8; i++) p[i] = (unsigned char)(u >> 8 * i);
 }
 
-/* Columns go out through a staging buffer; after a failure nothing more is
- * written. */
-typedef struct stage {
-    spn_sink *sink;
-    spn_status st;
-    size_t used;
-    unsigned char buf[1 << 16];
-} stage;
-
-static void flush(stage *s)
-{
-    if (s->st == SPN_OK && s->used) s->st = s->sink->write(s->sink->ctx, s->buf, s->used);
-    s->used = 0;
-}
-
-static unsigned char *room(stage *s, size_t n)
-{
-    if (s->used + n > sizeof s->buf) flush(s);
-    unsigned char *p = s->buf + s->used;
-    s->used += n;
-    return p;
-}
-
-/* Entry j of item i of column c as a double (float64 columns) or a whole
- * number (the others); false, with the error set, for a value no web file
- * may hold. */
+/* Entry j of item i of column c: a double for the float64 columns, a whole
+ * number for the others; false, with the error set, for a float no web file
+ * may hold (any non-finite value but break_max's +infinity, "never"). */
 static bool entry(const spn_world *w, int c, uint32_t i, int j, double *d, uint32_t *u)
 {
-    if (c == C_POSITION || c == C_VELOCITY) {
-        const spn_vec3 v = (c == C_POSITION ? spn_world_positions(w) : spn_world_velocities(w))[i];
-        *d = j == 0 ? v.x : j == 1 ? v.y : v.z;
-        if (isfinite(*d)) return true;
-        spn_error(SPN_ERR_INVALID, "particle %u: %s is not finite; not saved", i,
-                  c == C_POSITION ? "position" : "velocity");
-        return false;
-    }
-    if (c == C_MASS || c == C_PTAG || c == C_FIXED) {
-        *d = spn_world_mass(w, i);
-        *u = c == C_PTAG ? spn_world_particle_tag(w, i) : (uint32_t)spn_world_is_fixed(w, i);
-        if (c != C_MASS || isfinite(*d)) return true;
-        spn_error(SPN_ERR_INVALID, "particle %u: mass is not finite; not saved", i);
-        return false;
-    }
-    const spn_spring_info s = spn_world_spring(w, i);
-    switch (c) {
-    case C_K: *d = s.k; break;
-    case C_KD: *d = s.kd; break;
-    case C_REST: *d = s.rest; break;
-    case C_BREAK_MIN: *d = s.break_min; break;
-    case C_BREAK_MAX: *d = s.break_max; break;
-    case C_A: *u = s.a; break;
-    case C_B: *u = s.b; break;
-    case C_STAG: *u = s.tag; break;
-    case C_STAGE: *u = s.stage; break;
-    case C_ORDER: *u = s.order; break;
-    case C_TENSION_ONLY: *u = s.tension_only; break;
-    default: *u = s.broken; break;
+    if (!LAYOUT[c].springs) {
+        switch (c) {
+        case C_POSITION:
+        case C_VELOCITY: {
+            const spn_vec3 v = (c == C_POSITION ? spn_world_positions(w) : spn_world_velocities(w))[i];
+            *d = j == 0 ? v.x : j == 1 ? v.y : v.z;
+            break;
+        }
+        case C_MASS: *d = spn_world_mass(w, i); break;
+        case C_PTAG: *u = spn_world_particle_tag(w, i); break;
+        default: *u = spn_world_is_fixed(w, i); break;
+        }
+    } else {
+        const spn_spring_info s = spn_world_spring(w, i);
+        switch (c) {
+        case C_K: *d = s.k; break;
+        case C_KD: *d = s.kd; break;
+        case C_REST: *d = s.rest; break;
+        case C_BREAK_MIN: *d = s.break_min; break;
+        case C_BREAK_MAX: *d = s.break_max; break;
+        case C_A: *u = s.a; break;
+        case C_B: *u = s.b; break;
+        case C_STAG: *u = s.tag; break;
+        case C_STAGE: *u = s.stage; break;
+        case C_ORDER: *u = s.order; break;
+        case C_TENSION_ONLY: *u = s.tension_only; break;
+        default: *u = s.broken; break;
+        }
     }
     if (LAYOUT[c].bytes != 8 || isfinite(*d) || (c == C_BREAK_MAX && *d == INFINITY)) return true;
-    spn_error(SPN_ERR_INVALID, "spring %u: %s is not finite; not saved", i, LAYOUT[c].path + strlen("springs."));
+    spn_error(SPN_ERR_INVALID, "%s %u: %s is not finite; not saved", LAYOUT[c].springs ? "spring" : "particle", i,
+              strchr(LAYOUT[c].path, '.') + 1);
     return false;
 }
 
@@ -173,39 +150,33 @@ spn_status spn_web_write_binary(const spn_world *w, spn_sink *sink)
     spn_sink hs = spn_sink_buffer(&header);
     st = spn__web_write_header(w, &hs);
     if (st == SPN_OK && header.size > UINT32_MAX) st = spn_error(SPN_ERR_INVALID, "web file header too long");
-    stage *s = st == SPN_OK ? malloc(sizeof *s) : NULL;
-    if (st == SPN_OK && !s) st = spn_error(SPN_ERR_NOMEM, "out of memory writing a binary web file");
     if (st != SPN_OK) {
         spn_buffer_free(&header);
         return st;
     }
-    s->sink = sink, s->st = SPN_OK, s->used = 0;
-    unsigned char frame[FRAME_BYTES];
+    spn__out o;
+    spn__out_init(&o, sink);
+    unsigned char *frame = spn__out_room(&o, FRAME_BYTES);
     memcpy(frame, MAGIC, sizeof MAGIC);
     put_u32(frame + 8, LAYOUT_VERSION);
     put_u32(frame + 12, (uint32_t)header.size);
-    memcpy(room(s, sizeof frame), frame, sizeof frame);
-    flush(s);
-    if (s->st == SPN_OK) s->st = sink->write(sink->ctx, header.data, header.size);
+    spn__out_put(&o, header.data, header.size);
     const size_t pad = (8 - (FRAME_BYTES + header.size) % 8) % 8;
     spn_buffer_free(&header);
-    memset(room(s, pad), 0, pad);
-    for (int c = 0; c < C_COUNT && s->st == SPN_OK; c++) {
+    memset(spn__out_room(&o, pad), 0, pad);
+    for (int c = 0; c < C_COUNT && o.st == SPN_OK; c++) {
         const uint32_t n = LAYOUT[c].springs ? ns : np;
         for (uint32_t i = 0; i < n; i++)
             for (int j = 0; j < LAYOUT[c].width; j++) {
                 double d = 0;
                 uint32_t u = 0;
                 entry(w, c, i, j, &d, &u); /* checked above */
-                if (LAYOUT[c].bytes == 8) put_f64(room(s, 8), d);
-                else if (LAYOUT[c].bytes == 4) put_u32(room(s, 4), u);
-                else *room(s, 1) = (unsigned char)u;
+                if (LAYOUT[c].bytes == 8) put_f64(spn__out_room(&o, 8), d);
+                else if (LAYOUT[c].bytes == 4) put_u32(spn__out_room(&o, 4), u);
+                else *spn__out_room(&o, 1) = (unsigned char)u;
             }
     }
-    flush(s);
-    st = s->st;
-    free(s);
-    return st;
+    return spn__out_finish(&o);
 }
 
 /* ---- reading -------------------------------------------------------------- */

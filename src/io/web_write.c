@@ -24,38 +24,11 @@ spn_status spn__error_prefix(spn_status status, const char *prefix)
     return spn_error(status, "%s: %s", prefix, copy);
 }
 
-/* The text goes to the sink in pieces of up to 16 KiB: a million-particle
- * web is 20 million numbers and twice as many separators, and a sink call
- * for each was a fifth of the time. */
-typedef struct writer {
-    spn_sink *sink;
-    spn_status st;
-    size_t used;
-    char buf[1 << 14];
-} writer;
-
-static void flush(writer *wr)
-{
-    if (wr->st == SPN_OK && wr->used) wr->st = wr->sink->write(wr->sink->ctx, wr->buf, wr->used);
-    wr->used = 0;
-}
+/* The text goes out buffered (out.c); a writer error set in `st` stops it. */
+typedef spn__out writer;
 
 /* Each put_* is a no-op once a write failed, so the callers read straight. */
-static void put_n(writer *wr, const char *text, size_t n)
-{
-    if (wr->st != SPN_OK) return;
-    if (wr->used + n > sizeof wr->buf) {
-        flush(wr);
-        if (n > sizeof wr->buf) { /* long metadata: straight through */
-            if (wr->st == SPN_OK) wr->st = wr->sink->write(wr->sink->ctx, text, n);
-            return;
-        }
-    }
-    memcpy(wr->buf + wr->used, text, n);
-    wr->used += n;
-}
-
-static void put(writer *wr, const char *text) { put_n(wr, text, strlen(text)); }
+static void put(writer *wr, const char *text) { spn__out_put(wr, text, strlen(text)); }
 
 static void put_double(writer *wr, double v)
 {
@@ -70,7 +43,7 @@ static void put_u64(writer *wr, unsigned long long v)
     size_t n = sizeof buf;
     do buf[--n] = (char)('0' + v % 10);
     while (v /= 10);
-    put_n(wr, buf + n, sizeof buf - n);
+    spn__out_put(wr, buf + n, sizeof buf - n);
 }
 
 static void put_vec3(writer *wr, spn_vec3 v)
@@ -279,7 +252,7 @@ static void put_springs(writer *wr, const spn_world *w, bool columns)
 static spn_status write_document(const spn_world *w, spn_sink *sink, bool columns)
 {
     writer wr;
-    wr.sink = sink, wr.st = SPN_OK, wr.used = 0;
+    spn__out_init(&wr, sink);
     put(&wr, "{\n  \"format\": \"" SPN__WEB_FORMAT_NAME "\",\n  \"version\": ");
     put_u64(&wr, SPN_WEB_FORMAT_VERSION);
     put(&wr, ",\n  \"units\": \"SI\",\n");
@@ -289,8 +262,7 @@ static spn_status write_document(const spn_world *w, spn_sink *sink, bool column
     put_particles(&wr, w, columns);
     put_springs(&wr, w, columns);
     put(&wr, "}\n");
-    flush(&wr);
-    return wr.st;
+    return spn__out_finish(&wr);
 }
 
 spn_status spn_web_write(const spn_world *w, spn_sink *sink)
