@@ -1,7 +1,7 @@
 /* The binary web file (docs/web-format.md, "Binary file"): the same content
  * as the JSON file, for webs too big to read and write as text in good time
  * (a million particles: 309 MB of JSON read in about 12 s, cJSON's tree of
- * 20 million numbers, and written in 2.2 s on this project's machine). A
+ * 20 million numbers, and written in 2.0 s on this project's machine). A
  * short frame, the JSON document without its columns as the header, then
  * every column as raw little-endian numbers in a fixed order whose lengths
  * follow from the header's counts.
