@@ -60,9 +60,14 @@ static inline uint32_t spn__get_u32(const unsigned char *p)
     return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
 }
 
+/* JSON text parsed into *root (web_read.c), or refused naming `name` and,
+ * when not NULL, the `part` of the file ("header"): empty, a NUL byte, a
+ * syntax error or text after the document, with its line and column. */
+struct cJSON;
+spn_status spn__web_parse_text(const char *text, size_t size, const char *name, const char *part,
+                               struct cJSON **root);
 /* A parsed document (web_read.c): its header checked, then read into a world;
  * `payload` NULL for a JSON file, or the binary file's columns. */
-struct cJSON;
 spn_status spn__web_read_root(const char *name, const struct cJSON *root, const unsigned char *payload,
                               size_t payload_size, spn_world **out);
 

@@ -195,19 +195,8 @@ spn_status spn__web_parse_binary(const unsigned char *data, size_t size, const c
     if (hlen > size - FRAME_BYTES || pad > size - start)
         return spn_error(SPN_ERR_FORMAT, "%s: binary web file cut short: its header claims %u bytes, %zu follow", name,
                          hlen, size - FRAME_BYTES);
-    const char *text = (const char *)data + FRAME_BYTES, *end = NULL;
-    if (memchr(text, '\0', hlen))
-        return spn_error(SPN_ERR_FORMAT, "%s: header: not JSON: NUL byte at offset %zu", name,
-                         (size_t)((const char *)memchr(text, '\0', hlen) - text));
-    cJSON *root = cJSON_ParseWithLengthOpts(text, hlen, &end, false);
-    size_t at = end ? (size_t)(end - text) : 0;
-    while (root && at < hlen && strchr(" \t\r\n", text[at])) at++;
-    if (!root || at != hlen) {
-        cJSON_Delete(root);
-        return spn_error(SPN_ERR_FORMAT, "%s: header: not JSON: %s at byte %zu of the header", name,
-                         root ? "text after the end of the document" : "syntax error", at);
-    }
-    spn_status st = SPN_OK;
+    cJSON *root = NULL;
+    spn_status st = spn__web_parse_text((const char *)data + FRAME_BYTES, hlen, name, "header", &root);
     for (size_t i = start; i < start + pad && st == SPN_OK; i++)
         if (data[i]) st = spn_error(SPN_ERR_FORMAT, "%s: byte %zu: the padding after the header is not zero", name, i);
     if (st == SPN_OK) st = spn__web_read_root(name, root, data + start + pad, size - start - pad, out);

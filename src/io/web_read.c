@@ -568,30 +568,43 @@ static bool non_number(const char *p, size_t n)
     return false;
 }
 
-spn_status spn_web_parse(const char *text, size_t size, const char *name, spn_world **out)
+spn_status spn__web_parse_text(const char *text, size_t size, const char *name, const char *part, cJSON **root)
 {
-    reader r = {name ? name : "web file", NULL, 0, 0};
-    if (!out) return spn_error(SPN_ERR_INVALID, "spn_web_parse: out is NULL");
-    *out = NULL;
-    if (text && spn__web_is_binary(text, size))
-        return spn__web_parse_binary((const unsigned char *)text, size, r.name, out);
-    if (!text || blank(text, size)) return bad(&r, "empty file");
+    const reader r = {name, NULL, 0, 0};
+    const char *sep = part ? ": " : "";
+    part = part ? part : "";
+    *root = NULL;
+    if (!text || blank(text, size)) return *part ? bad(&r, "%s: empty", part) : bad(&r, "empty file");
     const char *nul = memchr(text, '\0', size);
-    if (nul) return bad(&r, "not JSON: NUL byte at offset %zu", (size_t)(nul - text));
+    if (nul) return bad(&r, "%s%snot JSON: NUL byte at offset %zu", part, sep, (size_t)(nul - text));
     const char *end = NULL;
-    cJSON *root = cJSON_ParseWithLengthOpts(text, size, &end, false);
+    *root = cJSON_ParseWithLengthOpts(text, size, &end, false);
     size_t line, col, offset = end ? (size_t)(end - text) : 0;
-    if (!root) {
+    if (!*root) {
         locate(text, offset, &line, &col);
-        return bad(&r, "not JSON: syntax error at line %zu, column %zu%s", line, col,
+        return bad(&r, "%s%snot JSON: syntax error at line %zu, column %zu%s", part, sep, line, col,
                    non_number(text + offset, size - offset) ? " (NaN and infinities are not allowed)" : "");
     }
     if (!blank(end, size - offset)) {
-        cJSON_Delete(root);
+        cJSON_Delete(*root);
+        *root = NULL;
         locate(text, offset, &line, &col);
-        return bad(&r, "not JSON: text after the end of the document at line %zu, column %zu", line, col);
+        return bad(&r, "%s%snot JSON: text after the end of the document at line %zu, column %zu", part, sep, line,
+                   col);
     }
-    spn_status st = spn__web_read_root(r.name, root, NULL, 0, out);
+    return SPN_OK;
+}
+
+spn_status spn_web_parse(const char *text, size_t size, const char *name, spn_world **out)
+{
+    name = name ? name : "web file";
+    if (!out) return spn_error(SPN_ERR_INVALID, "spn_web_parse: out is NULL");
+    *out = NULL;
+    if (text && spn__web_is_binary(text, size))
+        return spn__web_parse_binary((const unsigned char *)text, size, name, out);
+    cJSON *root = NULL;
+    spn_status st = spn__web_parse_text(text, size, name, NULL, &root);
+    if (st == SPN_OK) st = spn__web_read_root(name, root, NULL, 0, out);
     cJSON_Delete(root);
     return st;
 }
