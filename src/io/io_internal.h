@@ -66,10 +66,36 @@ static inline uint32_t spn__get_u32(const unsigned char *p)
 struct cJSON;
 spn_status spn__web_parse_text(const char *text, size_t size, const char *name, const char *part,
                                struct cJSON **root);
+/* The columns of a JSON web file read straight from its text (web_lift.c):
+ * each array of numbers and nulls that is a field of the top-level
+ * "particles" or "springs" object, as doubles (null as NaN), and the text
+ * with each such array replaced by "[]" (the skeleton, NUL-terminated),
+ * which is valid JSON exactly when the text is. count 0: nothing taken,
+ * no skeleton. Fails only for want of memory. */
+enum { SPN__LIFT_MAX = 32 };
+typedef struct spn__lifted_col {
+    char path[32]; /* "particles.position" */
+    double *v;
+    size_t n;
+} spn__lifted_col;
+typedef struct spn__lifted {
+    spn__lifted_col col[SPN__LIFT_MAX];
+    int count;
+    char *skeleton;
+    size_t skeleton_size;
+} spn__lifted;
+spn_status spn__web_lift(const char *text, size_t size, spn__lifted *l);
+const spn__lifted_col *spn__lifted_find(const spn__lifted *l, const char *path);
+void spn__lifted_free(spn__lifted *l);
+/* spn_web_parse for JSON text, with the columns read by web_lift.c or
+ * (lift false, for the tests' and fuzzers' comparisons) all by cJSON. */
+spn_status spn__web_parse_json(const char *text, size_t size, const char *name, bool lift, spn_world **out);
+
 /* A parsed document (web_read.c): its header checked, then read into a world;
- * `payload` NULL for a JSON file, or the binary file's columns. */
+ * `payload` NULL for a JSON file, or the binary file's columns; `lifted`
+ * the columns taken from a JSON file's text, or NULL. */
 spn_status spn__web_read_root(const char *name, const struct cJSON *root, const unsigned char *payload,
-                              size_t payload_size, spn_world **out);
+                              size_t payload_size, const spn__lifted *lifted, spn_world **out);
 
 /* Put "prefix: " before the last error message; returns `status`. */
 spn_status spn__error_prefix(spn_status status, const char *prefix);

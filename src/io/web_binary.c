@@ -199,7 +199,7 @@ spn_status spn__web_parse_binary(const unsigned char *data, size_t size, const c
     spn_status st = spn__web_parse_text((const char *)data + FRAME_BYTES, hlen, name, "header", &root);
     for (size_t i = start; i < start + pad && st == SPN_OK; i++)
         if (data[i]) st = spn_error(SPN_ERR_FORMAT, "%s: byte %zu: the padding after the header is not zero", name, i);
-    if (st == SPN_OK) st = spn__web_read_root(name, root, data + start + pad, size - start - pad, out);
+    if (st == SPN_OK) st = spn__web_read_root(name, root, data + start + pad, size - start - pad, NULL, out);
     cJSON_Delete(root);
     return st;
 }

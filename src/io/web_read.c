@@ -2,7 +2,9 @@
  * every field is checked before it reaches the world, and the first bad value
  * is reported as "FILE: FIELD[INDEX]: what is wrong". A binary file
  * (web_binary.c) has the same document as its header and its columns as raw
- * numbers; they pass the same checks here, read by the same column calls.
+ * numbers; they pass the same checks here, read by the same column calls, as
+ * do the big columns of a JSON file read straight from its text
+ * (web_lift.c), which give every entry and message that cJSON's would.
  *
  * Invariants: on any failure *out is NULL and everything built is freed (never
  * a half-built world). Array lengths are checked against the declared counts
@@ -16,6 +18,10 @@
 
 #include <cjson/cJSON.h>
 #include <errno.h>
+#if defined(__unix__)
+#include <sys/mman.h>
+#include <sys/stat.h>
+#endif
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
@@ -25,6 +31,7 @@ typedef struct reader {
     const char *name;              /* the file, for messages */
     const unsigned char *payload;  /* a binary file's columns (web_binary.c); NULL for JSON */
     size_t particles, springs;     /* the counts, for the columns' offsets in the payload */
+    const spn__lifted *lifted;     /* a JSON file's columns read from its text, or NULL */
 } reader;
 
 static spn_status bad(const reader *r, const char *fmt, ...) SPN_PRINTF(2, 3);
@@ -101,6 +108,7 @@ static spn_status whole_number(const reader *r, const cJSON *j, const char *fiel
 typedef struct column {
     const cJSON *next;        /* entry to read next; NULL for a missing optional column */
     const unsigned char *bin; /* a binary file's column, its first entry; NULL for JSON */
+    const double *lift;       /* a column read from the JSON text (web_lift.c; null as NaN), or NULL */
     char path[64];            /* "particles.mass" */
     uint32_t index;           /* entry index of `next` */
     int width;                /* entries per item: 3 for vectors */
@@ -112,6 +120,7 @@ static spn_status column_open(const reader *r, const cJSON *section, const char 
     snprintf(col->path, sizeof col->path, "%s.%s", sect, key);
     col->next = NULL;
     col->bin = NULL;
+    col->lift = NULL;
     col->index = 0;
     col->width = width;
     if (r->payload) { /* every column is there, its length checked with the file's */
@@ -121,24 +130,37 @@ static spn_status column_open(const reader *r, const cJSON *section, const char 
     const cJSON *arr = cJSON_GetObjectItemCaseSensitive(section, key);
     if (!arr) return required ? bad(r, "missing field '%s'", col->path) : SPN_OK;
     if (!cJSON_IsArray(arr)) return bad(r, "%s: expected an array, got %s", col->path, type_name(arr));
-    size_t want = count * (size_t)width, have = 0;
+    const spn__lifted_col *lifted = spn__lifted_find(r->lifted, col->path); /* then arr is its "[]" */
+    size_t want = count * (size_t)width, have = lifted ? lifted->n : 0;
     for (const cJSON *c = arr->child; c && have <= want; c = c->next) have++;
     if (have != want)
         return bad(r, "%s: has %s%zu entries, expected %zu (%s.count = %zu%s)", col->path, have > want ? "more than " : "",
                    have > want ? want : have, want, sect, count, width == 3 ? ", 3 per particle" : "");
     col->next = arr->child;
+    col->lift = lifted ? lifted->v : NULL;
     return SPN_OK;
+}
+
+/* A lifted entry as the cJSON item it stands for: a number, or null (NaN);
+ * only for the messages, which then read as for any other JSON entry. */
+static const cJSON *as_item(double v, cJSON *tmp)
+{
+    memset(tmp, 0, sizeof *tmp);
+    tmp->type = isnan(v) ? cJSON_NULL : cJSON_Number;
+    tmp->valuedouble = v;
+    return tmp;
 }
 
 /* The next entry as a finite number, or `dflt` for a missing column. */
 static spn_status col_number(const reader *r, column *col, double dflt, double *out)
 {
-    if (!col->next && !col->bin) {
+    if (!col->next && !col->bin && !col->lift) {
         *out = dflt;
         return SPN_OK;
     }
     const cJSON *j = col->next;
-    const double v = j ? j->valuedouble : spn__get_f64(col->bin + 8 * (size_t)col->index);
+    const double v = j ? j->valuedouble
+                       : col->lift ? col->lift[col->index] : spn__get_f64(col->bin + 8 * (size_t)col->index);
     if (j) col->next = j->next;
     col->index++;
     if ((!j || cJSON_IsNumber(j)) && isfinite(v)) { /* the field's name is only made for a message */
@@ -150,6 +172,8 @@ static spn_status col_number(const reader *r, column *col, double dflt, double *
     if (col->width == 3)
         snprintf(field, sizeof field, "%s[%u] (particle %u, %c)", col->path, i, i / 3, "xyz"[i % 3]);
     else snprintf(field, sizeof field, "%s[%u]", col->path, i);
+    cJSON tmp;
+    if (col->lift) j = as_item(v, &tmp);
     if (!j) return bad(r, "%s: %s is not allowed", field, isnan(v) ? "NaN" : "an infinity");
     return finite_number(r, j, field, out);
 }
@@ -169,22 +193,23 @@ static spn_status col_uint32(const reader *r, column *col, uint32_t *out)
         *out = spn__get_u32(col->bin + 4 * (size_t)col->index++);
         return SPN_OK;
     }
-    if (!col->next) {
+    if (!col->next && !col->lift) {
         *out = 0;
         return SPN_OK;
     }
-    const cJSON *j = col->next;
-    col->next = j->next;
+    cJSON tmp;
+    const cJSON *j = col->lift ? NULL : col->next;
+    if (j) col->next = j->next;
+    const double u = j ? j->valuedouble : col->lift[col->index];
     col->index++;
-    const double u = j->valuedouble;
-    if (cJSON_IsNumber(j) && u >= 0 && u <= 4294967295.0 && floor(u) == u) {
+    if ((!j || cJSON_IsNumber(j)) && u >= 0 && u <= 4294967295.0 && floor(u) == u) { /* NaN fails */
         *out = (uint32_t)u;
         return SPN_OK;
     }
     char field[96];
     snprintf(field, sizeof field, "%s[%u]", col->path, col->index - 1);
     double v = 0;
-    spn_status st = whole_number(r, j, field, 4294967295.0, &v);
+    spn_status st = whole_number(r, j ? j : as_item(u, &tmp), field, 4294967295.0, &v);
     *out = (uint32_t)v;
     return st;
 }
@@ -200,10 +225,11 @@ static spn_status col_flag(const reader *r, column *col, bool *out)
         *out = v == 1;
         return SPN_OK;
     }
-    if (!col->next) return SPN_OK;
-    const cJSON *j = col->next;
+    if (!col->next && !col->lift) return SPN_OK;
+    cJSON tmp;
+    const cJSON *j = col->lift ? as_item(col->lift[col->index], &tmp) : col->next;
     uint32_t i = col->index;
-    col->next = j->next;
+    if (!col->lift) col->next = j->next;
     col->index++;
     if (cJSON_IsBool(j)) *out = cJSON_IsTrue(j);
     else if (cJSON_IsNumber(j) && (j->valuedouble == 0 || j->valuedouble == 1)) *out = j->valuedouble == 1;
@@ -216,6 +242,11 @@ static spn_status col_flag(const reader *r, column *col, bool *out)
 static spn_status col_break_max(const reader *r, column *col, double *out)
 {
     if (col->bin && spn__get_f64(col->bin + 8 * (size_t)col->index) == INFINITY) { /* "never", as null in JSON */
+        col->index++;
+        *out = INFINITY;
+        return SPN_OK;
+    }
+    if (col->lift && isnan(col->lift[col->index])) { /* null */
         col->index++;
         *out = INFINITY;
         return SPN_OK;
@@ -570,7 +601,7 @@ static bool non_number(const char *p, size_t n)
 
 spn_status spn__web_parse_text(const char *text, size_t size, const char *name, const char *part, cJSON **root)
 {
-    const reader r = {name, NULL, 0, 0};
+    const reader r = {name, NULL, 0, 0, NULL};
     const char *sep = part ? ": " : "";
     part = part ? part : "";
     *root = NULL;
@@ -595,6 +626,28 @@ spn_status spn__web_parse_text(const char *text, size_t size, const char *name, 
     return SPN_OK;
 }
 
+spn_status spn__web_parse_json(const char *text, size_t size, const char *name, bool lift, spn_world **out)
+{
+    *out = NULL;
+    spn__lifted lifted;
+    memset(&lifted, 0, sizeof lifted);
+    if (lift && text) {
+        spn_status st = spn__web_lift(text, size, &lifted);
+        if (st != SPN_OK) return spn__error_prefix(st, name);
+    }
+    cJSON *root = NULL;
+    spn_status st = SPN_ERR_FORMAT;
+    if (lifted.count) { /* after a syntax error the text itself is parsed, for its positions */
+        st = spn__web_parse_text(lifted.skeleton, lifted.skeleton_size, name, NULL, &root);
+        if (st != SPN_OK) spn__lifted_free(&lifted);
+    }
+    if (!root) st = spn__web_parse_text(text, size, name, NULL, &root);
+    if (st == SPN_OK) st = spn__web_read_root(name, root, NULL, 0, lifted.count ? &lifted : NULL, out);
+    cJSON_Delete(root);
+    spn__lifted_free(&lifted);
+    return st;
+}
+
 spn_status spn_web_parse(const char *text, size_t size, const char *name, spn_world **out)
 {
     name = name ? name : "web file";
@@ -602,17 +655,13 @@ spn_status spn_web_parse(const char *text, size_t size, const char *name, spn_wo
     *out = NULL;
     if (text && spn__web_is_binary(text, size))
         return spn__web_parse_binary((const unsigned char *)text, size, name, out);
-    cJSON *root = NULL;
-    spn_status st = spn__web_parse_text(text, size, name, NULL, &root);
-    if (st == SPN_OK) st = spn__web_read_root(name, root, NULL, 0, out);
-    cJSON_Delete(root);
-    return st;
+    return spn__web_parse_json(text, size, name, true, out);
 }
 
 spn_status spn__web_read_root(const char *name, const cJSON *root, const unsigned char *payload, size_t payload_size,
-                              spn_world **out)
+                              const spn__lifted *lifted, spn_world **out)
 {
-    reader r = {name, payload, 0, 0};
+    reader r = {name, payload, 0, 0, lifted};
     spn_status st = check_header(&r, root);
     return st == SPN_OK ? read_document(&r, root, payload_size, out) : st;
 }
@@ -624,6 +673,21 @@ spn_status spn_web_load(const char *path, spn_world **out)
     if (!path || !*path) return spn_error(SPN_ERR_INVALID, "web file: the path is empty");
     FILE *fp = fopen(path, "rb");
     if (!fp) return spn_error(SPN_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+#if defined(__unix__)
+    /* A regular file is read where the system keeps it: no copy, and no
+     * fresh pages for one (a million-particle web is hundreds of MB). */
+    struct stat sb;
+    if (fstat(fileno(fp), &sb) == 0 && S_ISREG(sb.st_mode) && sb.st_size > 0 &&
+        (uint64_t)sb.st_size < SPN__WEB_MAX_BYTES) {
+        void *map = mmap(NULL, (size_t)sb.st_size, PROT_READ, MAP_PRIVATE, fileno(fp), 0);
+        if (map != MAP_FAILED) {
+            fclose(fp);
+            spn_status st = spn_web_parse(map, (size_t)sb.st_size, path, out);
+            munmap(map, (size_t)sb.st_size);
+            return st;
+        }
+    }
+#endif
     /* A regular file is read into one buffer of its size (no copies as it
      * grows: a million-particle web is hundreds of MB); a pipe grows one. */
     size_t cap = 1 << 16, size = 0;
