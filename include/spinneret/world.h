@@ -183,6 +183,12 @@ SPN_API void spn_world_set_mass(spn_world *w, uint32_t i, double mass);
 SPN_API void spn_world_set_particle_tag(spn_world *w, uint32_t i, uint32_t tag);
 
 SPN_API spn_spring_info spn_world_spring(const spn_world *w, uint32_t s);
+/// The definition that adds spring s again as it is now (ends, stiffness,
+/// damping, rest and break lengths, tension-only, tag, stage, order): for
+/// copying a world's springs, and cheaper than spn_world_spring, which also
+/// measures the spring. Whether it is broken: spn_world_spring_is_broken.
+SPN_API spn_spring_def spn_world_spring_def(const spn_world *w, uint32_t s);
+SPN_API bool spn_world_spring_is_broken(const spn_world *w, uint32_t s);
 SPN_API void spn_world_set_spring_rest(spn_world *w, uint32_t s, double rest);
 SPN_API void spn_world_set_spring_stiffness(spn_world *w, uint32_t s, double k, double kd);
 SPN_API void spn_world_set_spring_tag(spn_world *w, uint32_t s, uint32_t tag);

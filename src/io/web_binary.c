@@ -102,7 +102,7 @@ static bool entry(const spn_world *w, int c, uint32_t i, int j, double *d, uint3
         default: *u = spn_world_is_fixed(w, i); break;
         }
     } else {
-        const spn_spring_info s = spn_world_spring(w, i);
+        const spn_spring_def s = spn_world_spring_def(w, i);
         switch (c) {
         case C_K: *d = s.k; break;
         case C_KD: *d = s.kd; break;
@@ -115,7 +115,7 @@ static bool entry(const spn_world *w, int c, uint32_t i, int j, double *d, uint3
         case C_STAGE: *u = s.stage; break;
         case C_ORDER: *u = s.order; break;
         case C_TENSION_ONLY: *u = s.tension_only; break;
-        default: *u = s.broken; break;
+        default: *u = spn_world_spring_is_broken(w, i); break;
         }
     }
     if (LAYOUT[c].bytes != 8 || isfinite(*d) || (c == C_BREAK_MAX && *d == INFINITY)) return true;

@@ -211,18 +211,18 @@ static void put_particles(writer *wr, const spn_world *w, bool columns)
     put(wr, "\n  },\n");
 }
 
-static double s_k(const spn_world *w, uint32_t s) { return spn_world_spring(w, s).k; }
-static double s_kd(const spn_world *w, uint32_t s) { return spn_world_spring(w, s).kd; }
-static double s_rest(const spn_world *w, uint32_t s) { return spn_world_spring(w, s).rest; }
-static double s_bmin(const spn_world *w, uint32_t s) { return spn_world_spring(w, s).break_min; }
-static double s_bmax(const spn_world *w, uint32_t s) { return spn_world_spring(w, s).break_max; }
-static unsigned long long s_a(const spn_world *w, uint32_t s) { return spn_world_spring(w, s).a; }
-static unsigned long long s_b(const spn_world *w, uint32_t s) { return spn_world_spring(w, s).b; }
-static unsigned long long s_tension(const spn_world *w, uint32_t s) { return spn_world_spring(w, s).tension_only; }
-static unsigned long long s_broken(const spn_world *w, uint32_t s) { return spn_world_spring(w, s).broken; }
-static unsigned long long s_tag(const spn_world *w, uint32_t s) { return spn_world_spring(w, s).tag; }
-static unsigned long long s_stage(const spn_world *w, uint32_t s) { return spn_world_spring(w, s).stage; }
-static unsigned long long s_order(const spn_world *w, uint32_t s) { return spn_world_spring(w, s).order; }
+static double s_k(const spn_world *w, uint32_t s) { return spn_world_spring_def(w, s).k; }
+static double s_kd(const spn_world *w, uint32_t s) { return spn_world_spring_def(w, s).kd; }
+static double s_rest(const spn_world *w, uint32_t s) { return spn_world_spring_def(w, s).rest; }
+static double s_bmin(const spn_world *w, uint32_t s) { return spn_world_spring_def(w, s).break_min; }
+static double s_bmax(const spn_world *w, uint32_t s) { return spn_world_spring_def(w, s).break_max; }
+static unsigned long long s_a(const spn_world *w, uint32_t s) { return spn_world_spring_def(w, s).a; }
+static unsigned long long s_b(const spn_world *w, uint32_t s) { return spn_world_spring_def(w, s).b; }
+static unsigned long long s_tension(const spn_world *w, uint32_t s) { return spn_world_spring_def(w, s).tension_only; }
+static unsigned long long s_broken(const spn_world *w, uint32_t s) { return spn_world_spring_is_broken(w, s); }
+static unsigned long long s_tag(const spn_world *w, uint32_t s) { return spn_world_spring_def(w, s).tag; }
+static unsigned long long s_stage(const spn_world *w, uint32_t s) { return spn_world_spring_def(w, s).stage; }
+static unsigned long long s_order(const spn_world *w, uint32_t s) { return spn_world_spring_def(w, s).order; }
 
 static void put_springs(writer *wr, const spn_world *w, bool columns)
 {

@@ -249,21 +249,41 @@ void spn_world_set_mass(spn_world *w, uint32_t i, double mass)
     w->free_mass += free_mass_of(w, i);
 }
 
+spn_spring_def spn_world_spring_def(const spn_world *w, uint32_t s)
+{
+    spn_spring_def d;
+    d.a = w->sa[s];
+    d.b = w->sb[s];
+    d.k = w->k[s];
+    d.kd = w->kd[s];
+    d.rest = w->rest[s];
+    d.break_min = w->bmin[s];
+    d.break_max = w->bmax[s];
+    d.tension_only = (w->sflags[s] & SPN_SPRING_TENSION_ONLY) != 0;
+    d.tag = w->stag[s];
+    d.stage = w->sstage[s];
+    d.order = w->sorder[s];
+    return d;
+}
+
+bool spn_world_spring_is_broken(const spn_world *w, uint32_t s) { return (w->sflags[s] & SPN_SPRING_BROKEN) != 0; }
+
 spn_spring_info spn_world_spring(const spn_world *w, uint32_t s)
 {
+    const spn_spring_def d = spn_world_spring_def(w, s);
     spn_spring_info info;
-    info.a = w->sa[s];
-    info.b = w->sb[s];
-    info.k = w->k[s];
-    info.kd = w->kd[s];
-    info.rest = w->rest[s];
-    info.break_min = w->bmin[s];
-    info.break_max = w->bmax[s];
-    info.tension_only = (w->sflags[s] & SPN_SPRING_TENSION_ONLY) != 0;
-    info.broken = (w->sflags[s] & SPN_SPRING_BROKEN) != 0;
-    info.tag = w->stag[s];
-    info.stage = w->sstage[s];
-    info.order = w->sorder[s];
+    info.a = d.a;
+    info.b = d.b;
+    info.k = d.k;
+    info.kd = d.kd;
+    info.rest = d.rest;
+    info.break_min = d.break_min;
+    info.break_max = d.break_max;
+    info.tension_only = d.tension_only;
+    info.broken = spn_world_spring_is_broken(w, s);
+    info.tag = d.tag;
+    info.stage = d.stage;
+    info.order = d.order;
     info.length = spn_v3_len(spn_v3_sub(w->x[info.a], w->x[info.b]));
     double stretch = info.length - info.rest;
     info.tension = (info.broken || (info.tension_only && stretch < 0)) ? 0 : info.k * stretch;
