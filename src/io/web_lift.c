@@ -235,7 +235,7 @@ spn_status spn__web_lift(const char *text, size_t size, spn__lifted *l)
     const char point = *localeconv()->decimal_point;
     size_t skel_cap = 0;
     int depth = 0;         /* open objects and arrays */
-    bool root_object = false, in_object[3] = {false, false, false};
+    bool in_object[3] = {false, false, false}; /* the containers open at depths 0-2 */
     char section[16] = "", key[16] = ""; /* the field open at depth 1 (when it may be lifted from), at depth 2 */
     bool expect_key = false, nomem = false;
     while (p < end && !nomem) {
@@ -256,7 +256,6 @@ spn_status spn__web_lift(const char *text, size_t size, spn__lifted *l)
             p = q;
         } else if (c == '{' || c == '[') {
             if (depth < 3) in_object[depth] = c == '{';
-            if (depth == 0) root_object = c == '{';
             if (depth == 1) key[0] = 0;
             depth++;
             expect_key = c == '{';
@@ -275,7 +274,7 @@ spn_status spn__web_lift(const char *text, size_t size, spn__lifted *l)
             p++;
             const char *v = skip_blank(p, end);
             char path[32];
-            if (depth == 2 && root_object && in_object[1] && v < end && *v == '[' && wanted(l, section, key, path)) {
+            if (depth == 2 && in_object[0] && in_object[1] && v < end && *v == '[' && wanted(l, section, key, path)) {
                 spn__lifted_col *col = &l->col[l->count];
                 size_t cap = 0;
                 const char *after = lift_array(v, end, point, col, &cap, &nomem);

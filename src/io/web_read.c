@@ -151,6 +151,16 @@ static const cJSON *as_item(double v, cJSON *tmp)
     return tmp;
 }
 
+/* The next entry of a JSON column that is there: its cJSON item, or the
+ * lifted one as such an item in *tmp. */
+static const cJSON *json_take(column *col, cJSON *tmp)
+{
+    const cJSON *j = col->lift ? as_item(col->lift[col->index], tmp) : col->next;
+    if (!col->lift) col->next = j->next;
+    col->index++;
+    return j;
+}
+
 /* The next entry as a finite number, or `dflt` for a missing column. */
 static spn_status col_number(const reader *r, column *col, double dflt, double *out)
 {
@@ -198,18 +208,16 @@ static spn_status col_uint32(const reader *r, column *col, uint32_t *out)
         return SPN_OK;
     }
     cJSON tmp;
-    const cJSON *j = col->lift ? NULL : col->next;
-    if (j) col->next = j->next;
-    const double u = j ? j->valuedouble : col->lift[col->index];
-    col->index++;
-    if ((!j || cJSON_IsNumber(j)) && u >= 0 && u <= 4294967295.0 && floor(u) == u) { /* NaN fails */
+    const cJSON *j = json_take(col, &tmp);
+    const double u = j->valuedouble;
+    if (cJSON_IsNumber(j) && u >= 0 && u <= 4294967295.0 && floor(u) == u) {
         *out = (uint32_t)u;
         return SPN_OK;
     }
     char field[96];
     snprintf(field, sizeof field, "%s[%u]", col->path, col->index - 1);
     double v = 0;
-    spn_status st = whole_number(r, j ? j : as_item(u, &tmp), field, 4294967295.0, &v);
+    spn_status st = whole_number(r, j, field, 4294967295.0, &v);
     *out = (uint32_t)v;
     return st;
 }
@@ -227,10 +235,8 @@ static spn_status col_flag(const reader *r, column *col, bool *out)
     }
     if (!col->next && !col->lift) return SPN_OK;
     cJSON tmp;
-    const cJSON *j = col->lift ? as_item(col->lift[col->index], &tmp) : col->next;
-    uint32_t i = col->index;
-    if (!col->lift) col->next = j->next;
-    col->index++;
+    const uint32_t i = col->index;
+    const cJSON *j = json_take(col, &tmp);
     if (cJSON_IsBool(j)) *out = cJSON_IsTrue(j);
     else if (cJSON_IsNumber(j) && (j->valuedouble == 0 || j->valuedouble == 1)) *out = j->valuedouble == 1;
     else if (cJSON_IsNumber(j)) return bad(r, "%s[%u]: expected 0, 1, true or false, got %.17g", col->path, i, j->valuedouble);
