@@ -219,8 +219,9 @@ static bool copy_out(spn__lifted *l, size_t *cap, const char *p, size_t n)
     return true;
 }
 
-/* The field at depth 2 that an array at p would be the value of, if it is
- * one to take: "particles.KEY" or "springs.KEY", not taken before. */
+/* Is the value of field `key` of the top-level object `section` one to take
+ * ("particles" or "springs", else section is empty), not taken before? Its
+ * path ("particles.mass") in path. */
 static bool wanted(const spn__lifted *l, const char *section, const char *key, char path[32])
 {
     if (!*section || !*key || l->count == SPN__LIFT_MAX) return false;
