@@ -5,7 +5,8 @@
     scripts/bench-table.py bench/results/<machine>.json --readme README.md
 
 The results file holds one JSON object per line: first the machine (name,
-CPU, cores, date), then one line per figure, each with a "bench" key. Known
+CPU, its family and model, the vector extension the kernels pick, cores,
+date), then one line per figure, each with a "bench" key. Known
 benches get a table with chosen columns; any other bench gets a table of all
 its keys, so a new benchmark shows up without editing this script. With
 --readme, the text between the markers <!-- bench-table:begin --> and
@@ -162,7 +163,12 @@ def render(path):
     for l in lines:
         if "bench" in l:
             groups.setdefault(l["bench"], []).append(l)
-    out = [f"Measured by `make bench` on `{machine.get('machine', '?')}`: {machine.get('cpu', '?')}, "
+    hardware = ", ".join(x for x in (
+        f"family {machine['cpu_family']}" if machine.get("cpu_family") else "",
+        f"model {machine['cpu_model']}" if machine.get("cpu_model") else "",
+        {"avx512": "AVX-512", "avx2": "AVX2, no AVX-512", "baseline": "no AVX2"}.get(machine.get("isa"), "")) if x)
+    out = [f"Measured by `make bench` on `{machine.get('machine', '?')}`: {machine.get('cpu', '?')}"
+           f"{f' ({hardware})' if hardware else ''}, "
            f"{machine.get('cores', '?')} cores, {machine.get('date', '?')} "
            f"(results: `{os.path.relpath(path)}`; tables made by `scripts/bench-table.py`).", ""]
     for extra in (targets(lines), bandwidth_table(lines)):

@@ -10,7 +10,11 @@
 # behind.
 . "$(dirname "$0")/lib/common.sh" "$@"
 SRC=${SPN_SOURCE_DIR:?SPN_SOURCE_DIR must name the source tree}
-machine=$(hostname -s 2>/dev/null || echo machine)
+# the results file is named for the host and its processor (family, model)
+field() { awk -F: -v k="$1" '$1 ~ "^" k "[ \t]*$" { sub(/^ */, "", $2); print $2; exit }' /proc/cpuinfo 2>/dev/null; }
+family=$(field "cpu family")
+model=$(field model)
+machine=$(hostname -s 2>/dev/null || echo machine)${family:+-f$family}${model:+m$model}
 
 # A project folder with the scripts, a README with the markers and a build
 # folder of fake programs (each prints JSON lines, as the real ones do).
@@ -49,7 +53,9 @@ res="$T/p/bench/results/$machine.json"
 [ "$(cat "$T/p/b/equilibrium.args")" = "--full" ] || fail "bench_equilibrium not run with --full"
 [ "$(cat "$T/p/b/rates.args")" = "--full" ] || fail "bench_mg_rates not run with --full"
 [ "$(grep -c '"bench"' "$res")" -eq 7 ] || fail "results should hold the seven lines: $(cat "$res")"
-head -1 "$res" | grep -q '"machine"' || fail "results should start with the machine"
+head -1 "$res" | grep -q "\"machine\":\"$machine\"" || fail "results should start with the machine: $(head -1 "$res")"
+head -1 "$res" | grep -Eq '"isa":"(avx512|avx2|baseline)"' || fail "the machine line should name the vector extension"
+grep -q "^Measured by .make bench. on .$machine.: .*cores" "$T/p/README.md" || fail "README should name the machine: $(cat "$T/p/README.md")"
 ls -a "$T/p/bench/results" | grep -q '^\.tmp' && fail "scratch file left behind"
 python3 - "$T/p/README.md" <<'PY' || fail "README tables: $(cat "$T/p/README.md")"
 import re, sys
