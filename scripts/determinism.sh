@@ -19,6 +19,8 @@ commands=(
   "settle $T/big.json -o OUT.json --solver symplectic --dt 1e-6 --max-time 1e-5"
   "settle $T/big.json -o OUT.json --solver rk4 --dt 1e-6 --max-time 1e-5"
   "settle $T/big.json -o OUT.json --solver implicit --dt 1e-4 --max-time 2e-4"
+  "settle $T/big.json -o OUT.json --method equilibrium --load 0,0,1e-7"
+  "settle $T/big.json -o OUT.json --method equilibrium --load 0,0,1e-7 --preconditioner multigrid"
   "settle $T/small.json -o OUT.json --solver adaptive --dt 1e-4 --max-time 0.01"
   "settle $T/small.json -o OUT.json --solver implicit --dt 1e-3 --max-time 0.2"
   "build --species araneus --seed 3 --settle --settle-time 0.5 -o OUT.json"

@@ -30,7 +30,7 @@ static void usage(FILE *out)
             "      --rel-tol X       equilibrium: largest net force <= X times the largest spring\n"
             "                        tension at the start, in [0, 1]; default %g (or --tol, in N)\n"
             "      --load FX,FY,FZ   equilibrium: constant force on every free particle [N]; default 0\n"
-            "      --preconditioner NAME  equilibrium: auto, block-jacobi, jacobi, sgs or multigrid\n"
+            "      --preconditioner NAME  equilibrium: auto, block-jacobi, jacobi, sgs, multigrid or cyclic\n"
             "      --solver NAME     euler, symplectic, rk4, adaptive or implicit (kept in OUT)\n"
             "                        (default: the integrator named in FILE)\n"
             "      --dt S            time step [s], in [1e-9, 1]; default %g\n"

@@ -19,6 +19,7 @@
  * Invariant: the world is written only at the end and only with finite values. */
 #include "core/big_alloc.h"
 #include "equilibrium_internal.h"
+#include "fft.h"
 #include "world_internal.h"
 
 #include <math.h>
@@ -48,6 +49,14 @@
  * 3 s with this. A taut web's late, tight solves also take more, but there a
  * new hierarchy did not help (measured at 100k), so they keep it. */
 #define MG_REBUILD_CG 40
+/* The cyclic preconditioner under SPN_PRECOND_AUTO: taken on a lattice web
+ * whose radials' count has no prime factor above CYC_MAX_FACTOR (the
+ * transform's cost), given up for the multigrid when a solve needs
+ * CYC_GIVE_UP iterations. On the standard web it takes 1-3 a Newton step,
+ * 7-15 under a point load of 4-256 T0 (docs/physics-equilibrium.md, "The
+ * cyclic preconditioner"). */
+#define CYC_MAX_FACTOR 13u
+#define CYC_GIVE_UP 60
 #define STALL_LIMIT 5 /* iterations in a row that lower neither energy nor residual */
 /* Hubs: particles spring-joined to more than HUB_MIN_NEIGHBOURS others and to
  * HUB_FACTOR times the mean (the standard web's hub, where every radial ends). Each accepted
@@ -57,7 +66,8 @@
 #define HUB_FACTOR 8.0
 #define HUB_STEPS 3
 
-static const char *const PRECOND_NAMES[SPN_PRECOND_COUNT] = {"jacobi", "block-jacobi", "multigrid", "sgs", "auto"};
+static const char *const PRECOND_NAMES[SPN_PRECOND_COUNT] = {"jacobi", "block-jacobi", "multigrid", "sgs", "auto",
+                                                                   "cyclic"};
 
 const char *spn_precond_name(spn_precond p)
 {
@@ -71,7 +81,7 @@ spn_status spn_precond_parse(const char *name, spn_precond *out)
             *out = (spn_precond)i;
             return SPN_OK;
         }
-    return spn_error(SPN_ERR_INVALID, "unknown preconditioner '%s' (jacobi, block-jacobi, multigrid, sgs or auto)",
+    return spn_error(SPN_ERR_INVALID, "unknown preconditioner '%s' (jacobi, block-jacobi, multigrid, sgs, cyclic or auto)",
                      name ? name : "(null)");
 }
 
@@ -150,6 +160,7 @@ typedef struct newton {
     spn__precond pc;
     double *p, *work;
     uint32_t *hubs, nhubs;
+    bool auto_cyclic; /* cyclic chosen by SPN_PRECOND_AUTO: the multigrid takes over if it does badly */
     double lambda, target, residual, eta, eta_max, energy_change;
     uint32_t worst;
     int max_cg, stalls;
@@ -290,6 +301,16 @@ static double relax_hub(spn__eq *e, uint32_t i)
     return change;
 }
 
+/* The multigrid instead of the cyclic preconditioner from now on (auto). */
+static void to_multigrid(newton *nt)
+{
+    spn__cyc_free(nt->pc.cyc);
+    nt->pc.cyc = NULL;
+    nt->pc.kind = SPN_PRECOND_MULTIGRID;
+    nt->rep.preconditioner = SPN_PRECOND_MULTIGRID;
+    nt->auto_cyclic = false;
+}
+
 /* One Newton iteration. Returns 1 to go on, 0 when stalled. */
 static int newton_iteration(newton *nt)
 {
@@ -307,8 +328,10 @@ static int newton_iteration(newton *nt)
     }
     memset(nt->p, 0, n3 * sizeof *nt->p);
     /* |r|_inf <= |r|_2: a linear residual under half the target is all the step can use */
-    int cg = spn__eq_pcg(e, &nt->pc, nt->p, nt->eta, 0.5 * nt->target, nt->max_cg, nt->work);
+    const int cap = nt->auto_cyclic && nt->max_cg > CYC_GIVE_UP ? CYC_GIVE_UP : nt->max_cg;
+    int cg = spn__eq_pcg(e, &nt->pc, nt->p, nt->eta, 0.5 * nt->target, cap, nt->work);
     nt->rep.cg_iterations += cg > 0 ? cg : 0;
+    if (nt->auto_cyclic && (cg < 0 || cg >= CYC_GIVE_UP)) to_multigrid(nt); /* from the next step on */
     if (nt->pc.kind == SPN_PRECOND_MULTIGRID && (cg < 0 || (cg > MG_REBUILD_CG && nt->lambda > 0))) {
         spn__mg_free(nt->pc.mg);
         nt->pc.mg = NULL;
@@ -362,7 +385,7 @@ static void run(newton *nt, const spn_equilibrium_def *d)
     nt->rep.force_scale = d->force_scale > 0 ? d->force_scale : auto_force_scale(e);
     nt->target = fmax(d->abs_tolerance, d->tolerance * nt->rep.force_scale);
     nt->max_cg = d->max_cg_iterations;
-    bool mg = nt->pc.kind == SPN_PRECOND_MULTIGRID;
+    bool mg = nt->pc.kind == SPN_PRECOND_MULTIGRID || nt->pc.kind == SPN_PRECOND_CYCLIC;
     nt->eta = mg ? ETA0_MG : ETA0;
     nt->eta_max = mg ? ETA_MAX_MG : ETA_MAX;
     nt->residual = spn__eq_assemble(e, 0, &nt->worst);
@@ -419,6 +442,32 @@ static spn_status write_back(newton *nt, spn_world *w, spn_equilibrium_report *r
     return SPN_OK;
 }
 
+/* Resolve SPN_PRECOND_AUTO, and build the cyclic preconditioner's lattice
+ * where it is asked for or chosen. */
+static spn_status choose_preconditioner(newton *nt)
+{
+    const char *why = NULL;
+    if (nt->pc.kind == SPN_PRECOND_CYCLIC) {
+        nt->pc.cyc = spn__cyc_build(&nt->e, &why);
+        if (!nt->pc.cyc)
+            return spn_error(strcmp(why, "out of memory") == 0 ? SPN_ERR_NOMEM : SPN_ERR_INVALID,
+                             "equilibrium: the cyclic preconditioner needs a hub + rings x radials web: %s", why);
+        return SPN_OK;
+    }
+    if (nt->pc.kind != SPN_PRECOND_AUTO) return SPN_OK;
+    nt->pc.cyc = spn__cyc_build(&nt->e, &why);
+    if (nt->pc.cyc && spn__fft_largest_factor(spn__cyc_radials(nt->pc.cyc)) <= CYC_MAX_FACTOR) {
+        nt->pc.kind = SPN_PRECOND_CYCLIC;
+        nt->auto_cyclic = true;
+        return SPN_OK;
+    }
+    spn__cyc_free(nt->pc.cyc);
+    nt->pc.cyc = NULL;
+    /* the crossover measured on the standard web (bench_equilibrium) */
+    nt->pc.kind = nt->e.n < AUTO_MULTIGRID ? SPN_PRECOND_BLOCK_JACOBI : SPN_PRECOND_MULTIGRID;
+    return SPN_OK;
+}
+
 spn_status spn_world_equilibrium(spn_world *w, const spn_equilibrium_def *def, spn_equilibrium_report *report)
 {
     spn_equilibrium_def d = def ? *def : spn_equilibrium_def_default();
@@ -435,8 +484,12 @@ spn_status spn_world_equilibrium(spn_world *w, const spn_equilibrium_def *def, s
         spn__eq_free(&nt.e);
         return spn_error(SPN_ERR_NOMEM, "equilibrium: out of memory");
     }
-    if (nt.pc.kind == SPN_PRECOND_AUTO) /* the crossover measured on the standard web (bench_equilibrium) */
-        nt.pc.kind = nt.e.n < AUTO_MULTIGRID ? SPN_PRECOND_BLOCK_JACOBI : SPN_PRECOND_MULTIGRID;
+    st = choose_preconditioner(&nt);
+    if (st != SPN_OK) {
+        free(nt.hubs);
+        spn__eq_free(&nt.e);
+        return st;
+    }
     nt.rep.preconditioner = nt.pc.kind;
     size_t n3 = 3 * (size_t)(nt.e.n ? nt.e.n : 1);
     nt.p = spn__big_alloc(n3 * sizeof *nt.p);

@@ -16,11 +16,13 @@
 #define SPN__EQ_LANE_SLOTS 8u
 
 typedef struct spn__mg spn__mg;
+typedef struct spn__cyc spn__cyc;
 
 typedef struct spn__eq {
     uint32_t n;        /* free particles: local ids 0..n-1 */
     uint32_t nl;       /* local particles: free, then fixed ones touched by a spring */
     uint32_t *world_id; /* nl: local -> world particle id */
+    uint32_t np_world;  /* the world's particles (the lattice test of equilibrium_cyclic.c) */
     double *x;         /* 3 nl: positions (fixed ones never change) */
     double *fext;      /* 3 n: gravity + load */
     double *xtrial;    /* 3 n: line-search positions */
@@ -122,6 +124,7 @@ typedef struct spn__precond {
     spn_precond kind;
     double *inv; /* 6 n: inverted diagonal blocks (or the diagonal) */
     spn__mg *mg;
+    spn__cyc *cyc; /* SPN_PRECOND_CYCLIC: built by the caller, factored by setup */
 } spn__precond;
 
 spn_status spn__precond_setup(spn__precond *pc, const spn__eq *e);
@@ -179,6 +182,19 @@ uint32_t spn__mg_set_refresh_min(uint32_t free_particles);
 /* Level l of a built hierarchy: its rows, its blocks and its longest row's
  * blocks (for tests and diagnostics); false when there is no level l. */
 bool spn__mg_level(const spn__mg *mg, int l, uint32_t *rows, uint32_t *blocks, uint32_t *longest);
+
+/* Cyclic preconditioner (equilibrium_cyclic.c): the exact solve of the
+ * rotational average of a hub + rings x radials web's system. build: NULL
+ * when the web is not such a lattice (*why says what breaks it) or out of
+ * memory; factor: per Newton step, false when the average is not definite. */
+spn__cyc *spn__cyc_build(const spn__eq *e, const char **why);
+bool spn__cyc_factor(spn__cyc *C, const spn__eq *e);
+void spn__cyc_apply(const spn__cyc *C, const spn__eq *e, const double *r, double *z);
+void spn__cyc_free(spn__cyc *C);
+/* The last factored system's spread about its average: sqrt(sum |X - mean|^2
+ * / sum |X|^2) over its blocks in local frames (0 for a symmetric web). */
+double spn__cyc_asymmetry(const spn__cyc *C);
+uint32_t spn__cyc_radials(const spn__cyc *C);
 
 /* Thread-line smoother (equilibrium_lines.c) over level 0 of the multigrid. */
 typedef struct spn__lines spn__lines;

@@ -44,6 +44,7 @@ spn_status spn__precond_setup(spn__precond *pc, const spn__eq *e)
     }
     if (bad) return SPN_ERR_UNSTABLE; /* a particle without stiffness: the caller shifts the diagonal */
     if (pc->kind == SPN_PRECOND_MULTIGRID) return spn__mg_setup(&pc->mg, e, pc->inv);
+    if (pc->kind == SPN_PRECOND_CYCLIC) return spn__cyc_factor(pc->cyc, e) ? SPN_OK : SPN_ERR_UNSTABLE;
     return SPN_OK;
 }
 
@@ -92,6 +93,10 @@ void spn__precond_apply(const spn__precond *pc, const spn__eq *e, const double *
         spn__mg_apply(pc->mg, e, r, z);
         return;
     }
+    if (pc->kind == SPN_PRECOND_CYCLIC) {
+        spn__cyc_apply(pc->cyc, e, r, z);
+        return;
+    }
     const uint32_t n = e->n;
 #pragma omp parallel for schedule(static) num_threads(team(e))
     for (uint32_t i = 0; i < n; i++) spn__sym_mul(pc->inv + 6 * (size_t)i, r + 3 * (size_t)i, z + 3 * (size_t)i);
@@ -101,8 +106,10 @@ void spn__precond_free(spn__precond *pc)
 {
     free(pc->inv);
     spn__mg_free(pc->mg);
+    spn__cyc_free(pc->cyc);
     pc->inv = NULL;
     pc->mg = NULL;
+    pc->cyc = NULL;
 }
 
 double spn__precond_contraction(const spn__precond *pc, const spn__eq *e, unsigned components, int cycles,
@@ -133,7 +140,7 @@ double spn__precond_contraction(const spn__precond *pc, const spn__eq *e, unsign
 /* z = M^-1 r; returns r . z (block preconditioners fused in one pass). */
 static double precond_dot(const spn__precond *pc, const spn__eq *e, const double *r, double *z)
 {
-    if ((pc->kind == SPN_PRECOND_MULTIGRID && pc->mg) || pc->kind == SPN_PRECOND_SGS) {
+    if ((pc->kind == SPN_PRECOND_MULTIGRID && pc->mg) || pc->kind == SPN_PRECOND_SGS || pc->kind == SPN_PRECOND_CYCLIC) {
         spn__precond_apply(pc, e, r, z);
         return spn__eq_dot(e, r, z);
     }

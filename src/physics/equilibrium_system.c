@@ -102,6 +102,7 @@ static spn_status number_particles(spn__eq *e, const spn_world *w, const spring_
         if (touched[i] && spn_world_is_fixed(w, i)) local[i] = (int32_t)nl++;
     e->n = n;
     e->nl = nl;
+    e->np_world = np;
     e->world_id = spn__big_alloc((nl ? nl : 1) * sizeof *e->world_id);
     e->x = spn__big_alloc(3 * (size_t)(nl ? nl : 1) * sizeof *e->x);
     e->xtrial = spn__big_alloc(3 * (size_t)(nl ? nl : 1) * sizeof *e->xtrial);

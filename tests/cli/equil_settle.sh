@@ -62,4 +62,14 @@ check_usage --rel-tol "$WEB" -o "$O" --method equilibrium --rel-tol -1e-3
 check_usage --load "$WEB" -o "$O" --method equilibrium --load 1,2
 check_usage --load "$WEB" -o "$O" --method equilibrium --load 0,nan,0
 check_usage --preconditioner "$WEB" -o "$O" --method equilibrium --preconditioner cholesky
+# The cyclic preconditioner: taken by auto on a rings x radials web, refused
+# by name on one that is not (exit 1, nothing written).
+"$SPN" export scene:orb:12x24 -o "$T/orb.json" 2>/dev/null || fail "export orb"
+"$SPN" settle "$T/orb.json" -o "$T/orb-rest.json" --method equilibrium --load 0,0,1e-6 2>"$T/err" \
+    || fail "orb settle exited $?: $(cat "$T/err")"
+grep -q 'CG iterations, cyclic)' "$T/err" || fail "auto should take cyclic on the orb web: $(cat "$T/err")"
+"$SPN" settle "$WEB" -o "$O" --method equilibrium --preconditioner cyclic 2>"$T/err"; rc=$?
+[ $rc -eq 1 ] || fail "cyclic on a chain exited $rc, expected 1"
+grep -q 'cyclic preconditioner needs a hub + rings x radials web' "$T/err" || fail "message: $(cat "$T/err")"
+[ -z "$(ls -A "$T/bad")" ] || fail "cyclic on a chain left a file"
 echo "equil_settle ok"
