@@ -122,7 +122,11 @@ static void test_solver_tolerance(void **state)
     assert_non_null(strstr(spn_last_error(), "cg_max_iterations"));
     assert_true(spn_world_get_def(w)->cg_tolerance == 1e-10); /* unchanged by a refused call */
 
+    /* block Jacobi: on this regular web the cyclic preconditioner (auto's
+     * choice) is exact, and CG stops after one iteration at either tolerance */
+    assert_int_equal(spn_world_set_implicit_preconditioner(w, SPN_PRECOND_BLOCK_JACOBI), SPN_OK);
     spn_world *loose = spn_world_clone(w);
+    assert_int_equal(spn_world_set_implicit_preconditioner(loose, SPN_PRECOND_BLOCK_JACOBI), SPN_OK);
     assert_int_equal(spn_world_set_solver_tolerance(loose, 1e-3, 1000), SPN_OK);
     assert_int_equal(spn_world_step(w, 1e-3), SPN_OK);
     assert_int_equal(spn_world_step(loose, 1e-3), SPN_OK);

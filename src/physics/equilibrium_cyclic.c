@@ -63,6 +63,7 @@ struct spn__cyc {
     uint32_t *ring_s; /* Q N: the spring (q, i) -> (q, i + 1) */
     uint32_t *rad_s;  /* Q N: the spring (q, i) -> (q + 1, i), or NONE when ring q + 1 is not the next free one */
     uint32_t *hub_s;  /* N: the spring hub -> (0, i), when hub_coupled */
+    uint32_t *sent;   /* per spring: its adjacency entry at its free end a (matrices kept in e->offd) */
     double base[9];   /* columns e1, e2, n: the frame of radial 0 */
     double *cs, *sn;  /* N: cos, sin of 2 pi i / N */
     /* the averaged blocks (row-major 3x3) */
@@ -114,7 +115,7 @@ static int slot_of(uint32_t n, uint32_t rings, uint32_t a, uint32_t b, int64_t *
 void spn__cyc_free(spn__cyc *C)
 {
     if (!C) return;
-    free(C->node), free(C->ring_s), free(C->rad_s), free(C->hub_s), free(C->cs), free(C->sn);
+    free(C->sent), free(C->node), free(C->ring_s), free(C->rad_s), free(C->hub_s), free(C->cs), free(C->sn);
     free(C->dbar), free(C->gbar), free(C->cbar), free(C->gam), free(C->zhub);
     free(C->zr), free(C->zi), free(C->tr), free(C->ti), free(C->xr), free(C->xi);
     spn__fft_free(C->fft);
@@ -163,28 +164,27 @@ static bool base_frame(spn__cyc *C, const spn__eq *e, uint32_t q)
 spn__cyc *spn__cyc_build(const spn__eq *e, const char **why)
 {
     *why = NULL;
-    const uint32_t np = e->np_world;
     int32_t *loc = NULL;
     spn__cyc *C = NULL;
-    if (np < 4) {
-        *why = "too few particles";
-        return NULL;
-    }
     /* the hub's springs: one per radial */
-    uint32_t hub_l = NONE, N = 0;
-    for (uint32_t l = 0; l < e->nl; l++)
+    uint32_t hub_l = NONE, N = 0, top = 0;
+    for (uint32_t l = 0; l < e->nl; l++) {
         if (e->world_id[l] == 0) hub_l = l;
+        if (e->world_id[l] > top) top = e->world_id[l];
+    }
     if (hub_l == NONE) {
         *why = "particle 0 (the hub) has no spring";
         return NULL;
     }
     for (uint32_t s = 0; s < e->m; s++)
         N += e->sa[s] == hub_l || e->sb[s] == hub_l;
-    if (N < 3 || (np - 1) % N) {
-        *why = "the particles are not a hub and rings of its radials";
+    if (N < 3 || top == 0) {
+        *why = "particle 0 is not a hub of three or more radials";
         return NULL;
     }
-    const uint32_t rings = (np - 1) / N;
+    /* the lattice: particles 1 .. rings N; particles after it without a
+     * spring (a prey body held by contacts) take no part */
+    const uint32_t rings = (top - 1) / N + 1, np = 1 + rings * N;
     loc = malloc(np * sizeof *loc);
     uint8_t *ring_free = calloc(rings, 1), *ring_fixed = calloc(rings, 1);
     uint32_t *qof = malloc(rings * sizeof *qof); /* ring -> free ring index, or NONE */
@@ -279,6 +279,13 @@ spn__cyc *spn__cyc_build(const spn__eq *e, const char **why)
                 *why = "a hub segment is missing";
                 goto fail;
             }
+    if (!(C->sent = malloc((e->m ? e->m : 1) * sizeof *C->sent))) {
+        *why = "out of memory";
+        goto fail;
+    }
+    for (uint32_t i = 0; i < e->n; i++)
+        for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++)
+            if (e->sa[e->adj[j] >> 1] == i) C->sent[e->adj[j] >> 1] = j;
     if (!base_frame(C, e, 0)) {
         *why = "a ring has no plane";
         goto fail;
@@ -338,10 +345,15 @@ static void add_rotated(double *acc, const double *Fa, const double *X, const do
 }
 
 /* -H_s as a full 3x3 */
-static void offdiag(const spn__eq *e, uint32_t s, double *X)
+static void offdiag(const spn__cyc *C, const spn__eq *e, uint32_t s, double *X)
 {
-    double m[9];
-    spn__sym_full(e->hs + 6 * (size_t)s, m);
+    double m[9], tmp[6];
+    spn__sym_full(e->hs ? e->hs + 6 * (size_t)s : spn__eq_offd(e, C->sent[s], tmp), m);
+    if (!e->hs) { /* offd holds the block itself, not H_s */
+        for (int c = 0; c < 9; c++)
+            X[c] = m[c];
+        return;
+    }
     for (int c = 0; c < 9; c++)
         X[c] = -m[c];
 }
@@ -453,14 +465,14 @@ static void ring_means(spn__cyc *C, const spn__eq *e, uint32_t q, double *spread
         for (int c = 0; c < 9; c++)
             D[c] += one[c];
         memset(one, 0, sizeof one);
-        offdiag(e, C->ring_s[(size_t)q * N + i], X);
+        offdiag(C, e, C->ring_s[(size_t)q * N + i], X);
         add_rotated(one, Fi, X, Fn);
         sq += frob2(one);
         for (int c = 0; c < 9; c++)
             G[c] += one[c];
         if (radial) {
             memset(one, 0, sizeof one);
-            offdiag(e, C->rad_s[(size_t)q * N + i], X);
+            offdiag(C, e, C->rad_s[(size_t)q * N + i], X);
             add_rotated(one, Fi, X, Fi);
             sq += frob2(one);
             for (int c = 0; c < 9; c++)
@@ -496,7 +508,7 @@ static void hub_means(spn__cyc *C, const spn__eq *e)
     for (uint32_t i = 0; i < N; i++) {
         double Fi[9], X[9];
         frame(C, i, Fi);
-        offdiag(e, C->hub_s[i], X);
+        offdiag(C, e, C->hub_s[i], X);
         add_rotated(C->hcoup, Fi, X, Fi);
     }
     for (int c = 0; c < 9; c++)
