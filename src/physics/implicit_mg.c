@@ -21,8 +21,8 @@
  * same; each step refreshes level 0 and the line factors only, as the
  * equilibrium solver does between Newton steps. A break, a new fixed point
  * or a recompiled world changes the signature and the hierarchy is rebuilt.
- * On a hub + rings x radials web (the compiled world's lattice) auto, and
- * SPN_PRECOND_CYCLIC, take the cyclic preconditioner (equilibrium_cyclic.c)
+ * On a hub + rings x radials web SPN_PRECOND_CYCLIC, and auto where it
+ * would take the multigrid, take the cyclic preconditioner (equilibrium_cyclic.c)
  * on the same level 0 instead of the V-cycle: the 20k web in a breeze at
  * 1/60 s, 15.2 -> 1.9 CG and 79 -> 13 ms a step (docs/physics-implicit-mg.md).
  * The preconditioner is a fixed linear map within a solve, so CG's result
@@ -186,8 +186,11 @@ static void assemble(spn__imp_mg *m, const spn_world *w, double h)
 
 bool spn__imp_mg_prepare(spn_world *w, double h)
 {
+    /* auto: where the multigrid pays (the cyclic preconditioner instead on a
+     * lattice web); block Jacobi on small webs and short steps, where it
+     * needs few iterations and nothing to set up */
     const bool auto_mg = w->implicit_pc == 0 && w->np >= SPN__IMPLICIT_MG_MIN && h >= SPN__IMPLICIT_MG_DT;
-    const bool want = w->implicit_pc >= 2 || w->implicit_pc == 0;
+    const bool want = w->implicit_pc >= 2 || auto_mg;
     if (!want) return false;
     const uint64_t sig = signature(w);
     if (w->imp_mg && w->imp_mg->sig != sig) {
@@ -195,13 +198,11 @@ bool spn__imp_mg_prepare(spn_world *w, double h)
         w->imp_mg = NULL;
     }
     if (!w->imp_mg) {
-        if (!auto_mg && w->implicit_pc == 0 && !w->lat) return false; /* auto: block Jacobi, no lattice to use */
         if (!(w->imp_mg = create(w))) return false; /* out of memory: block Jacobi does the step */
         w->imp_mg->sig = sig;
     }
     spn__imp_mg *m = w->imp_mg;
     if (m->failed || m->e.n == 0) return false;
-    if (!m->cyc && w->implicit_pc == 0 && !auto_mg) return false; /* auto on a small web or step: block Jacobi */
     assemble(m, w, h);
     if (m->cyc) {
         if (spn__cyc_factor(m->cyc, &m->e)) return true;
