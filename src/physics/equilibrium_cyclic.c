@@ -447,6 +447,16 @@ static inline void herm_mul(const double *g, const double *xr, const double *xi,
 
 /* ---- factoring ---- */
 
+/* sum += Fa^T X Fb; returns that block's |.|_F^2 (for the spread) */
+static double add_local(double *sum, const double *Fa, const double *X, const double *Fb)
+{
+    double one[9] = {0};
+    add_rotated(one, Fa, X, Fb);
+    for (int c = 0; c < 9; c++)
+        sum[c] += one[c];
+    return frob2(one);
+}
+
 /* The averaged blocks of free ring q, and its spread about them. */
 static void ring_means(spn__cyc *C, const spn__eq *e, uint32_t q, double *spread, double *size)
 {
@@ -456,27 +466,16 @@ static void ring_means(spn__cyc *C, const spn__eq *e, uint32_t q, double *spread
     double sq = 0;
     const bool radial = C->rad_s[(size_t)q * N] != NONE;
     for (uint32_t i = 0; i < N; i++) {
-        double Fi[9], Fn[9], X[9], one[9] = {0};
+        double Fi[9], Fn[9], X[9];
         frame(C, i, Fi);
         frame(C, (i + 1) % N, Fn);
         spn__sym_full(e->diag + 6 * (size_t)C->node[(size_t)q * N + i], X);
-        add_rotated(one, Fi, X, Fi);
-        sq += frob2(one);
-        for (int c = 0; c < 9; c++)
-            D[c] += one[c];
-        memset(one, 0, sizeof one);
+        sq += add_local(D, Fi, X, Fi);
         offdiag(C, e, C->ring_s[(size_t)q * N + i], X);
-        add_rotated(one, Fi, X, Fn);
-        sq += frob2(one);
-        for (int c = 0; c < 9; c++)
-            G[c] += one[c];
+        sq += add_local(G, Fi, X, Fn);
         if (radial) {
-            memset(one, 0, sizeof one);
             offdiag(C, e, C->rad_s[(size_t)q * N + i], X);
-            add_rotated(one, Fi, X, Fi);
-            sq += frob2(one);
-            for (int c = 0; c < 9; c++)
-                R[c] += one[c];
+            sq += add_local(R, Fi, X, Fi);
         }
     }
     for (int c = 0; c < 9; c++)
