@@ -447,6 +447,14 @@ static inline void herm_mul(const double *g, const double *xr, const double *xi,
 
 /* ---- factoring ---- */
 
+/* A (row-major 3x3) replaced by (A + A^T) / 2 */
+static void symmetrise(double *A)
+{
+    for (int r = 0; r < 3; r++)
+        for (int c = r + 1; c < 3; c++)
+            A[3 * r + c] = A[3 * c + r] = 0.5 * (A[3 * r + c] + A[3 * c + r]);
+}
+
 /* sum += Fa^T X Fb; returns that block's |.|_F^2 (for the spread) */
 static double add_local(double *sum, const double *Fa, const double *X, const double *Fb)
 {
@@ -481,11 +489,7 @@ static void ring_means(spn__cyc *C, const spn__eq *e, uint32_t q, double *spread
     for (int c = 0; c < 9; c++)
         D[c] /= N, G[c] /= N, R[c] /= N;
     /* symmetric by construction up to rounding: make them exactly so */
-    for (int r = 0; r < 3; r++)
-        for (int c = r + 1; c < 3; c++) {
-            double d = 0.5 * (D[3 * r + c] + D[3 * c + r]), s = 0.5 * (R[3 * r + c] + R[3 * c + r]);
-            D[3 * r + c] = D[3 * c + r] = d, R[3 * r + c] = R[3 * c + r] = s;
-        }
+    symmetrise(D), symmetrise(R);
     *size = sq;
     *spread = sq - N * (frob2(D) + frob2(G) + frob2(R)); /* sum |X - mean|^2 = sum |X|^2 - N |mean|^2 */
 }
@@ -512,9 +516,7 @@ static void hub_means(spn__cyc *C, const spn__eq *e)
     }
     for (int c = 0; c < 9; c++)
         C->hcoup[c] /= N;
-    for (int r = 0; r < 3; r++)
-        for (int c = r + 1; c < 3; c++)
-            C->hcoup[3 * r + c] = C->hcoup[3 * c + r] = 0.5 * (C->hcoup[3 * r + c] + C->hcoup[3 * c + r]);
+    symmetrise(C->hcoup);
 }
 
 /* Block Thomas factors of mode k; false when a pivot is not definite. */
