@@ -4,7 +4,8 @@
 # figures come from the same run), writes bench/results/<machine>.json and
 # the README's generated tables; scripts/bench-table.py reads issue 10's
 # targets off the run's own lines (the 1M equilibrium figure from the
-# process's first solve, not the warm one) and each lattice step's share of
+# process's first solve, not the warm one; a target under the floor that
+# bench_floor measures says so) and each lattice step's share of
 # the triad on as many threads, with the cache a pass fits in. A failing
 # program fails the run and leaves no results file and no scratch file
 # behind.
@@ -39,8 +40,14 @@ EOF
 #!/bin/sh
 echo "$*" >"$(dirname "$0")/rates.args"
 EOF
+    cat >"$T/p/b/bench_floor" <<'EOF'
+#!/bin/sh
+echo '{"bench":"floor","kernel":"spring_step","integrator":"symplectic","ns_per_spring_step":0.9}'
+echo '{"bench":"floor","kernel":"spring_step","integrator":"rk4","ns_per_spring_step":5.5}'
+EOF
     cat >"$T/p/b/bench_step" <<'EOF'
 #!/bin/sh
+echo '{"bench":"step","integrator":"rk4","particles":5001,"threads":1,"path":"lattice","precision":"float64","ns_per_spring_step":20.0}'
 echo '{"bench":"step","integrator":"symplectic","particles":5001,"threads":1,"path":"lattice","precision":"float64","ns_per_spring_step":1.0,"model_bytes_per_spring_step":80.0,"model_gb_per_s":10.0,"pass_mib":0.8}'
 echo '{"bench":"step","integrator":"symplectic","particles":1000001,"threads":2,"path":"lattice","precision":"float64","ns_per_spring_step":4.0,"model_bytes_per_spring_step":20.0,"model_gb_per_s":10.0,"pass_mib":150.0}'
 EOF
@@ -53,7 +60,7 @@ res="$T/p/bench/results/$machine.json"
 [ -f "$res" ] || fail "no results file $res"
 [ "$(cat "$T/p/b/equilibrium.args")" = "--full" ] || fail "bench_equilibrium not run with --full"
 [ "$(cat "$T/p/b/rates.args")" = "--full" ] || fail "bench_mg_rates not run with --full"
-[ "$(grep -c '"bench"' "$res")" -eq 8 ] || fail "results should hold the eight lines: $(cat "$res")"
+[ "$(grep -c '"bench"' "$res")" -eq 11 ] || fail "results should hold the eleven lines: $(cat "$res")"
 head -1 "$res" | grep -q "\"machine\":\"$machine\"" || fail "results should start with the machine: $(head -1 "$res")"
 head -1 "$res" | grep -Eq '"isa":"(avx512|avx2|baseline)"' || fail "the machine line should name the vector extension"
 grep -q "^Measured by .make bench. on .$machine.: .*cores" "$T/p/README.md" || fail "README should name the machine: $(cat "$T/p/README.md")"
@@ -67,7 +74,9 @@ def row(prefix):
     assert len(rows) == 1, (prefix, rows)
     return [c.strip() for c in rows[0].strip("|").split("|")]
 r = row("explicit (symplectic) step, 5k")
-assert r[1] == "≤ 1.2" and r[2] == "1" and r[4] == "yes", r
+assert r[1] == "≤ 1.2" and r[2] == "1" and r[4] == "yes" and "floor (bench_floor) 0.9" in r[3], r
+r = row("RK4 step, 5k")   # a target under the machine's floor says so
+assert r[2] == "20" and r[4] == "no, and the target is under this machine's floor", r
 r = row("explicit step, 1M")
 assert r[2] == "4" and r[4] == "no", r
 r = row("static equilibrium, 1M")   # the cold cyclic solve; the warm one and the multigrid's beside it
