@@ -10,7 +10,10 @@ date), then one line per figure, each with a "bench" key. Known
 benches get a table with chosen columns; any other bench gets a table of all
 its keys, so a new benchmark shows up without editing this script. With
 --readme, the text between the markers <!-- bench-table:begin --> and
-<!-- bench-table:end --> is replaced (written atomically)."""
+<!-- bench-table:end --> is replaced (written atomically). When the
+results folder holds other machines' files, issue 10's targets are also
+set side by side for each of them."""
+import glob
 import json
 import os
 import sys
@@ -124,6 +127,32 @@ def targets(lines):
     return "\n".join(out) + "\n" if len(out) > 4 else ""
 
 
+def machines_table(paths):
+    """Issue 10's targets on every machine with a results file beside this
+    one (bench/results/*.json): the same guest has run on more than one
+    processor, and a figure from one must not be read against another."""
+    runs = []
+    for path in sorted(paths):
+        with open(path) as f:
+            lines = [json.loads(s) for s in f if s.strip()]
+        machine = next((l for l in lines if "bench" not in l), {})
+        isa = {"avx512": "AVX-512", "avx2": "AVX2", "baseline": "no AVX2"}.get(machine.get("isa"), "")
+        runs.append((f"`{machine.get('machine', os.path.basename(path))}` "
+                     f"({', '.join(x for x in (isa, machine.get('date', '')) if x)})", lines))
+    if len(runs) < 2:
+        return ""
+    out = ["**Issue 10's targets on each machine measured (each a whole `make bench` run)**", "",
+           "| figure | target | " + " | ".join(name for name, _ in runs) + " |",
+           "|---|---:|" + "---:|" * len(runs)]
+    for name, limit, rule, key, _ in TARGETS:
+        vals = [next((l[key] for l in lines if rule(l) and key in l), None) for _, lines in runs]
+        if all(v is None for v in vals):
+            continue
+        out.append(f"| {name} | ≤ {cell(limit)} | " + " | ".join(
+            "" if v is None else f"{cell(v)} ({'met' if v <= limit else 'not met'})" for v in vals) + " |")
+    return "\n".join(out) + "\n"
+
+
 def bandwidth_table(rows):
     """Each lattice step's unavoidable traffic (bench_step's model: a pass
     reads the state, masses and spring slots once and writes the state once)
@@ -194,7 +223,8 @@ def render(path):
            f"{f' ({hardware})' if hardware else ''}, "
            f"{machine.get('cores', '?')} cores, {machine.get('date', '?')} "
            f"(results: `{os.path.relpath(path)}`; tables made by `scripts/bench-table.py`).", ""]
-    for extra in (targets(lines), bandwidth_table(lines)):
+    others = glob.glob(os.path.join(os.path.dirname(os.path.abspath(path)), "*.json"))
+    for extra in (targets(lines), machines_table(set(others) | {os.path.abspath(path)}), bandwidth_table(lines)):
         if extra:
             out.append(extra)
     for name in list(KNOWN) + sorted(set(groups) - set(KNOWN)):
