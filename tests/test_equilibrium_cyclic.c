@@ -181,8 +181,20 @@ static void test_auto_takes_it_on_lattices_only(void **state)
     assert_int_equal(spn_world_equilibrium(w, &d, &r), SPN_OK);
     assert_int_equal(r.preconditioner, SPN_PRECOND_CYCLIC);
     spn_world_destroy(w);
-    /* 17 radials: a prime the transform would take by a direct DFT */
-    w = orb(20, 17, 1);
+    /* 17 and 997 radials: primes the transform takes by a direct DFT, which
+     * still pays (auto takes it) */
+    const int primes[2] = {17, 997};
+    for (int k = 0; k < 2; k++) {
+        w = orb(k ? 3 : 20, primes[k], 1);
+        d = loaded(w, SPN_PRECOND_AUTO, &t0);
+        assert_int_equal(spn_world_equilibrium(w, &d, &r), SPN_OK);
+        assert_int_equal(r.preconditioner, SPN_PRECOND_CYCLIC);
+        assert_int_equal(r.reason, SPN_EQUILIBRIUM_CONVERGED);
+        spn_world_destroy(w);
+    }
+    /* 1,009 radials: a prime factor past what was measured, so auto leaves it */
+    w = orb(3, 1009, 1);
+    d = loaded(w, SPN_PRECOND_AUTO, &t0);
     assert_int_equal(spn_world_equilibrium(w, &d, &r), SPN_OK);
     assert_int_not_equal(r.preconditioner, SPN_PRECOND_CYCLIC);
     assert_int_equal(r.reason, SPN_EQUILIBRIUM_CONVERGED);

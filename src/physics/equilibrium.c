@@ -51,11 +51,18 @@
 #define MG_REBUILD_CG 40
 /* The cyclic preconditioner under SPN_PRECOND_AUTO: taken on a lattice web
  * whose radials' count has no prime factor above CYC_MAX_FACTOR (the
- * transform's cost), given up for the multigrid when a solve needs
- * CYC_GIVE_UP iterations. On the standard web it takes 1-3 a Newton step,
- * 7-15 under a point load of 4-256 T0 (docs/physics-equilibrium.md, "The
- * cyclic preconditioner"). */
-#define CYC_MAX_FACTOR 13u
+ * transform does a prime factor p by a direct DFT, p operations an
+ * element), given up for the multigrid when a solve needs CYC_GIVE_UP
+ * iterations. On the standard web it takes 1-3 a Newton step, 7-15 under a
+ * point load of 4-256 T0 (docs/physics-equilibrium.md, "The cyclic
+ * preconditioner"). The limit is as far as measured: with a prime radial
+ * count the whole settle still took a third to a fifth of the multigrid's
+ * time at 40 x 79, 127, 251, 509 and 997 and at 200 x 997 (3 or 4 CG
+ * iterations against 16-38); 1,000 radials is also the command line's
+ * largest web. (It was 13 until the nineteenth session, which left the 100k
+ * standard web, 316 = 4 x 79 radials, on the multigrid: 1.23 s against
+ * 0.18.) */
+#define CYC_MAX_FACTOR 1000u
 #define CYC_GIVE_UP 60
 #define STALL_LIMIT 5 /* iterations in a row that lower neither energy nor residual */
 /* Hubs: particles spring-joined to more than HUB_MIN_NEIGHBOURS others and to
