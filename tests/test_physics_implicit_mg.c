@@ -5,7 +5,9 @@
  * 2. the same with a prey particle held by contacts, and after a spring breaks
  *    between steps (the hierarchy rebuilt for the new spring set);
  * 3. 1 vs 2 threads give bit-identical states;
- * 4. preconditioners the step does not have are refused, naming the choices. */
+ * 4. preconditioners the step does not have are refused, naming the choices;
+ * 5. auto at short steps on a big web: the cyclic preconditioner on a rings
+ *    x radials web, block Jacobi (bit for bit) on one that is no lattice. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -89,6 +91,54 @@ static void test_cyclic_matches_block_jacobi(void **state)
     compare(SPN_PRECOND_CYCLIC, BREAK);
 }
 
+/* auto at a short step (dt 1e-4 s, where the multigrid does not pay) on a
+ * web of 5,001 particles: a rings x radials web takes the cyclic
+ * preconditioner (block Jacobi needs some 150 iterations a step there);
+ * the same web with a spring broken is no lattice and gets block Jacobi,
+ * bit for bit. `broken`: break spring 1200 first. */
+static spn_vec3 *short_steps(spn_precond pc, bool broken, long *cg)
+{
+    spn_world_def wd = spn_world_def_default();
+    wd.integrator = SPN_INTEGRATOR_IMPLICIT;
+    spn_orb_scene_def od = spn_orb_scene_def_default();
+    od.rings = 40, od.radials = 125;
+    spn_world *w = NULL;
+    assert_int_equal(spn_scene_orb(&wd, &od, &w), SPN_OK);
+    assert_int_equal(spn_world_set_implicit_preconditioner(w, pc), SPN_OK);
+    assert_int_equal(spn_world_set_solver_tolerance(w, 1e-10, 1000), SPN_OK);
+    if (broken) spn_world_break_spring(w, 1200);
+    *cg = 0;
+    for (int i = 0; i < 3; i++) {
+        assert_int_equal(spn_world_step(w, 1e-4), SPN_OK);
+        *cg += spn_world_last_step(w).cg_iterations;
+    }
+    return util_take_state(w);
+}
+
+static void test_auto_at_short_steps(void **state)
+{
+    (void)state;
+    const uint32_t n = spn_orb_scene_particles(40, 125);
+    long cg_auto, cg_bj;
+    spn_vec3 *a = short_steps(SPN_PRECOND_AUTO, false, &cg_auto),
+             *b = short_steps(SPN_PRECOND_BLOCK_JACOBI, false, &cg_bj);
+    double dv = 0, vmax = 0;
+    for (uint32_t i = n; i < 2 * n; i++) {
+        dv = fmax(dv, spn_v3_len(spn_v3_sub(a[i], b[i])));
+        vmax = fmax(vmax, spn_v3_len(b[i]));
+    }
+    print_message("lattice, dt 1e-4: CG %ld (auto) vs %ld (block Jacobi); max |dv| %.2e of %.2e\n", cg_auto, cg_bj, dv,
+                  vmax);
+    assert_true(vmax > 0);
+    assert_true(dv <= 1e-6 * vmax);
+    assert_true(cg_auto * 10 < cg_bj);
+    free(a), free(b);
+    a = short_steps(SPN_PRECOND_AUTO, true, &cg_auto), b = short_steps(SPN_PRECOND_BLOCK_JACOBI, true, &cg_bj);
+    assert_int_equal(cg_auto, cg_bj);
+    assert_memory_equal(a, b, 2 * n * sizeof *a);
+    free(a), free(b);
+}
+
 static void test_threads_bit_identical(void **state)
 {
     (void)state;
@@ -113,9 +163,13 @@ static void test_refused(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_matches_block_jacobi), cmocka_unit_test(test_contact), cmocka_unit_test(test_break),
-        cmocka_unit_test(test_threads_bit_identical), cmocka_unit_test(test_refused),
+        cmocka_unit_test(test_matches_block_jacobi),
+        cmocka_unit_test(test_contact),
+        cmocka_unit_test(test_break),
+        cmocka_unit_test(test_threads_bit_identical),
+        cmocka_unit_test(test_refused),
         cmocka_unit_test(test_cyclic_matches_block_jacobi),
+        cmocka_unit_test(test_auto_at_short_steps),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -37,8 +37,8 @@ SPN_API const char *spn_precond_name(spn_precond p);
 /// The implicit step's CG preconditioner: SPN_PRECOND_BLOCK_JACOBI, SPN_PRECOND_MULTIGRID
 /// (the hierarchy is kept across steps while no spring breaks), SPN_PRECOND_CYCLIC (a hub +
 /// rings x radials web's rotational average solved exactly; the multigrid on other webs) or
-/// SPN_PRECOND_AUTO (the default: from 4,096 particles at steps of 5 ms and up the cyclic
-/// preconditioner on such a web, the multigrid on others; block Jacobi below that). Results agree to the
+/// SPN_PRECOND_AUTO (the default: from 4,096 particles the cyclic preconditioner on such a web at
+/// any step, the multigrid on others at steps of 5 ms and up; block Jacobi otherwise). Results agree to the
 /// solver tolerance; a clone of a world mid-run continues within it, not bit for bit
 /// (the clone builds its hierarchy afresh).
 SPN_API spn_status spn_world_set_implicit_preconditioner(spn_world *w, spn_precond p);

@@ -21,8 +21,8 @@
  * same; each step refreshes level 0 and the line factors only, as the
  * equilibrium solver does between Newton steps. A break, a new fixed point
  * or a recompiled world changes the signature and the hierarchy is rebuilt.
- * On a hub + rings x radials web SPN_PRECOND_CYCLIC, and auto where it
- * would take the multigrid, take the cyclic preconditioner (equilibrium_cyclic.c)
+ * On a hub + rings x radials web SPN_PRECOND_CYCLIC, and auto from
+ * SPN__IMPLICIT_MG_MIN particles at any step, take the cyclic preconditioner (equilibrium_cyclic.c)
  * on the same level 0 instead of the V-cycle: the 20k web in a breeze at
  * 1/60 s, 15.2 -> 1.9 CG and 79 -> 13 ms a step (docs/physics-implicit-mg.md).
  * The preconditioner is a fixed linear map within a solve, so CG's result
@@ -187,10 +187,15 @@ static void assemble(spn__imp_mg *m, const spn_world *w, double h)
 bool spn__imp_mg_prepare(spn_world *w, double h)
 {
     /* auto: where the multigrid pays (the cyclic preconditioner instead on a
-     * lattice web); block Jacobi on small webs and short steps, where it
-     * needs few iterations and nothing to set up */
-    const bool auto_mg = w->implicit_pc == 0 && w->np >= SPN__IMPLICIT_MG_MIN && h >= SPN__IMPLICIT_MG_DT;
-    const bool want = w->implicit_pc >= 2 || auto_mg;
+     * lattice web); on a big lattice web (w->lat: numbered as the cyclic
+     * preconditioner reads it) the cyclic preconditioner at short steps too,
+     * where block Jacobi still needs hundreds of iterations (dt 1e-4 s:
+     * 158, 614 and 1,000 on the 5k, 100k and 1M webs, the cyclic 2); block
+     * Jacobi on small webs and on short steps of other webs, where it needs
+     * few iterations and nothing to set up */
+    const bool auto_big = w->implicit_pc == 0 && w->np >= SPN__IMPLICIT_MG_MIN;
+    const bool auto_mg = auto_big && h >= SPN__IMPLICIT_MG_DT;
+    const bool want = w->implicit_pc >= 2 || auto_mg || (auto_big && w->lat);
     if (!want) return false;
     const uint64_t sig = signature(w);
     if (w->imp_mg && w->imp_mg->sig != sig) {
@@ -203,6 +208,7 @@ bool spn__imp_mg_prepare(spn_world *w, double h)
     }
     spn__imp_mg *m = w->imp_mg;
     if (m->failed || m->e.n == 0) return false;
+    if (w->implicit_pc == 0 && !auto_mg && !m->cyc) return false; /* a short step without the cyclic one */
     assemble(m, w, h);
     if (m->cyc) {
         if (spn__cyc_factor(m->cyc, &m->e)) return true;
