@@ -12,6 +12,7 @@
 #include "world_internal.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <string.h>
 
 /* Per-band sums: elastic energy, spring damping power, sum m v^2 at the
@@ -109,10 +110,12 @@ typedef struct lat_args {
 } lat_args;
 
 #define LK_T double
+#define LK_U uint64_t
 #define LK(name) name##64
 #define LK_SCRATCH 0
 #include "lattice_rows_t.h"
 #undef LK_SCRATCH
+#undef LK_U
 #undef LK
 #undef LK_T
 
@@ -195,7 +198,7 @@ LAT_INLINE void springs(uint32_t n, const double *restrict axp, const double *re
         const bool on = len > 0 && !(stretch < 0 && rs < 0);
         const double inv = on ? 1 / len : 0;
         const double rate = (ux * lx + uy * ly + uz * lz) * inv;
-        const double k = on ? kk[j] : 0, kd = kkd[j];
+        const double k = pick64(on, kk[j], 0), kd = kkd[j];
         const double mag = k * stretch + kd * rate;
         const double s = -mag * inv;
         ce[j] += 0.5 * k * stretch * stretch;

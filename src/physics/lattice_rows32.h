@@ -13,10 +13,12 @@
 #include <math.h>
 
 #define LK_T float
+#define LK_U uint32_t
 #define LK(name) name##32
 #define LK_SCRATCH 1
 #include "lattice_rows_t.h"
 #undef LK_SCRATCH
+#undef LK_U
 #undef LK
 #undef LK_T
 
@@ -41,7 +43,7 @@ LAT_INLINE void springs32(uint32_t n, const float *restrict dax, const float *re
         const bool on = len > 0 && !(stretch < 0 && rs < 0);
         const float inv = on ? 1.0f / len : 0.0f;
         const float rate = (ux * lx + uy * ly + uz * lz) * inv;
-        const float k = on ? kk[j] : 0.0f, kd = kkd[j];
+        const float k = pick32(on, kk[j], 0.0f), kd = kkd[j];
         const float s = -(k * stretch + kd * rate) * inv;
         e[j] = 0.5f * k * stretch * stretch;
         p[j] = kd * rate * rate;
