@@ -236,13 +236,14 @@ static void hub(const lat_args *a, double *const *rad, const lat_cols *cs)
 }
 
 /* The sweep (lattice_sweep_t.h) on the float64 state. */
-LAT_INLINE void radials64(const lat_args *a, double *const *Xa, double *const *Va, double *const *Xb,
-                          double *const *Vb, uint32_t j, double *const *f, const lat_cols *cs)
+LAT_INLINE void radials64(const lat_args *a, double *const *Xa, double *const *Va, double *const *Xb, double *const *Vb,
+                          uint32_t j, double *const *f, const lat_cols *cs)
 {
     const spn__lattice *L = a->L;
     const size_t s0 = (size_t)j * L->radials;
     springs_rows(L->radials, (const double *const *)Xa, (const double *const *)Va, (const double *const *)Xb,
-                 (const double *const *)Vb, 0, 0, L->rk + s0, L->rkd + s0, L->rrest + s0, f, 0, cs);
+                 (const double *const *)Vb, 0, 0, L->rk + s0, L->rkd + s0, L->rrest + s0, f, 0, cs,
+                 wants_elastic(a->mode, a->first));
 }
 
 LAT_INLINE void rings64(const lat_args *a, double *const *X, double *const *V, uint32_t j, double *const *f,
@@ -252,9 +253,10 @@ LAT_INLINE void rings64(const lat_args *a, double *const *X, double *const *V, u
     const uint32_t n = L->radials;
     const size_t s0 = (size_t)j * n;
     const double *const *cX = (const double *const *)X, *const *cV = (const double *const *)V;
-    springs_rows(n - 1, cX, cV, cX, cV, 0, 1, L->gk + s0, L->gkd + s0, L->grest + s0, f, 0, cs);
-    springs_rows(1, cX, cV, cX, cV, 0, n - 1, L->gk + s0 + n - 1, L->gkd + s0 + n - 1, L->grest + s0 + n - 1, f,
-                 n - 1, cs);
+    const bool el = wants_elastic(a->mode, a->first);
+    springs_rows(n - 1, cX, cV, cX, cV, 0, 1, L->gk + s0, L->gkd + s0, L->grest + s0, f, 0, cs, el);
+    springs_rows(1, cX, cV, cX, cV, 0, n - 1, L->gk + s0 + n - 1, L->gkd + s0 + n - 1, L->grest + s0 + n - 1, f, n - 1,
+                 cs, el);
 }
 
 LAT_INLINE void hub_state64(const lat_args *a, double *x, double *v)

@@ -146,8 +146,8 @@ LAT_INLINE void radials32(const a32 *a, float *const *Da, float *const *Ua, floa
                           uint32_t j, float *const *f, const lat_cols *cs)
 {
     const spn__lat32 *F = a->F;
-    spring_rows(a->L->radials, Da, Ua, Db, Ub, (float *const *)F->rl, (size_t)j * a->L->radials, F->rk, F->rkd,
-                F->rr, f, 0, cs);
+    spring_rows(a->L->radials, Da, Ua, Db, Ub, (float *const *)F->rl, (size_t)j * a->L->radials, F->rk, F->rkd, F->rr,
+                f, 0, cs, wants_elastic(a->mode, a->first));
 }
 
 LAT_INLINE void rings32(const a32 *a, float *const *D, float *const *U, uint32_t j, float *const *f,
@@ -158,8 +158,9 @@ LAT_INLINE void rings32(const a32 *a, float *const *D, float *const *U, uint32_t
     const size_t s0 = (size_t)j * n;
     float *D1[3], *U1[3], *Dl[3], *Ul[3]; /* the row from its second and its last particle */
     for (int c = 0; c < 3; c++) D1[c] = D[c] + 1, U1[c] = U[c] + 1, Dl[c] = D[c] + n - 1, Ul[c] = U[c] + n - 1;
-    spring_rows(n - 1, D, U, D1, U1, (float *const *)F->gl, s0, F->gk, F->gkd, F->gr, f, 0, cs);
-    spring_rows(1, D, U, Dl, Ul, (float *const *)F->gl, s0 + n - 1, F->gk, F->gkd, F->gr, f, n - 1, cs);
+    const bool el = wants_elastic(a->mode, a->first);
+    spring_rows(n - 1, D, U, D1, U1, (float *const *)F->gl, s0, F->gk, F->gkd, F->gr, f, 0, cs, el);
+    spring_rows(1, D, U, Dl, Ul, (float *const *)F->gl, s0 + n - 1, F->gk, F->gkd, F->gr, f, n - 1, cs, el);
 }
 
 LAT_INLINE void hub_state32(const a32 *a, float *x, float *v)

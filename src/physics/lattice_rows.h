@@ -176,11 +176,12 @@ LAT_INLINE void store_band_sums(double *out, bool first, const lat_cols *cs, uin
 }
 
 /* Springs j = 0..n-1 from (a[j]) to (b[j]), SoA: force on end a into f, the
- * elastic energy and damping power added into the sum columns ce, cp. The arithmetic of chunk_forces
+ * elastic energy (when `elastic`, a constant in each call) and damping power
+ * added into the sum columns ce, cp. The arithmetic of chunk_forces
  * (same bits): a spring is off (no force) at zero length or when slack and
  * tension-only, and then 1/len is replaced by 0 and k by 0, which is what
  * chunk_forces' 0/1 factors give, with selects instead of products. */
-LAT_INLINE void springs(uint32_t n, const double *restrict axp, const double *restrict ayp,
+LAT_INLINE void springs(bool elastic, uint32_t n, const double *restrict axp, const double *restrict ayp,
                         const double *restrict azp, const double *restrict bxp, const double *restrict byp,
                         const double *restrict bzp, const double *restrict avx, const double *restrict avy,
                         const double *restrict avz, const double *restrict bvx, const double *restrict bvy,
@@ -201,22 +202,34 @@ LAT_INLINE void springs(uint32_t n, const double *restrict axp, const double *re
         const double k = pick64(on, kk[j], 0), kd = kkd[j];
         const double mag = k * stretch + kd * rate;
         const double s = -mag * inv;
-        ce[j] += 0.5 * k * stretch * stretch;
+        if (elastic) ce[j] += 0.5 * k * stretch * stretch;
         cp[j] += kd * rate * rate;
         fx[j] = s * lx, fy[j] = s * ly, fz[j] = s * lz;
     }
 }
 
+/* Whether a sweep or a level of a blocked pass sums the springs' elastic
+ * energy: RK4 reads it from its first stage only (lat_rk4_result), so its
+ * other three stages leave it out (their L_ELASTIC sums stay 0). */
+LAT_INLINE bool wants_elastic(int mode, bool first)
+{
+    return first || (mode != MODE_RK4_STAGE && mode != MODE_RK4_LAST);
+}
+
 /* Springs from rows a to b of a state (3 arrays each, offsets off_a,
  * off_b) with parameters k, kd, rest, forces into f and sums into the
- * columns cs, both at off_f. */
+ * columns cs, both at off_f (the elastic energy if `elastic`). */
 LAT_INLINE void springs_rows(uint32_t n, const double *const *ax, const double *const *av, const double *const *bx,
                              const double *const *bv, size_t off_a, size_t off_b, const double *k, const double *kd,
-                             const double *rest, double *const *f, size_t off_f, const lat_cols *cs)
+                             const double *rest, double *const *f, size_t off_f, const lat_cols *cs, bool elastic)
 {
-    springs(n, ax[0] + off_a, ax[1] + off_a, ax[2] + off_a, bx[0] + off_b, bx[1] + off_b, bx[2] + off_b,
-            av[0] + off_a, av[1] + off_a, av[2] + off_a, bv[0] + off_b, bv[1] + off_b, bv[2] + off_b, k, kd, rest,
-            f[0] + off_f, f[1] + off_f, f[2] + off_f, cs->c[L_ELASTIC] + off_f, cs->c[L_DAMP] + off_f);
+#define LAT_SPRINGS(elastic)                                                                                           \
+    springs(elastic, n, ax[0] + off_a, ax[1] + off_a, ax[2] + off_a, bx[0] + off_b, bx[1] + off_b, bx[2] + off_b,      \
+            av[0] + off_a, av[1] + off_a, av[2] + off_a, bv[0] + off_b, bv[1] + off_b, bv[2] + off_b, k, kd, rest,     \
+            f[0] + off_f, f[1] + off_f, f[2] + off_f, cs->c[L_ELASTIC] + off_f, cs->c[L_DAMP] + off_f)
+    if (elastic) LAT_SPRINGS(true);
+    else LAT_SPRINGS(false);
+#undef LAT_SPRINGS
 }
 
 /* An Euler or symplectic step's results from its sweep's sums. */

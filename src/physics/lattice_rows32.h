@@ -23,9 +23,10 @@
 #undef LK_T
 
 /* Springs j = 0..n-1 from a to b: chunk.h's expression in float32, the
- * difference as L + (d_a - d_b); force on end a into f, energy and damping
- * power into e, p (float32 scratch). */
-LAT_INLINE void springs32(uint32_t n, const float *restrict dax, const float *restrict day,
+ * difference as L + (d_a - d_b); force on end a into f, elastic energy
+ * (when `elastic`, a constant in each call) and damping power into e, p
+ * (float32 scratch). */
+LAT_INLINE void springs32(bool elastic, uint32_t n, const float *restrict dax, const float *restrict day,
                           const float *restrict daz, const float *restrict dbx, const float *restrict dby,
                           const float *restrict dbz, const float *restrict uax, const float *restrict uay,
                           const float *restrict uaz, const float *restrict ubx, const float *restrict uby,
@@ -45,22 +46,30 @@ LAT_INLINE void springs32(uint32_t n, const float *restrict dax, const float *re
         const float rate = (ux * lx + uy * ly + uz * lz) * inv;
         const float k = pick32(on, kk[j], 0.0f), kd = kkd[j];
         const float s = -(k * stretch + kd * rate) * inv;
-        e[j] = 0.5f * k * stretch * stretch;
+        if (elastic) e[j] = 0.5f * k * stretch * stretch;
         p[j] = kd * rate * rate;
         fx[j] = s * lx, fy[j] = s * ly, fz[j] = s * lz;
     }
 }
 
 /* Springs between rows (3 arrays each, already offset) a and b; forces
- * into f and sums into the columns cs, both at off_f. */
+ * into f and sums into the columns cs, both at off_f (the elastic energy
+ * if `elastic`: wants_elastic in lattice_rows.h). */
 LAT_INLINE void spring_rows(uint32_t n, float *const *da, float *const *ua, float *const *db, float *const *ub,
                             float *const *L, size_t s0, const float *k, const float *kd, const float *rest,
-                            float *const *f, size_t off_f, const lat_cols *cs)
+                            float *const *f, size_t off_f, const lat_cols *cs, bool elastic)
 {
-    springs32(n, da[0], da[1], da[2], db[0], db[1], db[2], ua[0], ua[1], ua[2], ub[0], ub[1], ub[2], L[0] + s0,
-              L[1] + s0, L[2] + s0, k + s0, kd + s0, rest + s0, f[0] + off_f, f[1] + off_f, f[2] + off_f,
-              cs->scr[L_ELASTIC], cs->scr[L_DAMP]);
-    col_addf(cs->c[L_ELASTIC], cs->scr[L_ELASTIC], n);
+#define LAT_SPRINGS(elastic)                                                                                           \
+    springs32(elastic, n, da[0], da[1], da[2], db[0], db[1], db[2], ua[0], ua[1], ua[2], ub[0], ub[1], ub[2],          \
+              L[0] + s0, L[1] + s0, L[2] + s0, k + s0, kd + s0, rest + s0, f[0] + off_f, f[1] + off_f, f[2] + off_f,   \
+              cs->scr[L_ELASTIC], cs->scr[L_DAMP])
+    if (elastic) {
+        LAT_SPRINGS(true);
+        col_addf(cs->c[L_ELASTIC], cs->scr[L_ELASTIC], n);
+    } else {
+        LAT_SPRINGS(false);
+    }
+#undef LAT_SPRINGS
     col_addf(cs->c[L_DAMP], cs->scr[L_DAMP], n);
 }
 
