@@ -78,74 +78,75 @@ def _floor(integ):
     return lambda r: r.get("bench") == "floor" and r.get("kernel") == "spring_step" and r.get("integrator") == integ
 
 
+# (figure, target, rule, key, beside, floor): floor the rule of bench_floor's
+# line for the figure, or None.
 TARGETS = [
     ("explicit (symplectic) step, 5k web, float64, ns per spring-step", 1.2, _step("symplectic", 5001, 1),
      "ns_per_spring_step", [("float32", _step("symplectic", 5001, 1, "float32"), "ns_per_spring_step"),
-                            ("two threads", _step("symplectic", 5001, 2), "ns_per_spring_step"),
-                            (FLOOR + " (bench_floor)", _floor("symplectic"),
-                             "ns_per_spring_step")]),
+                            ("two threads", _step("symplectic", 5001, 2), "ns_per_spring_step")],
+     _floor("symplectic")),
     ("explicit step, 1M web, float64, 2 threads, ns per spring-step (wall)", 3.5, _step("symplectic", 1000001, 2),
      "ns_per_spring_step", [("one thread", _step("symplectic", 1000001, 1), "ns_per_spring_step"),
-                            ("float32", _step("symplectic", 1000001, 2, "float32"), "ns_per_spring_step")]),
+                            ("float32", _step("symplectic", 1000001, 2, "float32"), "ns_per_spring_step")], None),
     ("RK4 step, 5k web, ns per spring-step", 5, _step("rk4", 5001, 1), "ns_per_spring_step",
-     [("float32", _step("rk4", 5001, 1, "float32"), "ns_per_spring_step"),
-      (FLOOR + " (bench_floor)", _floor("rk4"), "ns_per_spring_step")]),
+     [("float32", _step("rk4", 5001, 1, "float32"), "ns_per_spring_step")], _floor("rk4")),
     ("RK4 step, 1M web, 2 threads, ns per spring-step (wall)", 12, _step("rk4", 1000001, 2), "ns_per_spring_step",
      [("one thread", _step("rk4", 1000001, 1), "ns_per_spring_step"),
-      ("float32", _step("rk4", 1000001, 2, "float32"), "ns_per_spring_step")]),
+      ("float32", _step("rk4", 1000001, 2, "float32"), "ns_per_spring_step")], None),
     ("static equilibrium, 5k web, 1e-6 T0, s (fastest of ten solves; cyclic, what auto takes)", 0.020,
      _equilibrium("orb-5k", 1), "seconds",
      [("first solve in the process, CPU", _equilibrium("orb-5k", 1), "cpu_first_seconds"),
-      ("multigrid", _equilibrium("orb-5k", 1, precond="multigrid"), "seconds")]),
+      ("multigrid", _equilibrium("orb-5k", 1, precond="multigrid"), "seconds")], None),
     ("static equilibrium, 1M web, 1e-6 T0, 2 threads, s (wall; the process's first solve; cyclic)", 5,
      _equilibrium("orb-1M", 2, cold=True), "seconds",
      [("the same after another 1M solve", _equilibrium("orb-1M", 2, cold=False), "seconds"),
       ("one thread", _equilibrium("orb-1M", 1), "seconds"),
-      ("multigrid, after the cyclic solves", _equilibrium("orb-1M", 2, precond="multigrid"), "seconds")]),
+      ("multigrid, after the cyclic solves", _equilibrium("orb-1M", 2, precond="multigrid"), "seconds")], None),
 ]
+
+
+def value(lines, rule, key):
+    """The first of a run's lines that the rule takes, its key; None if none."""
+    return next((l[key] for l in lines if rule(l) and key in l), None)
 
 
 def targets(lines):
     """Issue 10's table against this run: each figure, its target and
     whether this run met it, with the figures beside it (other precisions,
-    thread counts, a cold or warm process)."""
-    def pick(rule, key):
-        hits = [l[key] for l in lines if rule(l) and key in l]
-        return hits[0] if hits else None
+    thread counts, a cold or warm process, the machine's floor)."""
     out = ["**Issue 10's targets against this run**", "",
            "| figure | target | this run | beside it | met |", "|---|---:|---:|---|---|"]
-    for name, limit, rule, key, beside in TARGETS:
-        v = pick(rule, key)
+    for name, limit, rule, key, beside, floor_rule in TARGETS:
+        v = value(lines, rule, key)
         if v is None:
             continue
-        side = "; ".join(f"{label} {cell(b)}" for label, r2, k2 in beside for b in [pick(r2, k2)] if b is not None)
-        floor = next((b for label, r2, k2 in beside if label.startswith(FLOOR) for b in [pick(r2, k2)]
-                      if b is not None), None)
+        floor = value(lines, floor_rule, "ns_per_spring_step") if floor_rule else None
+        side = [(label, value(lines, r2, k2)) for label, r2, k2 in beside] + [(FLOOR + " (bench_floor)", floor)]
+        side = "; ".join(f"{label} {cell(b)}" for label, b in side if b is not None)
         met = "yes" if v <= limit else "no, and the target is under this machine's floor" \
             if floor is not None and floor > limit else "no"
         out.append(f"| {name} | ≤ {cell(limit)} | {cell(v)} | {side} | {met} |")
     return "\n".join(out) + "\n" if len(out) > 4 else ""
 
 
-def machines_table(paths):
+def machines_table(runs):
     """Issue 10's targets on every machine with a results file beside this
-    one (bench/results/*.json): the same guest has run on more than one
-    processor, and a figure from one must not be read against another."""
-    runs = []
-    for path in sorted(paths):
-        with open(path) as f:
-            lines = [json.loads(s) for s in f if s.strip()]
+    one (bench/results/*.json, read as (path, lines) in runs): the same
+    guest has run on more than one processor, and a figure from one must
+    not be read against another."""
+    named = []
+    for path, lines in sorted(runs, key=lambda run: run[0]):
         machine = next((l for l in lines if "bench" not in l), {})
         isa = {"avx512": "AVX-512", "avx2": "AVX2", "baseline": "no AVX2"}.get(machine.get("isa"), "")
-        runs.append((f"`{machine.get('machine', os.path.basename(path))}` "
-                     f"({', '.join(x for x in (isa, machine.get('date', '')) if x)})", lines))
-    if len(runs) < 2:
+        named.append((f"`{machine.get('machine', os.path.basename(path))}` "
+                      f"({', '.join(x for x in (isa, machine.get('date', '')) if x)})", lines))
+    if len(named) < 2:
         return ""
     out = ["**Issue 10's targets on each machine measured (each a whole `make bench` run)**", "",
-           "| figure | target | " + " | ".join(name for name, _ in runs) + " |",
-           "|---|---:|" + "---:|" * len(runs)]
-    for name, limit, rule, key, _ in TARGETS:
-        vals = [next((l[key] for l in lines if rule(l) and key in l), None) for _, lines in runs]
+           "| figure | target | " + " | ".join(name for name, _ in named) + " |",
+           "|---|---:|" + "---:|" * len(named)]
+    for name, limit, rule, key, _, _ in TARGETS:
+        vals = [value(lines, rule, key) for _, lines in named]
         if all(v is None for v in vals):
             continue
         out.append(f"| {name} | ≤ {cell(limit)} | " + " | ".join(
@@ -207,9 +208,13 @@ def table(title, columns, rows):
     return "\n".join(out) + "\n"
 
 
-def render(path):
+def read_run(path):
     with open(path) as f:
-        lines = [json.loads(s) for s in f if s.strip()]
+        return [json.loads(s) for s in f if s.strip()]
+
+
+def render(path):
+    lines = read_run(path)
     machine = next((l for l in lines if "bench" not in l), {})
     groups = {}
     for l in lines:
@@ -223,8 +228,10 @@ def render(path):
            f"{f' ({hardware})' if hardware else ''}, "
            f"{machine.get('cores', '?')} cores, {machine.get('date', '?')} "
            f"(results: `{os.path.relpath(path)}`; tables made by `scripts/bench-table.py`).", ""]
-    others = glob.glob(os.path.join(os.path.dirname(os.path.abspath(path)), "*.json"))
-    for extra in (targets(lines), machines_table(set(others) | {os.path.abspath(path)}), bandwidth_table(lines)):
+    here = os.path.abspath(path)
+    runs = [(here, lines)] + [(p, read_run(p)) for p in glob.glob(os.path.join(os.path.dirname(here), "*.json"))
+                              if os.path.abspath(p) != here]
+    for extra in (targets(lines), machines_table(runs), bandwidth_table(lines)):
         if extra:
             out.append(extra)
     for name in list(KNOWN) + sorted(set(groups) - set(KNOWN)):
