@@ -8,10 +8,10 @@
  * of both precisions call these. Every kernel updates a row of the state in
  * place (structure of arrays, positions x or float32 displacements d,
  * velocities v) once the row's forces are complete. Fixed particles are
- * selected out, not skipped, so the loops vectorise; the per-particle terms of the energy sums add into the
- * sum columns (lattice_rows.h) t_mv2, t_gain, t_mvn2, in double.
- * Each expression is the general path's (chunk.h, explicit.c), so the
- * float64 lattice gives its bits. Plain loops for GCC 12 to vectorise; where
+ * selected out, not skipped, so the loops vectorise; the per-particle terms
+ * of the energy sums add into the sum columns (lattice_rows.h) t_mv2,
+ * t_gain, t_mvn2, in double. Each expression is the general path's
+ * (chunk.h, explicit.c), so the float64 lattice gives its bits. Plain loops for GCC 12 to vectorise; where
  * it would not, the comment says what was changed. */
 #if !defined(LK_T) || !defined(LK_U) || !defined(LK) || !defined(LK_SCRATCH)
 #error "define LK_T, LK_U, LK(name) and LK_SCRATCH before including lattice_rows_t.h"
@@ -40,8 +40,9 @@
  * into masked loads and stores (vmaskmovpd), even with the load hoisted out
  * of the select; AMD processors before Zen 4 run those slowly (the stores as
  * microcode). This form it vectorises as a blend between plain loads and
- * stores. Measured on a Zen 1 (2026-12-02), 5k web, CPU ns a spring-step:
- * RK4 72 -> 50 (float32 45 -> 30), symplectic 13.4 -> 11.0. */
+ * stores. Measured on a Zen 1 (2026-12-02), 5k web, CPU ns a spring-step,
+ * fastest of five: RK4 67.0 -> 50.6 (float32 44.9 -> 31.1), symplectic
+ * 13.9 -> 11.7 (docs/physics-lattice.md, "Masked loads and stores"). */
 LAT_INLINE LK_T LK(pick)(bool c, LK_T a, LK_T b)
 {
     LK_U ua, ub;
