@@ -139,17 +139,15 @@ LAT_INLINE lat_cols col_set(double *cols, size_t stride, int set)
     return cs;
 }
 
-/* n float32 terms t added into a sum column c: in eight running sums
- * (term i into sum i mod 8), added into c[0 .. 7] at the end (col_take sums
- * the whole column, so where in it a term lands does not matter). */
+/* n float32 terms t added into a sum column c, term i into c[i], like the
+ * float64 kernels' terms (col_take sums the whole column). Element by
+ * element, not into eight running sums: those were a chain of dependent
+ * additions, and GCC 12 left some of the inlined copies scalar and kept the
+ * sums on the stack for the tail (i mod 8), about a fifth of the 5k web's
+ * float32 symplectic step on a Zen 1 (docs/physics-lattice.md). */
 LAT_INLINE void col_addf(double *restrict c, const float *restrict t, uint32_t n)
 {
-    double acc[LANES] = {0};
-    uint32_t i = 0;
-    for (; i + LANES <= n; i += LANES)
-        for (int l = 0; l < LANES; l++) acc[l] += (double)t[i + l];
-    for (; i < n; i++) acc[i % LANES] += (double)t[i];
-    for (int l = 0; l < LANES; l++) c[l] += acc[l];
+    for (uint32_t i = 0; i < n; i++) c[i] += (double)t[i];
 }
 
 /* The sum of column c[0 .. n) (in eight lanes, i mod 8, then lane_total),
