@@ -198,8 +198,7 @@ LAT_INLINE void rk4_update(const lat_args *a, size_t p0, uint32_t n, double *con
         R.xt[c] = a->tx[c] ? a->tx[c] + p0 : NULL, R.vt[c] = a->tv[c] ? a->tv[c] + p0 : NULL;
         R.ax[c] = L->ax[c] + p0, R.av[c] = L->av[c] + p0;
     }
-    rk4_update64(n, a->mode == MODE_RK4_LAST, a->first, a->h, a->weight, a->drag, a->g, a->mass + p0,
-                 a->inv_mass + p0, &R, F, cs);
+    rk4_update64(n, a->stage, a->h, a->weight, a->drag, a->g, a->mass + p0, a->inv_mass + p0, &R, F, cs);
 }
 
 /* Row p0 complete (radial in, ring, radial out or NULL): its update. */
@@ -243,7 +242,7 @@ LAT_INLINE void radials64(const lat_args *a, double *const *Xa, double *const *V
     const size_t s0 = (size_t)j * L->radials;
     springs_rows(L->radials, (const double *const *)Xa, (const double *const *)Va, (const double *const *)Xb,
                  (const double *const *)Vb, 0, 0, L->rk + s0, L->rkd + s0, L->rrest + s0, f, 0, cs,
-                 wants_elastic(a->mode, a->first));
+                 wants_elastic(a->mode, a->stage));
 }
 
 LAT_INLINE void rings64(const lat_args *a, double *const *X, double *const *V, uint32_t j, double *const *f,
@@ -253,7 +252,7 @@ LAT_INLINE void rings64(const lat_args *a, double *const *X, double *const *V, u
     const uint32_t n = L->radials;
     const size_t s0 = (size_t)j * n;
     const double *const *cX = (const double *const *)X, *const *cV = (const double *const *)V;
-    const bool el = wants_elastic(a->mode, a->first);
+    const bool el = wants_elastic(a->mode, a->stage);
     springs_rows(n - 1, cX, cV, cX, cV, 0, 1, L->gk + s0, L->gkd + s0, L->grest + s0, f, 0, cs, el);
     springs_rows(1, cX, cV, cX, cV, 0, n - 1, L->gk + s0 + n - 1, L->gkd + s0 + n - 1, L->grest + s0 + n - 1, f, n - 1,
                  cs, el);
@@ -496,7 +495,7 @@ bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r)
             a.tx[c] = to[c], a.tv[c] = to[3 + c];
         }
         a.mode = stage < 3 ? MODE_RK4_STAGE : MODE_RK4_LAST;
-        a.first = stage == 0;
+        a.stage = stage;
         a.weight = weight[stage];
         a.h = stage < 3 ? frac[stage + 1] * dt : dt / 6;
         sweep64(&a, threads, sums[stage]);
@@ -535,7 +534,7 @@ int spn__lattice_block_steps(spn_world *w, double dt, int k, spn__step_result *r
     for (uint32_t s = 0; s < levels; s++) {
         la[s] = la[0];
         la[s].mode = rk4 ? (s < 3 ? MODE_RK4_STAGE : MODE_RK4_LAST) : mode;
-        la[s].first = s == 0;
+        la[s].stage = rk4 ? (int)s : 0;
         la[s].weight = weight[s % 4];
         la[s].h = s < 3 ? frac[s + 1] * dt : dt / 6;
     }

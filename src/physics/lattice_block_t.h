@@ -36,7 +36,7 @@
  * the "cut", summed apart), so they are bit-identical too.
  *
  * The including file defines LK_T, LK(name), LK_ARGS (its step arguments:
- * members L, g, drag, dt, h, weight, mode, first, in LK_T where they are
+ * members L, g, drag, dt, h, weight, mode, stage, in LK_T where they are
  * numbers) and, besides lattice_sweep_t.h's LK(radials), LK(rings) and
  * LK(stride):
  *   LK(state)(a, X, V)   the state arrays (3 + 3, whole; float32:
@@ -151,8 +151,7 @@ LAT_INLINE void LK(block_hub)(LK(block) *B, uint32_t s, LK_T *const *X, LK_T *co
         R.vt[c] = s < 4 ? &B->hub_trial[s - 1][3 + c] : NULL;
         R.ax[c] = &B->hub_sums[c], R.av[c] = &B->hub_sums[3 + c];
     }
-    LK(rk4_update)(1, a->mode == MODE_RK4_LAST, a->first, a->h, a->weight, a->drag, a->g, B->mass, B->inv_mass, &R,
-                   Fp, cs);
+    LK(rk4_update)(1, a->stage, a->h, a->weight, a->drag, a->g, B->mass, B->inv_mass, &R, Fp, cs);
 }
 
 /* Row r (particles from p0) moved to level s, its forces complete (radial
@@ -180,8 +179,7 @@ LAT_INLINE void LK(block_move)(LK(block) *B, uint32_t s, uint32_t r, LK_T *const
         R.vt[c] = s < 4 ? B->trial[s - 1][r % 4][3 + c] : NULL;
         R.ax[c] = B->sums[r % 8][c], R.av[c] = B->sums[r % 8][3 + c];
     }
-    LK(rk4_update)(n, a->mode == MODE_RK4_LAST, a->first, a->h, a->weight, a->drag, a->g, B->mass + p0,
-                   B->inv_mass + p0, &R, B->F, cs);
+    LK(rk4_update)(n, a->stage, a->h, a->weight, a->drag, a->g, B->mass + p0, B->inv_mass + p0, &R, B->F, cs);
 }
 
 /* op(s, j): see the file comment. (Inlined into run_block, so that each

@@ -74,7 +74,7 @@ typedef struct a32 {
     float *td[3], *tu[3];       /* RK4 stage: the next trial state */
     float g[3], drag, dt, h, weight;
     int mode;                   /* MODE_* (lattice_rows.h) */
-    bool first;                 /* RK4: stage 0 */
+    int stage;                  /* RK4: the stage, 0-3 (MODE_RK4_LAST at 3) */
 } a32;
 
 void spn__lat32_free(spn__lat32 *F)
@@ -104,8 +104,7 @@ LAT_INLINE void rk4_update(const a32 *a, size_t p0, uint32_t n, float *const *F,
         R.xt[c] = a->td[c] ? a->td[c] + p0 : NULL, R.vt[c] = a->tu[c] ? a->tu[c] + p0 : NULL;
         R.ax[c] = S->ax[c] + p0, R.av[c] = S->av[c] + p0;
     }
-    rk4_update32(n, a->mode == MODE_RK4_LAST, a->first, a->h, a->weight, a->drag, a->g, S->mass + p0,
-                 S->inv_mass + p0, &R, F, cs);
+    rk4_update32(n, a->stage, a->h, a->weight, a->drag, a->g, S->mass + p0, S->inv_mass + p0, &R, F, cs);
 }
 
 LAT_INLINE void finish32(const a32 *a, size_t p0, uint32_t n, float *const *ri, float *const *rg,
@@ -147,7 +146,7 @@ LAT_INLINE void radials32(const a32 *a, float *const *Da, float *const *Ua, floa
 {
     const spn__lat32 *F = a->F;
     spring_rows(a->L->radials, Da, Ua, Db, Ub, (float *const *)F->rl, (size_t)j * a->L->radials, F->rk, F->rkd, F->rr,
-                f, 0, cs, wants_elastic(a->mode, a->first));
+                f, 0, cs, wants_elastic(a->mode, a->stage));
 }
 
 LAT_INLINE void rings32(const a32 *a, float *const *D, float *const *U, uint32_t j, float *const *f,
@@ -158,7 +157,7 @@ LAT_INLINE void rings32(const a32 *a, float *const *D, float *const *U, uint32_t
     const size_t s0 = (size_t)j * n;
     float *D1[3], *U1[3], *Dl[3], *Ul[3]; /* the row from its second and its last particle */
     for (int c = 0; c < 3; c++) D1[c] = D[c] + 1, U1[c] = U[c] + 1, Dl[c] = D[c] + n - 1, Ul[c] = U[c] + n - 1;
-    const bool el = wants_elastic(a->mode, a->first);
+    const bool el = wants_elastic(a->mode, a->stage);
     spring_rows(n - 1, D, U, D1, U1, (float *const *)F->gl, s0, F->gk, F->gkd, F->gr, f, 0, cs, el);
     spring_rows(1, D, U, Dl, Ul, (float *const *)F->gl, s0 + n - 1, F->gk, F->gkd, F->gr, f, n - 1, cs, el);
 }
@@ -372,7 +371,7 @@ bool spn__lat32_rk4(spn_world *w, int threads, double dt, spn__step_result *r)
             a.td[c] = to[c], a.tu[c] = to[3 + c];
         }
         a.mode = stage < 3 ? MODE_RK4_STAGE : MODE_RK4_LAST;
-        a.first = stage == 0;
+        a.stage = stage;
         a.weight = weight[stage];
         a.h = stage < 3 ? frac[stage + 1] * (float)dt : (float)dt / 6;
         sweep32(&a, threads, sums[stage]);
@@ -398,7 +397,7 @@ int spn__lat32_block_steps(spn_world *w, int threads, double dt, int mode, int k
     for (uint32_t s = 0; s < levels; s++) {
         la[s] = la[0];
         la[s].mode = rk4 ? (s < 3 ? MODE_RK4_STAGE : MODE_RK4_LAST) : mode;
-        la[s].first = s == 0;
+        la[s].stage = rk4 ? (int)s : 0;
         la[s].weight = weight[s % 4];
         la[s].h = s < 3 ? frac[s + 1] * (float)dt : (float)dt / 6;
     }

@@ -106,7 +106,7 @@ typedef struct lat_args {
     const double *mass, *inv_mass;
     double g[3], drag, dt, h, weight;
     int mode;
-    bool first;                  /* RK4: stage 0 */
+    int stage; /* RK4: the stage, 0-3 (MODE_RK4_LAST at 3) */
 } lat_args;
 
 #define LK_T double
@@ -209,9 +209,9 @@ LAT_INLINE void springs(bool elastic, uint32_t n, const double *restrict axp, co
 /* Whether a sweep or a level of a blocked pass sums the springs' elastic
  * energy: RK4 reads it from its first stage only (lat_rk4_result), so its
  * other three stages leave it out (their L_ELASTIC sums stay 0). */
-LAT_INLINE bool wants_elastic(int mode, bool first)
+LAT_INLINE bool wants_elastic(int mode, int stage)
 {
-    return first || (mode != MODE_RK4_STAGE && mode != MODE_RK4_LAST);
+    return stage == 0 || (mode != MODE_RK4_STAGE && mode != MODE_RK4_LAST);
 }
 
 /* Springs from rows a to b of a state (3 arrays each, offsets off_a,

@@ -170,11 +170,15 @@ LAT_INLINE void LK(rk4_kin)(uint32_t n, const LK_T *restrict mass, const LK_T *r
 
 /* One component of a stage but the last: the weighted sums ax, av and the
  * next trial state xt = xb + h V, vt = vb + h F / m (xb, vb: the step's
- * base; a fixed particle stays there). A fixed particle's ax and av are
- * summed too, though nothing moves it by them: a select there would be a
- * masked store (LK(pick) above), and the sums are then never left
+ * base; a fixed particle stays there). `stage` is 0, 1 or 2, a constant in
+ * each call. The first stage is evaluated at the base state, so its V is
+ * vb itself: it leaves ax unwritten and the second stage starts the sum
+ * from vb (vb + V wgt, the bits of ax + V wgt with ax = vb), a store and
+ * a load fewer per particle and component. A fixed particle's ax and av
+ * are summed too, though nothing moves it by them: a select there would be
+ * a masked store (LK(pick) above), and the sums are then never left
  * unwritten for LK(rk4_sums) to read (it multiplies them by a mass of 0). */
-LAT_INLINE void LK(rk4_stage)(uint32_t n, bool first, LK_T h, LK_T wgt, const LK_T *restrict inv_mass,
+LAT_INLINE void LK(rk4_stage)(uint32_t n, int stage, LK_T h, LK_T wgt, const LK_T *restrict inv_mass,
                               const LK_T *restrict Vc, const LK_T *restrict Fc, const LK_T *restrict xb,
                               const LK_T *restrict vb, LK_T *restrict xt, LK_T *restrict vt, LK_T *restrict ax,
                               LK_T *restrict av)
@@ -183,8 +187,11 @@ LAT_INLINE void LK(rk4_stage)(uint32_t n, bool first, LK_T h, LK_T wgt, const LK
         const LK_T im = inv_mass[i], s = h * im;
         const bool fr = im != 0;
         const LK_T vc = Vc[i], fc = Fc[i];
-        ax[i] = first ? vc : ax[i] + vc * wgt;
-        av[i] = first ? fc : av[i] + fc * wgt;
+        if (stage == 1)
+            ax[i] = vb[i] + vc * wgt;
+        else if (stage == 2)
+            ax[i] = ax[i] + vc * wgt;
+        av[i] = stage == 0 ? fc : av[i] + fc * wgt;
         xt[i] = fr ? xb[i] + vc * h : xb[i];
         vt[i] = fr ? vb[i] + fc * s : vb[i];
     }
@@ -289,29 +296,42 @@ typedef struct LK(rk4_rows) {
     LK_T *xb[3], *vb[3], *xt[3], *vt[3], *ax[3], *av[3];
 } LK(rk4_rows);
 
-/* n particles of an RK4 stage (the last one when `last`; weighted `wgt`,
- * step fraction h, or h = dt / 6 at the last), their force F known and
- * masses from mass and inv_mass; sum terms into the columns cs. */
-LAT_INLINE void LK(rk4_update)(uint32_t n, bool last, bool first, LK_T h, LK_T wgt, LK_T drag, const LK_T *g,
-                               const LK_T *mass, const LK_T *inv_mass, const LK(rk4_rows) *R, LK_T *const *F,
-                               const lat_cols *cs)
+/* The three components of a stage but the last (`stage` 0-2, a constant
+ * in each call). Three calls, not a loop: GCC 12 does not vectorise an
+ * inlined function with restrict parameters inside a loop. */
+LAT_INLINE void LK(rk4_stages)(uint32_t n, int stage, LK_T h, LK_T wgt, const LK_T *inv_mass, const LK(rk4_rows) *R,
+                               LK_T *const *F)
 {
-    if (!last) {
+    LK(rk4_stage)(n, stage, h, wgt, inv_mass, R->V[0], F[0], R->xb[0], R->vb[0], R->xt[0], R->vt[0], R->ax[0],
+                  R->av[0]);
+    LK(rk4_stage)(n, stage, h, wgt, inv_mass, R->V[1], F[1], R->xb[1], R->vb[1], R->xt[1], R->vt[1], R->ax[1],
+                  R->av[1]);
+    LK(rk4_stage)(n, stage, h, wgt, inv_mass, R->V[2], F[2], R->xb[2], R->vb[2], R->xt[2], R->vt[2], R->ax[2],
+                  R->av[2]);
+}
+
+/* n particles of RK4 stage `stage` (0-3; weighted `wgt`, step fraction h,
+ * or h = dt / 6 at the last), their force F known and masses from mass and
+ * inv_mass; sum terms into the columns cs. */
+LAT_INLINE void LK(rk4_update)(uint32_t n, int stage, LK_T h, LK_T wgt, LK_T drag, const LK_T *g, const LK_T *mass,
+                               const LK_T *inv_mass, const LK(rk4_rows) * R, LK_T *const *F, const lat_cols *cs)
+{
+    if (stage < 3) {
         /* m v^2 at a stage's state serves the drag's loss (and, at the first
          * stage, the energy before the step); without drag the later stages
          * skip it, as drag * m v^2 would add exactly zero */
-        if (first || drag != 0) {
+        if (stage == 0 || drag != 0) {
             LK(rk4_kin)(n, mass, inv_mass, R->V[0], R->V[1], R->V[2], LK_TERMS(cs, L_MV2));
             LK_DONE(cs, L_MV2, n);
         }
-        /* (three calls, not a loop: GCC 12 does not vectorise an inlined
-         * function with restrict parameters inside a loop) */
-        LK(rk4_stage)(n, first, h, wgt, inv_mass, R->V[0], F[0], R->xb[0], R->vb[0], R->xt[0], R->vt[0], R->ax[0],
-                      R->av[0]);
-        LK(rk4_stage)(n, first, h, wgt, inv_mass, R->V[1], F[1], R->xb[1], R->vb[1], R->xt[1], R->vt[1], R->ax[1],
-                      R->av[1]);
-        LK(rk4_stage)(n, first, h, wgt, inv_mass, R->V[2], F[2], R->xb[2], R->vb[2], R->xt[2], R->vt[2], R->ax[2],
-                      R->av[2]);
+        /* (the stage a constant in each call: GCC 12 does not vectorise a
+         * select on a run-time value) */
+        if (stage == 0)
+            LK(rk4_stages)(n, 0, h, wgt, inv_mass, R, F);
+        else if (stage == 1)
+            LK(rk4_stages)(n, 1, h, wgt, inv_mass, R, F);
+        else
+            LK(rk4_stages)(n, 2, h, wgt, inv_mass, R, F);
         return;
     }
     LK(rk4_sums)(n, h, g, mass, inv_mass, R->V[0], R->V[1], R->V[2], F[0], F[1], F[2], R->ax[0], R->ax[1],
