@@ -105,8 +105,8 @@ typedef struct lat_args {
     double *tx[3], *tv[3];       /* RK4 stage: the next trial state */
     const double *mass, *inv_mass;
     double g[3], drag, dt, h, weight;
-    int mode;
-    int stage; /* RK4: the stage, 0-3 (MODE_RK4_LAST at 3) */
+    int mode;                    /* MODE_* above */
+    int stage;                   /* RK4: the stage, 0-3 (MODE_RK4_LAST at 3) */
 } lat_args;
 
 #define LK_T double
