@@ -11,8 +11,9 @@
  * selected out, not skipped, so the loops vectorise; the per-particle terms
  * of the energy sums add into the sum columns (lattice_rows.h) t_mv2,
  * t_gain, t_mvn2, in double. Each expression is the general path's
- * (chunk.h, explicit.c), so the float64 lattice gives its bits. Plain loops for GCC 12 to vectorise; where
- * it would not, the comment says what was changed. */
+ * (chunk.h, explicit.c), so the float64 lattice gives its bits. Plain
+ * loops for GCC 12 to vectorise; where it would not, the comment says what
+ * was changed. */
 #if !defined(LK_T) || !defined(LK_U) || !defined(LK) || !defined(LK_SCRATCH)
 #error "define LK_T, LK_U, LK(name) and LK_SCRATCH before including lattice_rows_t.h"
 #endif
@@ -314,7 +315,7 @@ LAT_INLINE void LK(rk4_stages)(uint32_t n, int stage, LK_T h, LK_T wgt, const LK
  * or h = dt / 6 at the last), their force F known and masses from mass and
  * inv_mass; sum terms into the columns cs. */
 LAT_INLINE void LK(rk4_update)(uint32_t n, int stage, LK_T h, LK_T wgt, LK_T drag, const LK_T *g, const LK_T *mass,
-                               const LK_T *inv_mass, const LK(rk4_rows) * R, LK_T *const *F, const lat_cols *cs)
+                               const LK_T *inv_mass, const LK(rk4_rows) *R, LK_T *const *F, const lat_cols *cs)
 {
     if (stage < 3) {
         /* m v^2 at a stage's state serves the drag's loss (and, at the first
@@ -324,8 +325,8 @@ LAT_INLINE void LK(rk4_update)(uint32_t n, int stage, LK_T h, LK_T wgt, LK_T dra
             LK(rk4_kin)(n, mass, inv_mass, R->V[0], R->V[1], R->V[2], LK_TERMS(cs, L_MV2));
             LK_DONE(cs, L_MV2, n);
         }
-        /* (the stage a constant in each call: GCC 12 does not vectorise a
-         * select on a run-time value) */
+        /* (the stage a constant in each call, so that each copy of the
+         * loop stores ax unconditionally or not at all) */
         if (stage == 0)
             LK(rk4_stages)(n, 0, h, wgt, inv_mass, R, F);
         else if (stage == 1)
