@@ -19,7 +19,6 @@
  * Invariant: the world is written only at the end and only with finite values. */
 #include "core/big_alloc.h"
 #include "equilibrium_internal.h"
-#include "fft.h"
 #include "world_internal.h"
 
 #include <math.h>
@@ -49,20 +48,16 @@
  * 3 s with this. A taut web's late, tight solves also take more, but there a
  * new hierarchy did not help (measured at 100k), so they keep it. */
 #define MG_REBUILD_CG 40
-/* The cyclic preconditioner under SPN_PRECOND_AUTO: taken on a lattice web
- * whose radials' count has no prime factor above CYC_MAX_FACTOR (the
- * transform does a prime factor p by a direct DFT, p operations an
- * element), given up for the multigrid when a solve needs CYC_GIVE_UP
+/* The cyclic preconditioner under SPN_PRECOND_AUTO: taken on any lattice
+ * web, given up for the multigrid when a solve needs CYC_GIVE_UP
  * iterations. On the standard web it takes 1-3 a Newton step, 7-15 under a
  * point load of 4-256 T0 (docs/physics-equilibrium.md, "The cyclic
- * preconditioner"). The limit is as far as measured: with a prime radial
- * count the whole settle still took a third to a fifth of the multigrid's
- * time at 40 x 79, 127, 251, 509 and 997 and at 200 x 997 (3 or 4 CG
- * iterations against 16-38); 1,000 radials is also the command line's
- * largest web. (It was 13 until the nineteenth session, which left the 100k
- * standard web, 316 = 4 x 79 radials, on the multigrid: 1.23 s against
- * 0.18.) */
-#define CYC_MAX_FACTOR 1000u
+ * preconditioner"). Until the twenty-second session it was taken only when
+ * the radial count had no prime factor above 1,000, as far as measured then
+ * (the transform did a prime p by a direct DFT, p operations an element);
+ * the transform now takes a length with a large prime factor by Bluestein's
+ * chirp (fft.h), a few times N log N for any N: 40 x 1009 settles in 0.08 s
+ * against the multigrid's 1.1 s. */
 #define CYC_GIVE_UP 60
 #define STALL_LIMIT 5 /* iterations in a row that lower neither energy nor residual */
 /* Hubs: particles spring-joined to more than HUB_MIN_NEIGHBOURS others and to
@@ -463,7 +458,7 @@ static spn_status choose_preconditioner(newton *nt)
     }
     if (nt->pc.kind != SPN_PRECOND_AUTO) return SPN_OK;
     nt->pc.cyc = spn__cyc_build(&nt->e, &why);
-    if (nt->pc.cyc && spn__fft_largest_factor(spn__cyc_radials(nt->pc.cyc)) <= CYC_MAX_FACTOR) {
+    if (nt->pc.cyc) {
         nt->pc.kind = SPN_PRECOND_CYCLIC;
         nt->auto_cyclic = true;
         return SPN_OK;

@@ -77,7 +77,7 @@ struct spn__cyc {
     double asym;     /* spread of the last factored system about its average */
     spn__fft *fft;
     /* work */
-    double *zr, *zi, *tr, *ti; /* N Bc each */
+    double *zr, *zi, *tr, *ti; /* N Bc each; the transform's scratch tr, ti spn__fft_scratch_rows Bc */
     double *xr, *xi;           /* K B each */
     int threads;
 };
@@ -296,10 +296,11 @@ spn__cyc *spn__cyc_build(const spn__eq *e, const char **why)
     C->gam = spn__big_alloc(9 * (size_t)C->K * Q * sizeof *C->gam);
     C->zhub = malloc(2 * 2 * 9 * (size_t)Q * sizeof *C->zhub);
     const size_t nz = (size_t)N * C->Bc, nx = (size_t)C->K * C->B;
-    C->zr = spn__big_alloc(nz * sizeof(double)), C->zi = spn__big_alloc(nz * sizeof(double));
-    C->tr = spn__big_alloc(nz * sizeof(double)), C->ti = spn__big_alloc(nz * sizeof(double));
-    C->xr = spn__big_alloc(nx * sizeof(double)), C->xi = spn__big_alloc(nx * sizeof(double));
     C->fft = spn__fft_plan(N);
+    const size_t nt = C->fft ? spn__fft_scratch_rows(C->fft) * C->Bc : 0;
+    C->zr = spn__big_alloc(nz * sizeof(double)), C->zi = spn__big_alloc(nz * sizeof(double));
+    C->tr = nt ? spn__big_alloc(nt * sizeof(double)) : NULL, C->ti = nt ? spn__big_alloc(nt * sizeof(double)) : NULL;
+    C->xr = spn__big_alloc(nx * sizeof(double)), C->xi = spn__big_alloc(nx * sizeof(double));
     if (!C->cs || !C->sn || !C->dbar || !C->gbar || !C->cbar || !C->gam || !C->zhub || !C->zr || !C->zi || !C->tr ||
         !C->ti || !C->xr || !C->xi || !C->fft) {
         *why = "out of memory";
@@ -685,7 +686,6 @@ bool spn__cyc_factor(spn__cyc *C, const spn__eq *e)
 }
 
 double spn__cyc_asymmetry(const spn__cyc *C) { return C->asym; }
-uint32_t spn__cyc_radials(const spn__cyc *C) { return C->N; }
 
 /* ---- applying ---- */
 

@@ -194,7 +194,6 @@ void spn__cyc_free(spn__cyc *C);
 /* The last factored system's spread about its average: sqrt(sum |X - mean|^2
  * / sum |X|^2) over its blocks in local frames (0 for a symmetric web). */
 double spn__cyc_asymmetry(const spn__cyc *C);
-uint32_t spn__cyc_radials(const spn__cyc *C);
 
 /* Thread-line smoother (equilibrium_lines.c) over level 0 of the multigrid. */
 typedef struct spn__lines spn__lines;

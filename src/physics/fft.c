@@ -8,6 +8,17 @@
  * which leaves s r sequences of length m; after the last stage the result
  * stands in natural order, without a bit-reversal pass.
  *
+ * A length whose mixed-radix plan would cost more (a large prime factor,
+ * which that plan takes by a direct DFT of p operations an element) is done
+ * by Bluestein's chirp transform instead: with j k = (j^2 + k^2 - (j - k)^2)
+ * / 2 and a_k = exp(-pi i k^2 / n),
+ *     X_j = sum_k x_k w_n^(-j k) = a_j sum_k (a_k x_k) conj(a_(j - k)),
+ * a convolution, which is done circularly at a length M >= 2 n - 1 with no
+ * prime factor above 5 by two mixed-radix transforms of length M and a
+ * product with the precomputed spectrum of conj(a) (symmetric, so wrapped
+ * to M as conj(a_m) at m and at M - m). Sign +1 is the conjugate of sign -1
+ * on the conjugated input.
+ *
  * An element x[e] here is a row of the batch, re[e * stride + b] for the
  * columns b, and every loop runs along the columns of a row doing the same
  * scalar operations for each (no fused multiply-adds: the project builds
@@ -16,6 +27,7 @@
 #include "physics/fft.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -34,6 +46,11 @@ struct spn__fft {
     uint32_t n, nstages;
     stage st[MAX_STAGES];
     double *tab; /* every stage's w and root */
+    /* Bluestein (chirp != NULL; then nstages is 0): the transform of length m */
+    spn__fft *inner;
+    uint32_t m;
+    double *chirp; /* (cos, sin) of -pi k^2 / n, k < n: a_k */
+    double *spec;  /* (re, im) of the length-m sign -1 transform of conj(a), wrapped, divided by m */
 };
 
 /* cos and sin of 2 pi m / n, from the octant of the angle (an integer
@@ -66,20 +83,9 @@ static uint32_t factor(uint32_t n, uint32_t f[MAX_STAGES])
     return k;
 }
 
-uint32_t spn__fft_largest_factor(uint32_t n)
+/* The mixed-radix plan of n. */
+static spn__fft *radix_plan(uint32_t n)
 {
-    if (n == 0) return 0;
-    uint32_t f[MAX_STAGES], k = factor(n, f), big = 1;
-    for (uint32_t i = 0; i < k; i++) {
-        const uint32_t prime = f[i] == 4 ? 2 : f[i];
-        if (prime > big) big = prime;
-    }
-    return big;
-}
-
-spn__fft *spn__fft_plan(uint32_t n)
-{
-    if (n == 0) return NULL;
     spn__fft *plan = calloc(1, sizeof *plan);
     if (!plan) return NULL;
     uint32_t f[MAX_STAGES];
@@ -112,14 +118,103 @@ spn__fft *spn__fft_plan(uint32_t n)
     return plan;
 }
 
+/* The smallest length >= n with no prime factor above 5. */
+static uint32_t smooth_above(uint32_t n)
+{
+    for (uint32_t m = n;; m++) {
+        uint32_t r = m;
+        while (r % 2 == 0)
+            r /= 2;
+        while (r % 3 == 0)
+            r /= 3;
+        while (r % 5 == 0)
+            r /= 5;
+        if (r == 1) return m;
+    }
+}
+
+static spn__fft *chirp_plan(uint32_t n)
+{
+    spn__fft *plan = calloc(1, sizeof *plan);
+    if (!plan) return NULL;
+    plan->n = n;
+    plan->m = smooth_above(2 * n - 1);
+    const uint32_t m = plan->m;
+    plan->inner = radix_plan(m);
+    plan->chirp = malloc(2 * (size_t)n * sizeof *plan->chirp);
+    plan->spec = malloc(2 * (size_t)m * sizeof *plan->spec);
+    double *br = calloc(4 * (size_t)m, sizeof *br), *bi = br + m, *tr = br + 2 * (size_t)m, *ti = br + 3 * (size_t)m;
+    if (!plan->inner || !plan->chirp || !plan->spec || !br) {
+        free(br);
+        spn__fft_free(plan);
+        return NULL;
+    }
+    for (uint32_t k = 0; k < n; k++) { /* k^2 mod 2n exactly: the angle -pi k^2 / n reduced */
+        const uint64_t e = (uint64_t)k * k % (2 * (uint64_t)n);
+        double c, sn;
+        unit_root(e, 2 * (uint64_t)n, &c, &sn);
+        plan->chirp[2 * k] = c, plan->chirp[2 * k + 1] = -sn;
+        br[k] = c, bi[k] = sn; /* conj(a_k) */
+        if (k) br[m - k] = c, bi[m - k] = sn;
+    }
+    spn__fft_run(plan->inner, -1, br, bi, 1, 0, 1, tr, ti);
+    for (uint32_t j = 0; j < m; j++)
+        plan->spec[2 * j] = br[j] / m, plan->spec[2 * j + 1] = bi[j] / m;
+    free(br);
+    return plan;
+}
+
+/* Cost estimates per element and column, in units of one radix (2-5)
+ * stage's element with its twiddle: a direct DFT of a prime p costs
+ * DFT_COST p of them; Bluestein does two transforms of length m ~ 2n and
+ * three complex products (CHIRP_COST) per element of m. Measured on a Zen 1
+ * (150 columns, ns an element, mixed radix / chirp): a radix stage ~1.4-2.5,
+ * a prime p ~0.41 p (p = 127: 48.6 / 19.8; 997: 412 / 50.6); the two meet
+ * near p = 50 (47: 19.2 / 19.2), and the estimate switches at 61 (23.8 /
+ * 21.5). For 316 = 4 x 79 they are near even (32.3 / 29.7); the estimate
+ * keeps the mixed radix. */
+#define DFT_COST 0.25
+#define CHIRP_COST 1.0
+static double radix_cost(uint32_t n)
+{
+    uint32_t f[MAX_STAGES];
+    const uint32_t k = factor(n, f);
+    double c = 0;
+    for (uint32_t t = 0; t < k; t++)
+        c += f[t] <= 5 ? 1.0 : DFT_COST * f[t];
+    return c;
+}
+
+static double chirp_cost(uint32_t n)
+{
+    const uint32_t m = smooth_above(2 * n - 1);
+    return (double)m / n * (2 * radix_cost(m) + CHIRP_COST);
+}
+
+spn__fft *spn__fft_plan_kind(uint32_t n, spn__fft_kind kind)
+{
+    if (n == 0) return NULL;
+    if (kind == SPN__FFT_AUTO) kind = chirp_cost(n) < radix_cost(n) ? SPN__FFT_CHIRP : SPN__FFT_RADIX;
+    return kind == SPN__FFT_CHIRP ? chirp_plan(n) : radix_plan(n);
+}
+
+spn__fft *spn__fft_plan(uint32_t n) { return spn__fft_plan_kind(n, SPN__FFT_AUTO); }
+
 void spn__fft_free(spn__fft *plan)
 {
     if (!plan) return;
+    spn__fft_free(plan->inner);
+    free(plan->chirp);
+    free(plan->spec);
     free(plan->tab);
     free(plan);
 }
 
 uint32_t spn__fft_length(const spn__fft *plan) { return plan->n; }
+
+bool spn__fft_is_chirp(const spn__fft *plan) { return plan->chirp != NULL; }
+
+size_t spn__fft_scratch_rows(const spn__fft *plan) { return plan->chirp ? 2 * (size_t)plan->m : plan->n; }
 
 /* The butterflies: inputs k < r at rows x + k xs, outputs j < r at rows
  * y + j ys, columns c0..c1-1; sg is the transform's sign, +1 or -1.
@@ -280,11 +375,54 @@ static void run_stage(const stage *g, double sg, const double *xr, const double 
         }
 }
 
+/* Rows k < rows, columns b0..b1-1: y_k = tab_k (x_k with its imaginary part
+ * times cin), the imaginary part of the product times cout (each +-1). y may
+ * be x: every element is read before it is written. */
+static void times_table(const double *xr, const double *xi, double *yr, double *yi, size_t stride, uint32_t rows,
+                        const double *tab, double cin, double cout, size_t b0, size_t b1)
+{
+    for (uint32_t k = 0; k < rows; k++) {
+        const double c = tab[2 * k], s = tab[2 * k + 1];
+        const double *ar = xr + k * stride, *ai = xi + k * stride;
+        double *br = yr + k * stride, *bi = yi + k * stride;
+        ROWS_APART
+        for (size_t b = b0; b < b1; b++) {
+            const double pr = ar[b], pi = cin * ai[b];
+            br[b] = pr * c - pi * s, bi[b] = cout * (pr * s + pi * c);
+        }
+    }
+}
+
+/* Bluestein, columns b0..b1-1: u = a x (conj(x) for sign +1) in the first m
+ * rows of the scratch, zero past n; its transform times spec; back; a times
+ * that (conjugated for sign +1) into x. The inner transforms use the next m
+ * rows of the scratch as theirs. */
+static void run_chirp(const spn__fft *plan, double sg, double *re, double *im, size_t stride, size_t b0, size_t b1,
+                      double *tre, double *tim)
+{
+    const uint32_t n = plan->n, m = plan->m;
+    const double cj = -sg; /* the sign of the imaginary parts in and out */
+    double *ur = tre, *ui = tim, *sr = tre + (size_t)m * stride, *si = tim + (size_t)m * stride;
+    times_table(re, im, ur, ui, stride, n, plan->chirp, cj, 1, b0, b1);
+    for (uint32_t k = n; k < m; k++) {
+        memset(ur + k * stride + b0, 0, (b1 - b0) * sizeof *ur);
+        memset(ui + k * stride + b0, 0, (b1 - b0) * sizeof *ui);
+    }
+    spn__fft_run(plan->inner, -1, ur, ui, stride, b0, b1, sr, si);
+    times_table(ur, ui, ur, ui, stride, m, plan->spec, 1, 1, b0, b1);
+    spn__fft_run(plan->inner, 1, ur, ui, stride, b0, b1, sr, si);
+    times_table(ur, ui, re, im, stride, n, plan->chirp, 1, cj, b0, b1);
+}
+
 void spn__fft_run(const spn__fft *plan, int sign, double *re, double *im, size_t stride, size_t b0, size_t b1,
                   double *tre, double *tim)
 {
     if (b0 >= b1) return;
     const double sg = sign < 0 ? -1.0 : 1.0;
+    if (plan->chirp) {
+        run_chirp(plan, sg, re, im, stride, b0, b1, tre, tim);
+        return;
+    }
     double *xr = re, *xi = im, *yr = tre, *yi = tim;
     for (uint32_t t = 0; t < plan->nstages; t++) {
         run_stage(&plan->st[t], sg, xr, xi, yr, yi, stride, b0, b1);
