@@ -27,7 +27,7 @@ typedef enum spn_precond {
     SPN_PRECOND_BLOCK_JACOBI, ///< each particle's 3x3 diagonal block, inverted
     SPN_PRECOND_MULTIGRID,   ///< smoothed-aggregation multigrid V-cycle over the spring graph, thread-line smoothing
     SPN_PRECOND_SGS,         ///< symmetric block Gauss-Seidel (sequential)
-    SPN_PRECOND_AUTO,        ///< cyclic on a hub + rings x radials web (radial count without a prime factor above 1,000), else block Jacobi below 1,000 free particles and multigrid above (measured)
+    SPN_PRECOND_AUTO,        ///< cyclic on a hub + rings x radials web (any radial count), else block Jacobi below 1,000 free particles and multigrid above (measured)
     SPN_PRECOND_CYCLIC,      ///< a hub + rings x radials web's rotational average solved exactly (Fourier modes around the rings)
     SPN_PRECOND_COUNT
 } spn_precond;
