@@ -172,7 +172,7 @@ static bool prepare(spn_world *w, int threads)
         L->ws = ws;
         L->stride = ((size_t)n + 7) & ~(size_t)7;
         for (; L->nws < threads; L->nws++) {
-            L->ws[L->nws] = malloc(WS_COUNT * L->stride * sizeof **L->ws);
+            L->ws[L->nws] = spn__lattice_arrays(WS_COUNT, L->stride, sizeof **L->ws, 0, NULL, NULL);
             if (!L->ws[L->nws]) return false;
         }
     }
@@ -300,8 +300,12 @@ static bool load(spn_world *w, int threads)
     spn__lattice *L = w->lat;
     const uint32_t np = w->np;
     if (!L->state) {
-        if (!(L->state = malloc(6 * (size_t)np * sizeof *L->state))) return false;
-        for (int c = 0; c < 3; c++) L->x[c] = L->state + (size_t)c * np, L->v[c] = L->state + (size_t)(3 + c) * np;
+        void *first;
+        size_t pitch;
+        if (!(L->state = spn__lattice_arrays(6, np, sizeof(double), 1, &first, &pitch))) return false;
+        double *q = first;
+        for (int c = 0; c < 3; c++)
+            L->x[c] = q + c * pitch, L->v[c] = q + (3 + c) * pitch;
     }
     const spn_vec3 *x = w->x, *v = w->v;
     double *x0 = L->x[0], *x1 = L->x[1], *x2 = L->x[2], *v0 = L->v[0], *v1 = L->v[1], *v2 = L->v[2];
@@ -355,12 +359,17 @@ static bool begin(spn_world *w, int threads, double dt, bool rk4, lat_args *a)
     }
     const size_t np = w->np;
     if (rk4 && !L->rk4) {
-        if (!(L->rk4 = malloc(18 * np * sizeof *L->rk4))) {
+        void *first;
+        size_t pitch;
+        if (!(L->rk4 = spn__lattice_arrays(18, np, sizeof(double), 1, &first, &pitch))) {
             spn__lattice_sync(w);
             return false;
         }
-        for (int k = 0; k < 6; k++) L->trial[0][k] = L->rk4 + k * np, L->trial[1][k] = L->rk4 + (6 + k) * np;
-        for (int c = 0; c < 3; c++) L->ax[c] = L->rk4 + (12 + c) * np, L->av[c] = L->rk4 + (15 + c) * np;
+        double *q = first;
+        for (int k = 0; k < 6; k++)
+            L->trial[0][k] = q + k * pitch, L->trial[1][k] = q + (6 + k) * pitch;
+        for (int c = 0; c < 3; c++)
+            L->ax[c] = q + (12 + c) * pitch, L->av[c] = q + (15 + c) * pitch;
     }
     memset(a, 0, sizeof *a);
     a->L = L;

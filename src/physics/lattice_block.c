@@ -10,6 +10,20 @@
 #include "world_internal.h"
 
 #include <stdlib.h>
+#include <string.h>
+
+void *spn__lattice_arrays(size_t count, size_t n, size_t size, size_t lead, void **first, size_t *pitch)
+{
+    const size_t per = 64 / size, skip = (per - lead % per) % per, step = (n + per - 1) / per * per;
+    if (count && step > (SIZE_MAX / size - per) / count) return NULL;
+    const size_t bytes = ((skip + count * step) * size + 63) & ~(size_t)63;
+    char *block = aligned_alloc(64, bytes ? bytes : 64);
+    if (!block) return NULL;
+    memset(block, 0, bytes);
+    if (first) *first = block + skip * size;
+    if (pitch) *pitch = step;
+    return block;
+}
 
 bool spn__lattice_block_ready(const spn__lattice *L, int threads, uint32_t K)
 {
@@ -28,7 +42,7 @@ bool spn__lattice_block_alloc(spn__lattice *L, int threads, size_t bytes)
         L->block_size = 0;
         if (!(L->bws = calloc((size_t)threads, sizeof *L->bws))) return false;
         for (; L->nbws < threads; L->nbws++)
-            if (!(L->bws[L->nbws] = malloc(bytes))) return false;
+            if (!(L->bws[L->nbws] = spn__lattice_arrays(1, bytes, 1, 0, NULL, NULL))) return false;
         L->block_size = bytes;
     }
     if (L->npartial_k < L->nbands) {
@@ -48,7 +62,8 @@ bool spn__lattice_cols_alloc(spn__lattice *L, int threads)
     L->cols = cols;
     L->col_stride = ((size_t)L->radials + 7) & ~(size_t)7;
     for (; L->ncols < threads; L->ncols++)
-        if (!(L->cols[L->ncols] = calloc(COL_COUNT * L->col_stride, sizeof **L->cols))) return false;
+        if (!(L->cols[L->ncols] = spn__lattice_arrays(COL_COUNT, L->col_stride, sizeof **L->cols, 0, NULL, NULL)))
+            return false;
     return true;
 }
 

@@ -49,7 +49,7 @@
 
 struct spn__lat32 {
     size_t np, m;
-    float *block;         /* every per-particle and per-slot array below */
+    float *block, *slots; /* the per-particle and the per-slot arrays below */
     float *d[3], *u[3];   /* displacement from w->x [m] and velocity, per particle */
     float *mass, *inv_mass;
     float *rl[3], *gl[3]; /* reference differences of the radial and ring slots */
@@ -81,7 +81,7 @@ void spn__lat32_free(spn__lat32 *F)
 {
     if (!F) return;
     for (int t = 0; t < F->nws; t++) free(F->ws[t]);
-    free(F->ws), free(F->cut), free(F->block), free(F->rk4);
+    free(F->ws), free(F->cut), free(F->block), free(F->slots), free(F->rk4);
     free(F);
 }
 
@@ -240,14 +240,22 @@ static bool alloc_state(spn__lattice *L, size_t np)
     if (L->f32 && L->f32->np == np) return true;
     spn__lat32_free(L->f32);
     spn__lat32 *F = L->f32 = calloc(1, sizeof *F);
-    if (!F || !(F->block = malloc((8 * np + 12 * m) * sizeof *F->block))) return false;
+    void *first, *sfirst;
+    size_t pitch, spitch;
+    if (!F || !(F->block = spn__lattice_arrays(8, np, sizeof(float), 1, &first, &pitch)) ||
+        !(F->slots = spn__lattice_arrays(12, m, sizeof(float), 0, &sfirst, &spitch)))
+        return false;
     F->np = np, F->m = m;
-    float *q = F->block;
-    for (int c = 0; c < 3; c++) F->d[c] = q, q += np, F->u[c] = q, q += np;
-    F->mass = q, q += np, F->inv_mass = q, q += np;
-    for (int c = 0; c < 3; c++) F->rl[c] = q, q += m, F->gl[c] = q, q += m;
+    float *q = first;
+    for (int c = 0; c < 3; c++)
+        F->d[c] = q, q += pitch, F->u[c] = q, q += pitch;
+    F->mass = q, q += pitch, F->inv_mass = q;
+    q = sfirst;
+    for (int c = 0; c < 3; c++)
+        F->rl[c] = q, q += spitch, F->gl[c] = q, q += spitch;
     float **par[6] = {&F->rk, &F->rkd, &F->rr, &F->gk, &F->gkd, &F->gr};
-    for (int k = 0; k < 6; k++) *par[k] = q, q += m;
+    for (int k = 0; k < 6; k++)
+        *par[k] = q, q += spitch;
     return true;
 }
 
@@ -295,7 +303,8 @@ static bool prepare32(spn__lattice *L, int threads)
         F->ws = ws;
         F->stride = ((size_t)L->radials + 15) & ~(size_t)15;
         for (; F->nws < threads; F->nws++)
-            if (!(F->ws[F->nws] = malloc(WS_COUNT * F->stride * sizeof **F->ws))) return false;
+            if (!(F->ws[F->nws] = spn__lattice_arrays(WS_COUNT, F->stride, sizeof **F->ws, 0, NULL, NULL)))
+                return false;
     }
     return spn__lattice_cols_alloc(L, threads);
 }
@@ -316,12 +325,17 @@ static bool begin(spn_world *w, int threads, double dt, bool rk4, a32 *a)
     }
     spn__lat32 *F = L->f32;
     if (rk4 && !F->rk4) {
-        if (!(F->rk4 = calloc(18 * F->np, sizeof *F->rk4))) {
+        void *first;
+        size_t pitch;
+        if (!(F->rk4 = spn__lattice_arrays(18, F->np, sizeof(float), 1, &first, &pitch))) {
             spn__lattice_sync(w);
             return false;
         }
-        for (int k = 0; k < 6; k++) F->trial[0][k] = F->rk4 + k * F->np, F->trial[1][k] = F->rk4 + (6 + k) * F->np;
-        for (int c = 0; c < 3; c++) F->ax[c] = F->rk4 + (12 + c) * F->np, F->av[c] = F->rk4 + (15 + c) * F->np;
+        float *q = first;
+        for (int k = 0; k < 6; k++)
+            F->trial[0][k] = q + k * pitch, F->trial[1][k] = q + (6 + k) * pitch;
+        for (int c = 0; c < 3; c++)
+            F->ax[c] = q + (12 + c) * pitch, F->av[c] = q + (15 + c) * pitch;
     }
     if (!prepare32(L, threads)) {
         spn__lattice_sync(w);

@@ -257,6 +257,16 @@ static inline void lat_rk4_result(double sums[4][L_NSUMS], double dt, double dra
     r->dissipated = dt / 6 * damp;
 }
 
+/* The lattice's arrays (lattice_block.c). A zero-filled block of `count`
+ * arrays of n elements of `size` bytes (a divisor of 64), each placed so
+ * that its element `lead` starts a 64-byte line: lead 1 for particle
+ * arrays, whose rows start at particle 1 + j * radials, 0 for spring slots
+ * and row workspaces. *first is array 0, the next `*pitch` elements on (n
+ * rounded up to a line); the block (to free()) is returned, NULL when out
+ * of memory. With lead 0 array 0 is the block itself, and first and pitch
+ * may be NULL. */
+void *spn__lattice_arrays(size_t count, size_t n, size_t size, size_t lead, void **first, size_t *pitch);
+
 /* Temporal blocking (lattice_block_t.h, helpers in lattice_block.c). */
 /* Whether K levels can go as one blocked pass on `threads` threads (each
  * thread's run of bands deep enough for its ghost rows). */
