@@ -138,13 +138,28 @@ LAT_INLINE void LK(row)(uint32_t n, bool sym, LK_T dt, const LK_T *g, LK_T drag,
  * the trial state it writes are different arrays (the sweep alternates two),
  * so no restrict pointer below aliases another. */
 
-/* The complete force on a row, component c, in LK(row)'s order. */
+/* The complete force on a row, component c, in LK(row)'s order. Without
+ * drag the loop drops the drag term and its load of v: (drag m) v is then
+ * a signed zero for a finite v (a stage that makes v infinite fails the
+ * step's energy check either way), and m g - (+-0) is m g bit for bit
+ * unless m g is -0, which for a particle with mass needs g = -0 (left to
+ * the general loop). A fixed particle of mass 0 may get the other zero, in
+ * a force nothing reads. Measured on a Zen 1 (2026-12-03), RK4, CPU ns a
+ * spring-step, median of four: 1M float32 24.1 -> 23.1 (two threads, wall,
+ * 13.9 -> 13.3), 1M float64 42.0 -> 39.7, 5k float64 36.8 -> 36.0. */
 LAT_INLINE void LK(assemble)(uint32_t n, LK_T gc, LK_T drag, const LK_T *restrict mass, const LK_T *restrict vc,
                              const LK_T *restrict in, const LK_T *restrict ring, const LK_T *restrict out,
                              LK_T *restrict f)
 {
     const LK_T wrap = ring[n - 1];
-    if (out)
+    if (drag == 0 && !(gc == 0 && signbit(gc))) {
+        if (out)
+            for (uint32_t i = 1; i + 1 < n; i++)
+                f[i] = ((((mass[i] * gc) + out[i]) + ring[i]) - in[i]) - ring[i - 1];
+        else
+            for (uint32_t i = 1; i + 1 < n; i++)
+                f[i] = (((mass[i] * gc) + ring[i]) - in[i]) - ring[i - 1];
+    } else if (out)
         for (uint32_t i = 1; i + 1 < n; i++)
             f[i] = ((((mass[i] * gc - (drag * mass[i]) * vc[i]) + out[i]) + ring[i]) - in[i]) - ring[i - 1];
     else
