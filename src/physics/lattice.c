@@ -236,8 +236,9 @@ static void hub(const lat_args *a, double *const *rad, const lat_cols *cs)
 
 /* The sweep (lattice_sweep_t.h) on the float64 state. */
 LAT_INLINE void radials64(const lat_args *a, double *const *Xa, double *const *Va, double *const *Xb, double *const *Vb,
-                          uint32_t j, double *const *f, const lat_cols *cs)
+                          uint32_t j, double *const *f, const lat_cols *cs, bool hold)
 {
+    (void)hold; /* float64 adds its terms into the columns in the spring loop */
     const spn__lattice *L = a->L;
     const size_t s0 = (size_t)j * L->radials;
     springs_rows(L->radials, (const double *const *)Xa, (const double *const *)Va, (const double *const *)Xb,
@@ -246,8 +247,9 @@ LAT_INLINE void radials64(const lat_args *a, double *const *Xa, double *const *V
 }
 
 LAT_INLINE void rings64(const lat_args *a, double *const *X, double *const *V, uint32_t j, double *const *f,
-                        const lat_cols *cs)
+                        const lat_cols *cs, bool held)
 {
+    (void)held;
     const spn__lattice *L = a->L;
     const uint32_t n = L->radials;
     const size_t s0 = (size_t)j * n;

@@ -125,7 +125,7 @@ static void LK(store_level)(LK(block) *B, double *partial, uint32_t s, uint32_t 
 /* The hub at level s: its radial springs into ring 0 (forces into rad),
  * then its update; sums into the columns cs. */
 LAT_INLINE void LK(block_hub)(LK(block) *B, uint32_t s, LK_T *const *X, LK_T *const *V, LK_T *const *rad,
-                              const lat_cols *cs)
+                              const lat_cols *cs, bool hold)
 {
     const LK_ARGS *a = &B->la[s - 1];
     const uint32_t n = B->L->radials;
@@ -136,7 +136,7 @@ LAT_INLINE void LK(block_hub)(LK(block) *B, uint32_t s, LK_T *const *X, LK_T *co
         hv[c] = base ? B->V[c][0] : B->hub_trial[s - 2][3 + c];
         for (uint32_t i = 0; i < n; i++) B->hub[c][i] = hx[c], B->hub[3 + c][i] = hv[c];
     }
-    LK(radials)(a, B->hub, B->hub + 3, X, V, 0, rad, cs);
+    LK(radials)(a, B->hub, B->hub + 3, X, V, 0, rad, cs, hold);
     if (!B->rk4) {
         LK(hub_move)(n, a->mode == MODE_SYMPLECTIC, a->dt, a->g, a->drag, B->mass[0], B->inv_mass[0], B->X, B->V,
                      rad, cs);
@@ -198,18 +198,19 @@ LAT_INLINE void LK(op)(LK(block) *B, double *partial, uint32_t s, uint32_t j)
         const int q = (int)((j / L->band_rows) & 1);
         const bool cut = j > 0 && j % L->band_rows == 0;
         const lat_cols *own = mine ? &lv->band[q] : &B->dummy;
+        const bool held = j < hi && !(mine && cut); /* the ring springs follow, into the same columns */
         if (j == 0) {
-            LK(block_hub)(B, s, X, V, lv->rad[cur], own);
+            LK(block_hub)(B, s, X, V, lv->rad[cur], own, held);
         } else {
             LK_T *Xp[3], *Vp[3];
             LK(eval_ptrs)(B, s, j - 1, Xp, Vp);
-            LK(radials)(a, Xp, Vp, X, V, j, lv->rad[cur], mine && cut ? &B->cut : own);
+            LK(radials)(a, Xp, Vp, X, V, j, lv->rad[cur], mine && cut ? &B->cut : own, held);
             if (mine && cut) {
                 lv->cut_e[q] = col_take(B->cut.c[L_ELASTIC], L->radials);
                 lv->cut_p[q] = col_take(B->cut.c[L_DAMP], L->radials);
             }
         }
-        if (j < hi) LK(rings)(a, X, V, j, lv->ring[cur], own);
+        if (j < hi) LK(rings)(a, X, V, j, lv->ring[cur], own, held);
     }
     if (j > LK(low)(B, s)) {
         const uint32_t r = j - 1, b = r / L->band_rows;

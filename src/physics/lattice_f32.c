@@ -142,15 +142,15 @@ static void hub32(const a32 *a, float *const *rad, const lat_cols *cs)
 /* The sweep (lattice_sweep_t.h) on the float32 state: a spring's
  * difference is its slot's reference difference plus the displacements'. */
 LAT_INLINE void radials32(const a32 *a, float *const *Da, float *const *Ua, float *const *Db, float *const *Ub,
-                          uint32_t j, float *const *f, const lat_cols *cs)
+                          uint32_t j, float *const *f, const lat_cols *cs, bool hold)
 {
     const spn__lat32 *F = a->F;
     spring_rows(a->L->radials, Da, Ua, Db, Ub, (float *const *)F->rl, (size_t)j * a->L->radials, F->rk, F->rkd, F->rr,
-                f, 0, cs, wants_elastic(a->mode, a->stage));
+                f, 0, cs, wants_elastic(a->mode, a->stage), hold ? SUMS_HOLD : SUMS_ADD);
 }
 
-LAT_INLINE void rings32(const a32 *a, float *const *D, float *const *U, uint32_t j, float *const *f,
-                        const lat_cols *cs)
+LAT_INLINE void rings32(const a32 *a, float *const *D, float *const *U, uint32_t j, float *const *f, const lat_cols *cs,
+                        bool held)
 {
     const spn__lat32 *F = a->F;
     const uint32_t n = a->L->radials;
@@ -158,8 +158,9 @@ LAT_INLINE void rings32(const a32 *a, float *const *D, float *const *U, uint32_t
     float *D1[3], *U1[3], *Dl[3], *Ul[3]; /* the row from its second and its last particle */
     for (int c = 0; c < 3; c++) D1[c] = D[c] + 1, U1[c] = U[c] + 1, Dl[c] = D[c] + n - 1, Ul[c] = U[c] + n - 1;
     const bool el = wants_elastic(a->mode, a->stage);
-    spring_rows(n - 1, D, U, D1, U1, (float *const *)F->gl, s0, F->gk, F->gkd, F->gr, f, 0, cs, el);
-    spring_rows(1, D, U, Dl, Ul, (float *const *)F->gl, s0 + n - 1, F->gk, F->gkd, F->gr, f, n - 1, cs, el);
+    spring_rows(n - 1, D, U, D1, U1, (float *const *)F->gl, s0, F->gk, F->gkd, F->gr, f, 0, cs, el,
+                held ? SUMS_JOIN : SUMS_ADD);
+    spring_rows(1, D, U, Dl, Ul, (float *const *)F->gl, s0 + n - 1, F->gk, F->gkd, F->gr, f, n - 1, cs, el, SUMS_ADD);
 }
 
 LAT_INLINE void hub_state32(const a32 *a, float *x, float *v)

@@ -45,13 +45,17 @@ typedef struct lat_cols {
      * terms here, in a loop that stays all float32 (16 lanes wide), and add
      * them into c after it (col_addf) */
     float *scr[L_NSUMS];
+    /* float32: a row's ring spring terms (elastic, damping) while its
+     * radial springs' are held in scr[L_ELASTIC], scr[L_DAMP], so that one
+     * pass adds both (col_join; spring_rows in lattice_rows32.h) */
+    float *join[2];
 } lat_cols;
 /* Per thread: COL_SETS sets, then the cut's two columns. A sweep uses set
  * 0; a blocked pass two per level (sets 2 s and 2 s + 1) and the last for
  * the ghost rows' sums, which are never read (that set alone is not kept
  * zero). */
 #define COL_SETS (2 * SPN__LAT_BLOCK_MAX + 1)
-#define COL_COUNT (COL_SETS * L_NSUMS + 2 + (L_NSUMS + 1) / 2)
+#define COL_COUNT (COL_SETS * L_NSUMS + 2 + (L_NSUMS + 2 + 1) / 2)
 
 /* The float32 step's state and arrays (lattice_f32.c). */
 typedef struct spn__lat32 spn__lat32;
@@ -127,9 +131,11 @@ LAT_INLINE double lane_total(const double *acc)
 /* Column set `set` of a thread's columns, or (set < 0) the cut's two. */
 LAT_INLINE lat_cols col_set(double *cols, size_t stride, int set)
 {
-    lat_cols cs = {{NULL}, {NULL}};
+    lat_cols cs = {{NULL}, {NULL}, {NULL}};
     float *scr = (float *)(cols + ((size_t)COL_SETS * L_NSUMS + 2) * stride); /* after every double column */
     for (int k = 0; k < L_NSUMS; k++) cs.scr[k] = scr + (size_t)k * stride;
+    for (int k = 0; k < 2; k++)
+        cs.join[k] = scr + (size_t)(L_NSUMS + k) * stride;
     if (set < 0) {
         cs.c[L_ELASTIC] = cols + (size_t)COL_SETS * L_NSUMS * stride;
         cs.c[L_DAMP] = cs.c[L_ELASTIC] + stride;
@@ -148,6 +154,17 @@ LAT_INLINE lat_cols col_set(double *cols, size_t stride, int set)
 LAT_INLINE void col_addf(double *restrict c, const float *restrict t, uint32_t n)
 {
     for (uint32_t i = 0; i < n; i++) c[i] += (double)t[i];
+}
+
+/* A row's held radial terms h (n + 1 of them) and its ring terms t (n)
+ * added into column c in one pass: (c[i] + h[i]) + t[i], the bits of
+ * col_addf(c, h, n + 1) and then col_addf(c, t, n), with one load and store
+ * of c fewer per term. */
+LAT_INLINE void col_join(double *restrict c, const float *restrict h, const float *restrict t, uint32_t n)
+{
+    for (uint32_t i = 0; i < n; i++)
+        c[i] = (c[i] + (double)h[i]) + (double)t[i];
+    c[n] += (double)h[n];
 }
 
 /* The sum of column c[0 .. n) (in eight lanes, i mod 8, then lane_total),

@@ -52,25 +52,40 @@ LAT_INLINE void springs32(bool elastic, uint32_t n, const float *restrict dax, c
     }
 }
 
+/* What spring_rows does with its sum terms: adds them into the columns
+ * (SUMS_ADD); leaves them in the scratch, held for the ring springs of the
+ * same row (SUMS_HOLD, a row's radial springs); or adds them together with
+ * the held terms, in one pass (SUMS_JOIN, the ring springs but the wrap).
+ * The columns get the same bits either way (col_join). */
+typedef enum { SUMS_ADD, SUMS_HOLD, SUMS_JOIN } lat_sums;
+
 /* Springs between rows (3 arrays each, already offset) a and b; forces
  * into f and sums into the columns cs, both at off_f (the elastic energy
- * if `elastic`: wants_elastic in lattice_rows.h). */
+ * if `elastic`: wants_elastic in lattice_rows.h), as `how` says; a joined
+ * call has one spring fewer than the held one. */
 LAT_INLINE void spring_rows(uint32_t n, float *const *da, float *const *ua, float *const *db, float *const *ub,
                             float *const *L, size_t s0, const float *k, const float *kd, const float *rest,
-                            float *const *f, size_t off_f, const lat_cols *cs, bool elastic)
+                            float *const *f, size_t off_f, const lat_cols *cs, bool elastic, lat_sums how)
 {
+    float *te = how == SUMS_JOIN ? cs->join[0] : cs->scr[L_ELASTIC];
+    float *tp = how == SUMS_JOIN ? cs->join[1] : cs->scr[L_DAMP];
 #define LAT_SPRINGS(elastic)                                                                                           \
     springs32(elastic, n, da[0], da[1], da[2], db[0], db[1], db[2], ua[0], ua[1], ua[2], ub[0], ub[1], ub[2],          \
               L[0] + s0, L[1] + s0, L[2] + s0, k + s0, kd + s0, rest + s0, f[0] + off_f, f[1] + off_f, f[2] + off_f,   \
-              cs->scr[L_ELASTIC], cs->scr[L_DAMP])
-    if (elastic) {
+              te, tp)
+    if (elastic)
         LAT_SPRINGS(true);
-        col_addf(cs->c[L_ELASTIC], cs->scr[L_ELASTIC], n);
-    } else {
+    else
         LAT_SPRINGS(false);
-    }
 #undef LAT_SPRINGS
-    col_addf(cs->c[L_DAMP], cs->scr[L_DAMP], n);
+    if (how == SUMS_HOLD) return;
+    if (how == SUMS_JOIN) {
+        if (elastic) col_join(cs->c[L_ELASTIC], cs->scr[L_ELASTIC], te, n);
+        col_join(cs->c[L_DAMP], cs->scr[L_DAMP], tp, n);
+        return;
+    }
+    if (elastic) col_addf(cs->c[L_ELASTIC], te, n);
+    col_addf(cs->c[L_DAMP], tp, n);
 }
 
 #endif

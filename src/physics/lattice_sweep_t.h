@@ -5,11 +5,15 @@
  * The including file defines LK(name), LK_ARGS (its step arguments, with a
  * member L, the spn__lattice) and, for its precision:
  *   LK(eval)(a, p0, X, V)        row p0 of the evaluated state (3 + 3 arrays)
- *   LK(radials)(a, Xa, Va, Xb, Vb, j, f, cs)
+ *   LK(radials)(a, Xa, Va, Xb, Vb, j, f, cs, hold)
  *                                the radial springs from row a into row j
  *                                (b), forces on the inner end into f, sums
- *                                into the columns cs (lattice_rows.h)
- *   LK(rings)(a, X, V, j, f, cs) row j's ring springs, wrap included
+ *                                into the columns cs (lattice_rows.h); if
+ *                                `hold`, row j's ring springs follow into
+ *                                the same cs, and the sums may wait for them
+ *   LK(rings)(a, X, V, j, f, cs, held)
+ *                                row j's ring springs, wrap included; `held`:
+ *                                the radials into row j were called with hold
  *   LK(hub_state)(a, x, v)       the hub's evaluated state (3 each)
  *   LK(hub)(a, rad, cs)          the hub's force from its radials, and its update
  *   LK(finish)(a, p0, n, ri, rg, ro, F, cs)
@@ -34,7 +38,7 @@ SPN__KERNEL static void LK(cut_pass)(const LK_ARGS *a, double *cols, uint32_t b)
     LK(eval)(a, 1 + (size_t)j * n, Xb, Vb);
     for (int c = 0; c < 3; c++) f[c] = LK(cut)(a) + ((size_t)b * 3 + c) * n;
     const lat_cols cs = col_set(cols, L->col_stride, -1);
-    LK(radials)(a, Xa, Va, Xb, Vb, j, f, &cs);
+    LK(radials)(a, Xa, Va, Xb, Vb, j, f, &cs, false);
     double *p = L->partial + (size_t)b * L_NSUMS;
     p[L_ELASTIC] = col_take(cs.c[L_ELASTIC], n), p[L_DAMP] = col_take(cs.c[L_DAMP], n);
 }
@@ -70,16 +74,16 @@ SPN__KERNEL static void LK(band_pass)(const LK_ARGS *a, LK_T *ws, double *cols, 
             LK(hub_state)(a, hx, hv);
             for (int c = 0; c < 3; c++)
                 for (uint32_t i = 0; i < n; i++) H[c][i] = hx[c], H[3 + c][i] = hv[c];
-            LK(radials)(a, H, H + 3, X, V, 0, RAD[cur], &cs);
+            LK(radials)(a, H, H + 3, X, V, 0, RAD[cur], &cs, true);
             rad_cur = RAD[cur];
             LK(hub)(a, rad_cur, &cs);
         } else {
             LK_T *Xp[3], *Vp[3];
             LK(eval)(a, p0 - n, Xp, Vp);
-            LK(radials)(a, Xp, Vp, X, V, j, RAD[cur], &cs);
+            LK(radials)(a, Xp, Vp, X, V, j, RAD[cur], &cs, true);
             rad_cur = RAD[cur];
         }
-        LK(rings)(a, X, V, j, RING[cur], &cs);
+        LK(rings)(a, X, V, j, RING[cur], &cs, j == 0 || j > lo); /* row lo's radials: the cut pass */
         if (j > lo) LK(finish)(a, p0 - n, n, rad_prev, RING[cur ^ 1], rad_cur, Fw, &cs);
         rad_prev = rad_cur;
     }
