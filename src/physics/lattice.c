@@ -198,7 +198,7 @@ LAT_INLINE void rk4_update(const lat_args *a, size_t p0, uint32_t n, double *con
         R.xt[c] = a->tx[c] ? a->tx[c] + p0 : NULL, R.vt[c] = a->tv[c] ? a->tv[c] + p0 : NULL;
         R.ax[c] = L->ax[c] + p0, R.av[c] = L->av[c] + p0;
     }
-    rk4_update64(n, a->stage, a->h, a->weight, a->drag, a->g, a->mass + p0, a->inv_mass + p0, &R, F, cs);
+    rk4_update64(n, a->stage, a->h, a->weight, a->drag, a->kin_known, a->g, a->mass + p0, a->inv_mass + p0, &R, F, cs);
 }
 
 /* Row p0 complete (radial in, ring, radial out or NULL): its update. */

@@ -36,6 +36,7 @@
 #include "lattice_rows32.h"
 #include "world_internal.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -65,6 +66,12 @@ struct spn__lat32 {
     bool live;            /* the state above is ahead of w->x, w->v */
     bool params_ok;       /* rk .. gr match the lattice's float64 slots */
     uint32_t since;       /* steps since the last rebase */
+    /* After an RK4 step: the sum of m v^2 over the state it left (its
+     * last stage's L_MVN2, the bits of the next step's first stage's
+     * L_MV2, see LK(rk4_update)); mv2_ok until the state is loaded again
+     * or another integrator steps it. */
+    double mv2;
+    bool mv2_ok;
 };
 
 typedef struct a32 {
@@ -75,6 +82,7 @@ typedef struct a32 {
     float g[3], drag, dt, h, weight;
     int mode;                   /* MODE_* (lattice_rows.h) */
     int stage;                  /* RK4: the stage, 0-3 (MODE_RK4_LAST at 3) */
+    bool kin_known;             /* RK4 without drag: m v^2 at the step's start is F->mv2 (LK(rk4_update)) */
 } a32;
 
 void spn__lat32_free(spn__lat32 *F)
@@ -104,7 +112,7 @@ LAT_INLINE void rk4_update(const a32 *a, size_t p0, uint32_t n, float *const *F,
         R.xt[c] = a->td[c] ? a->td[c] + p0 : NULL, R.vt[c] = a->tu[c] ? a->tu[c] + p0 : NULL;
         R.ax[c] = S->ax[c] + p0, R.av[c] = S->av[c] + p0;
     }
-    rk4_update32(n, a->stage, a->h, a->weight, a->drag, a->g, S->mass + p0, S->inv_mass + p0, &R, F, cs);
+    rk4_update32(n, a->stage, a->h, a->weight, a->drag, a->kin_known, a->g, S->mass + p0, S->inv_mass + p0, &R, F, cs);
 }
 
 LAT_INLINE void finish32(const a32 *a, size_t p0, uint32_t n, float *const *ri, float *const *rg,
@@ -285,6 +293,7 @@ static bool load(spn_world *w, int threads)
     references(w, threads);
     F->since = 0;
     F->live = true;
+    F->mv2_ok = false;
     return true;
 }
 
@@ -350,6 +359,34 @@ static bool begin(spn_world *w, int threads, double dt, bool rk4, a32 *a)
     return true;
 }
 
+/* Before an RK4 step: whether its first stage can take m v^2 from the step
+ * before (lattice_rows_t.h, LK(rk4_update)). A debug build checks the
+ * carried sum against the state (to float32's round-off: the carry is
+ * meant to be bit-exact, but a stale one is what this would catch). */
+static bool mv2_known(const spn_world *w)
+{
+    const spn__lat32 *F = w->lat->f32;
+    if (!F->mv2_ok || w->def.drag != 0) return false;
+#ifndef NDEBUG
+    double mv2 = 0;
+    for (size_t i = 0; i < F->np; i++)
+        if (F->inv_mass[i] != 0)
+            mv2 += (double)F->mass[i] * ((double)F->u[0][i] * F->u[0][i] + (double)F->u[1][i] * F->u[1][i] +
+                                         (double)F->u[2][i] * F->u[2][i]);
+    assert(fabs(mv2 - F->mv2) <= 1e-4 * mv2 + 1e-300);
+#endif
+    return true;
+}
+
+/* After an RK4 step (its four stages' sums; `known`: mv2_known before it):
+ * the first stage's m v^2 put in, and the last's kept for the next step. */
+static void mv2_carry(spn__lat32 *F, bool known, double sums[][L_NSUMS])
+{
+    if (known) sums[0][L_MV2] = F->mv2;
+    F->mv2 = sums[3][L_MVN2];
+    F->mv2_ok = true;
+}
+
 /* After a step: rebase every REBASE steps, write back after a step with a
  * backup (spn_world_step, or a run that does not replay). */
 static void end(spn_world *w, int threads)
@@ -363,6 +400,7 @@ bool spn__lat32_explicit(spn_world *w, int threads, double dt, bool symplectic, 
     a32 a;
     if (!begin(w, threads, dt, false, &a)) return false;
     a.mode = symplectic ? MODE_SYMPLECTIC : MODE_EULER;
+    w->lat->f32->mv2_ok = false;
     double sum[L_NSUMS];
     sweep32(&a, threads, sum);
     lat_explicit_result(sum, dt, w->def.drag, r);
@@ -379,6 +417,8 @@ bool spn__lat32_rk4(spn_world *w, int threads, double dt, spn__step_result *r)
     spn__lat32 *F = w->lat->f32;
     static const float weight[4] = {1, 2, 2, 1}, frac[4] = {0, 0.5f, 0.5f, 1};
     double sums[4][L_NSUMS];
+    const bool known = mv2_known(w);
+    a.kin_known = known;
     for (int stage = 0; stage < 4; stage++) {
         float *const *from = F->trial[(stage + 1) % 2], *const *to = F->trial[stage % 2];
         for (int c = 0; c < 3; c++) {
@@ -391,6 +431,7 @@ bool spn__lat32_rk4(spn_world *w, int threads, double dt, spn__step_result *r)
         a.h = stage < 3 ? frac[stage + 1] * (float)dt : (float)dt / 6;
         sweep32(&a, threads, sums[stage]);
     }
+    mv2_carry(F, known, sums);
     lat_rk4_result(sums, dt, w->def.drag, r);
     end(w, threads);
     return true;
@@ -408,6 +449,8 @@ int spn__lat32_block_steps(spn_world *w, int threads, double dt, int mode, int k
     const uint32_t levels = rk4 ? 4 : (uint32_t)k;
     a32 la[LAT_LEVELS];
     if (levels < 2 || !begin(w, threads, dt, false, &la[0])) return 0;
+    const bool known = rk4 && mv2_known(w);
+    la[0].kin_known = known;
     static const float weight[4] = {1, 2, 2, 1}, frac[4] = {0, 0.5f, 0.5f, 1};
     for (uint32_t s = 0; s < levels; s++) {
         la[s] = la[0];
@@ -419,10 +462,15 @@ int spn__lat32_block_steps(spn_world *w, int threads, double dt, int mode, int k
     double sums[LAT_LEVELS][L_NSUMS];
     if (!block_pass32(w->lat, la, rk4, threads, levels, sums)) return 0;
     const int steps = rk4 ? 1 : k;
-    if (rk4) lat_rk4_result(sums, dt, w->def.drag, &r[0]);
-    else
-        for (int q = 0; q < k; q++) lat_explicit_result(sums[q], dt, w->def.drag, &r[q]);
     spn__lat32 *F = w->lat->f32;
+    if (rk4) {
+        mv2_carry(F, known, sums);
+        lat_rk4_result(sums, dt, w->def.drag, &r[0]);
+    } else {
+        F->mv2_ok = false;
+        for (int q = 0; q < k; q++)
+            lat_explicit_result(sums[q], dt, w->def.drag, &r[q]);
+    }
     F->since += (uint32_t)steps;
     if (F->since >= REBASE) write_back(w, threads, true); /* (as `end` after the pass's last step) */
     return steps;

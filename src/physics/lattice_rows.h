@@ -111,6 +111,7 @@ typedef struct lat_args {
     double g[3], drag, dt, h, weight;
     int mode;                    /* MODE_* above */
     int stage;                   /* RK4: the stage, 0-3 (MODE_RK4_LAST at 3) */
+    bool kin_known;              /* RK4 (float32 only): see LK(rk4_update) */
 } lat_args;
 
 #define LK_T double

@@ -328,15 +328,22 @@ LAT_INLINE void LK(rk4_stages)(uint32_t n, int stage, LK_T h, LK_T wgt, const LK
 
 /* n particles of RK4 stage `stage` (0-3; weighted `wgt`, step fraction h,
  * or h = dt / 6 at the last), their force F known and masses from mass and
- * inv_mass; sum terms into the columns cs. */
-LAT_INLINE void LK(rk4_update)(uint32_t n, int stage, LK_T h, LK_T wgt, LK_T drag, const LK_T *g, const LK_T *mass,
-                               const LK_T *inv_mass, const LK(rk4_rows) *R, LK_T *const *F, const lat_cols *cs)
+ * inv_mass; sum terms into the columns cs. kin_known: no drag, and the sum
+ * of m v^2 at the first stage is known already, so it is not summed. (The
+ * last stage's m v'^2 terms are those of the next step's first stage, bit
+ * for bit: LK(rk4_sums) forms v' as LK(rk4_last) stores it, the masses
+ * and the mass-0 select are the same, and the terms go into the same
+ * columns in the same order. The float32 step keeps that sum from step to
+ * step inside a call: spn__lat32.mv2.) */
+LAT_INLINE void LK(rk4_update)(uint32_t n, int stage, LK_T h, LK_T wgt, LK_T drag, bool kin_known, const LK_T *g,
+                               const LK_T *mass, const LK_T *inv_mass, const LK(rk4_rows) *R, LK_T *const *F,
+                               const lat_cols *cs)
 {
     if (stage < 3) {
         /* m v^2 at a stage's state serves the drag's loss (and, at the first
          * stage, the energy before the step); without drag the later stages
          * skip it, as drag * m v^2 would add exactly zero */
-        if (stage == 0 || drag != 0) {
+        if ((stage == 0 && !kin_known) || drag != 0) {
             LK(rk4_kin)(n, mass, inv_mass, R->V[0], R->V[1], R->V[2], LK_TERMS(cs, L_MV2));
             LK_DONE(cs, L_MV2, n);
         }
