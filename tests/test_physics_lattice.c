@@ -199,6 +199,29 @@ static void test_blocked_passes(void **state)
     spn_world_destroy(ref);
 }
 
+/* The float64 RK4 pass in each of its versions (SPN_RK4_AVX2=0: the one
+ * target_clones picks, AVX-512 where the processor has it; 1: AVX2 code,
+ * where it has that; lattice_block.c): the bits of single steps, on 1 and
+ * 2 threads. */
+static void test_rk4_pass_versions(void **state)
+{
+    (void)state;
+    const double dt = 2e-6;
+    spn_world *ref = disturbed_orb(SPN_INTEGRATOR_RK4, 40, 50, 1, 256, true);
+    for (int i = 0; i < 29; i++) assert_int_equal(spn_world_step(ref, dt), SPN_OK);
+    const char *const version[2] = {"0", "1"};
+    for (int v = 0; v < 2; v++) {
+        assert_int_equal(setenv("SPN_RK4_AVX2", version[v], 1), 0);
+        spn_world *one = disturbed_orb(SPN_INTEGRATOR_RK4, 40, 50, 1, 256, true);
+        spn_world *two = disturbed_orb(SPN_INTEGRATOR_RK4, 40, 50, 2, 256, true);
+        assert_passes_match(one, two, ref, dt, 29, 29);
+        spn_world_destroy(one);
+        spn_world_destroy(two);
+    }
+    assert_int_equal(unsetenv("SPN_RK4_AVX2"), 0);
+    spn_world_destroy(ref);
+}
+
 /* disturbed_orb on the float32 step (spn_world_set_precision). */
 static spn_world *disturbed_orb32(spn_integrator integ, int threads, uint32_t parallel_min)
 {
@@ -434,6 +457,7 @@ int main(void)
         cmocka_unit_test(test_same_trajectory),
         cmocka_unit_test(test_bands_and_threads),
         cmocka_unit_test(test_blocked_passes),
+        cmocka_unit_test(test_rk4_pass_versions),
         cmocka_unit_test(test_blocked_passes_float32),
         cmocka_unit_test(test_changes_and_break),
         cmocka_unit_test(test_hand_built_and_breakage),

@@ -289,7 +289,9 @@ static void state64(const lat_args *a, double **X, double **V)
 static const double *mass64(const lat_args *a) { return a->mass; }
 static const double *inv_mass64(const lat_args *a) { return a->inv_mass; }
 
+#define LK_RK4_AVX2
 #include "lattice_block_t.h"
+#undef LK_RK4_AVX2
 #undef LK_ARGS
 #undef LK
 #undef LK_T

@@ -275,7 +275,9 @@ static void LK(copy_ghosts)(LK(block) *B)
     }
 }
 
-SPN__KERNEL static void LK(run_block)(LK(block) *B, double *partial)
+/* This block's pass, front by front. Inlined into each version of
+ * run_block below. */
+LAT_INLINE void LK(fronts)(LK(block) *B, double *partial)
 {
     const uint32_t K = B->K, first = LK(low)(B, 1), last = LK(high)(B, K) + K - 1;
     for (uint32_t J = first; J <= last; J++)
@@ -284,6 +286,27 @@ SPN__KERNEL static void LK(run_block)(LK(block) *B, double *partial)
             const uint32_t j = J + 1 - s;
             if (j >= LK(low)(B, s) && j <= LK(high)(B, s)) LK(op)(B, partial, s, j);
         }
+}
+
+SPN__KERNEL static void LK(run_block)(LK(block) *B, double *partial) { LK(fronts)(B, partial); }
+
+/* The same in AVX2 code alone, where the including file defines
+ * LK_RK4_AVX2 (float64): its RK4 passes on the processors
+ * spn__lattice_rk4_avx2 names run this instead of the AVX-512 version
+ * target_clones would pick. Same bits, as every version gives. */
+#if defined(LK_RK4_AVX2) && defined(SPN__AVX2)
+SPN__AVX2 static void LK(avx2_block)(LK(block) *B, double *partial) { LK(fronts)(B, partial); }
+#endif
+
+/* The version of run_block a pass (rk4 or not) runs. */
+static void (*LK(runner)(bool rk4))(LK(block) *, double *)
+{
+#if defined(LK_RK4_AVX2) && defined(SPN__AVX2)
+    if (rk4 && spn__lattice_rk4_avx2()) return LK(avx2_block);
+#else
+    (void)rk4;
+#endif
+    return LK(run_block);
 }
 
 /* K levels (2 .. LAT_LEVELS, spn__lattice_block_ready) in one pass over the
@@ -297,6 +320,7 @@ static bool LK(block_pass)(spn__lattice *L, const LK_ARGS *la, bool rk4, int thr
         !spn__lattice_cols_alloc(L, threads))
         return false;
     const uint32_t nb = L->nbands;
+    void (*const run)(LK(block) *, double *) = LK(runner)(rk4);
 #pragma omp parallel num_threads(threads)
     {
         const int t = spn__thread_num();
@@ -307,7 +331,7 @@ static bool LK(block_pass)(spn__lattice *L, const LK_ARGS *la, bool rk4, int thr
         LK(block_init)(&B, la, rk4, (LK_T *)L->bws[t], L->cols[t], R0, R1, K);
         LK(copy_ghosts)(&B);
 #pragma omp barrier
-        LK(run_block)(&B, L->partial_k);
+        run(&B, L->partial_k);
     }
     spn__lattice_block_sums(L, K, sums);
     return true;

@@ -305,6 +305,9 @@ bool spn__lattice_block_alloc(spn__lattice *L, int threads, size_t bytes);
 bool spn__lattice_cols_alloc(spn__lattice *L, int threads);
 /* Each level's sums from its band partials, in band order. */
 void spn__lattice_block_sums(const spn__lattice *L, uint32_t K, double sums[][L_NSUMS]);
+/* Whether float64 RK4 passes run their AVX2 version (lattice_block_t.h,
+ * LK(runner)) on this processor; see lattice_block.c. */
+bool spn__lattice_rk4_avx2(void);
 /* Up to k float32 Euler or symplectic steps (mode), or one RK4 step, as one
  * blocked pass on `threads` threads (block ready); each step's results
  * into r[], the count done (0: none, nothing done). */

@@ -202,6 +202,9 @@ struct spn_world {
  * the same bits. */
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && !defined(SPN_NO_CLONES)
 #define SPN__KERNEL __attribute__((target_clones("avx512f", "avx2", "default")))
+/* One version of a kernel, for code that picks the version itself at run
+ * time (spn__lattice_rk4_avx2): SPN__AVX2 compiles a function for AVX2. */
+#define SPN__AVX2 __attribute__((target("avx2")))
 #else
 #define SPN__KERNEL
 #endif
