@@ -66,12 +66,7 @@ struct spn__lat32 {
     bool live;            /* the state above is ahead of w->x, w->v */
     bool params_ok;       /* rk .. gr match the lattice's float64 slots */
     uint32_t since;       /* steps since the last rebase */
-    /* After an RK4 step: the sum of m v^2 over the state it left (its
-     * last stage's L_MVN2, the bits of the next step's first stage's
-     * L_MV2, see LK(rk4_update)); mv2_ok until the state is loaded again
-     * or another integrator steps it. */
-    double mv2;
-    bool mv2_ok;
+    lat_mv2 mv2;          /* RK4 without drag: m v^2 of the state above (lat_mv2) */
 };
 
 typedef struct a32 {
@@ -293,7 +288,7 @@ static bool load(spn_world *w, int threads)
     references(w, threads);
     F->since = 0;
     F->live = true;
-    F->mv2_ok = false;
+    F->mv2.ok = false;
     return true;
 }
 
@@ -366,25 +361,16 @@ static bool begin(spn_world *w, int threads, double dt, bool rk4, a32 *a)
 static bool mv2_known(const spn_world *w)
 {
     const spn__lat32 *F = w->lat->f32;
-    if (!F->mv2_ok || w->def.drag != 0) return false;
+    if (!F->mv2.ok || w->def.drag != 0) return false;
 #ifndef NDEBUG
     double mv2 = 0;
     for (size_t i = 0; i < F->np; i++)
         if (F->inv_mass[i] != 0)
             mv2 += (double)F->mass[i] * ((double)F->u[0][i] * F->u[0][i] + (double)F->u[1][i] * F->u[1][i] +
                                          (double)F->u[2][i] * F->u[2][i]);
-    assert(fabs(mv2 - F->mv2) <= 1e-4 * mv2 + 1e-300);
+    assert(fabs(mv2 - F->mv2.sum) <= 1e-4 * mv2 + 1e-300);
 #endif
     return true;
-}
-
-/* After an RK4 step (its four stages' sums; `known`: mv2_known before it):
- * the first stage's m v^2 put in, and the last's kept for the next step. */
-static void mv2_carry(spn__lat32 *F, bool known, double sums[][L_NSUMS])
-{
-    if (known) sums[0][L_MV2] = F->mv2;
-    F->mv2 = sums[3][L_MVN2];
-    F->mv2_ok = true;
 }
 
 /* After a step: rebase every REBASE steps, write back after a step with a
@@ -400,7 +386,7 @@ bool spn__lat32_explicit(spn_world *w, int threads, double dt, bool symplectic, 
     a32 a;
     if (!begin(w, threads, dt, false, &a)) return false;
     a.mode = symplectic ? MODE_SYMPLECTIC : MODE_EULER;
-    w->lat->f32->mv2_ok = false;
+    w->lat->f32->mv2.ok = false;
     double sum[L_NSUMS];
     sweep32(&a, threads, sum);
     lat_explicit_result(sum, dt, w->def.drag, r);
@@ -431,7 +417,7 @@ bool spn__lat32_rk4(spn_world *w, int threads, double dt, spn__step_result *r)
         a.h = stage < 3 ? frac[stage + 1] * (float)dt : (float)dt / 6;
         sweep32(&a, threads, sums[stage]);
     }
-    mv2_carry(F, known, sums);
+    lat_mv2_carry(&F->mv2, known, sums);
     lat_rk4_result(sums, dt, w->def.drag, r);
     end(w, threads);
     return true;
@@ -464,10 +450,10 @@ int spn__lat32_block_steps(spn_world *w, int threads, double dt, int mode, int k
     const int steps = rk4 ? 1 : k;
     spn__lat32 *F = w->lat->f32;
     if (rk4) {
-        mv2_carry(F, known, sums);
+        lat_mv2_carry(&F->mv2, known, sums);
         lat_rk4_result(sums, dt, w->def.drag, &r[0]);
     } else {
-        F->mv2_ok = false;
+        F->mv2.ok = false;
         for (int q = 0; q < k; q++)
             lat_explicit_result(sums[q], dt, w->def.drag, &r[q]);
     }

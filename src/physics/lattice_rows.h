@@ -74,6 +74,25 @@ bool spn__lat32_explicit(spn_world *w, int threads, double dt, bool symplectic, 
 /* One float32 RK4 step over the lattice, likewise. */
 bool spn__lat32_rk4(spn_world *w, int threads, double dt, spn__step_result *r);
 
+/* m v^2 over the state an RK4 step left: its last stage's L_MVN2 sum,
+ * which is the next step's first-stage L_MV2 bit for bit (see
+ * LK(rk4_update)). `ok` from that step until the state is loaded again or
+ * another integrator steps it. */
+typedef struct lat_mv2 {
+    double sum;
+    bool ok;
+} lat_mv2;
+
+/* After an RK4 step's four stages (`known`: its first stage took m v^2
+ * from m, kin_known): that sum put into its first stage's sums, the last
+ * stage's kept for the next step. */
+static inline void lat_mv2_carry(lat_mv2 *m, bool known, double sums[][L_NSUMS])
+{
+    if (known) sums[0][L_MV2] = m->sum;
+    m->sum = sums[3][L_MVN2];
+    m->ok = true;
+}
+
 struct spn__lattice {
     uint32_t rings, radials;
     double *rk, *rkd, *rrest; /* radial slots: ring * N + i, (ring - 1, i) -> (ring, i) */
@@ -87,6 +106,7 @@ struct spn__lattice {
     double *state;   /* the float64 state, structure of arrays: x, v by component, np each */
     double *x[3], *v[3];
     bool live;       /* inside spn_world_advance: x, v above are ahead of w->x, w->v */
+    lat_mv2 mv2;     /* RK4 without drag: m v^2 of x, v above (lat_mv2) */
     double *rk4;     /* RK4 (on first use): two trial states, 6 x np each, ax, av */
     double *trial[2][6], *ax[3], *av[3];
     void **bws;        /* temporal blocking (lattice_block_t.h): per-thread workspaces, */
@@ -111,7 +131,7 @@ typedef struct lat_args {
     double g[3], drag, dt, h, weight;
     int mode;                    /* MODE_* above */
     int stage;                   /* RK4: the stage, 0-3 (MODE_RK4_LAST at 3) */
-    bool kin_known;              /* RK4 (float32 only): see LK(rk4_update) */
+    bool kin_known;              /* RK4 without drag: m v^2 at the step's start is L->mv2 (LK(rk4_update)) */
 } lat_args;
 
 #define LK_T double
