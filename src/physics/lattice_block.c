@@ -70,9 +70,10 @@ bool spn__lattice_cols_alloc(spn__lattice *L, int threads)
 /* The float64 RK4 pass in AVX2 code on Intel processors with AVX-512,
  * where target_clones would pick its AVX-512 version. On an Intel Xeon
  * (family 6, model 207; 2026-12-04) the AVX2 version took 1M RK4 steps
- * about a tenth faster (one thread 30.9 -> 28.0 CPU ns a spring-step, two
- * 15.8 -> 14.2 wall), while the explicit passes ran a tenth faster in
- * AVX-512 (symplectic 5.27 -> 4.76), so only RK4 is moved. On AMD's Zen 4
+ * about a tenth faster on one thread (30.3 -> 27.2 CPU ns a spring-step,
+ * the minimum of six alternating runs; on two threads no difference stood
+ * out of the host's noise), while the explicit passes ran a tenth faster
+ * in AVX-512 (symplectic 5.27 -> 4.76), so only RK4 is moved. On AMD's Zen 4
  * the two were not compared, and it keeps AVX-512 as in its `make bench`
  * figures. SPN_RK4_AVX2=1 or 0 in the environment (read at each pass)
  * overrides the choice on any processor with AVX2, to compare the two
