@@ -8,7 +8,8 @@
 # bench_floor measures says so) and each lattice step's share of
 # the triad on as many threads, with the cache a pass fits in. A failing
 # program fails the run and leaves no results file and no scratch file
-# behind.
+# behind. scripts/ab-step.sh refuses bad input (usage, a bad revision)
+# before it builds anything, and leaves nothing behind.
 . "$(dirname "$0")/lib/common.sh" "$@"
 SRC=${SPN_SOURCE_DIR:?SPN_SOURCE_DIR must name the source tree}
 # the results file is named for the host and its processor (family, model)
@@ -106,4 +107,23 @@ printf '#!/bin/sh\necho "{\\"bench\\":\\"x\\"}"\nexit 3\n' >"$T/p/b/bench_zz_bro
 [ "$(cat "$T/p/bench/results/$machine.json")" = keep ] || fail "the last results were replaced"
 grep -q '^old$' "$T/p/README.md" || fail "the README was rewritten after a failed run"
 ls -a "$T/p/bench/results" | grep -q '^\.tmp' && fail "scratch file left behind after a failure"
+
+# scripts/ab-step.sh refuses bad input before building anything: a usage
+# line and exit 2 for a missing side or a bad run count; a side that is not
+# a revision is named, and no worktree or scratch folder is left behind.
+AB=$SRC/scripts/ab-step.sh
+"$AB" HEAD >"$T/out" 2>"$T/err" && fail "ab-step with one side should fail"
+[ $? -eq 2 ] || fail "ab-step with one side: exit 2 expected"
+grep -q '^usage: scripts/ab-step.sh' "$T/err" || fail "ab-step should print its usage: $(cat "$T/err")"
+"$AB" -n 0 HEAD HEAD >"$T/out" 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] && grep -q '^usage:' "$T/err" || fail "ab-step -n 0: exit 2 and usage expected (exit $rc)"
+if git -C "$SRC" rev-parse --git-dir >/dev/null 2>&1; then
+    before=$(git -C "$SRC" worktree list | wc -l)
+    mkdir -p "$T/tmp"
+    (cd "$SRC" && TMPDIR="$T/tmp" "$AB" no-such-revision HEAD >"$T/out" 2>"$T/err"); rc=$?
+    [ $rc -eq 2 ] || fail "ab-step with a bad revision: exit 2 expected, not $rc"
+    grep -q "'no-such-revision' is not a revision" "$T/err" || fail "ab-step should name the bad side: $(cat "$T/err")"
+    [ "$(git -C "$SRC" worktree list | wc -l)" -eq "$before" ] || fail "ab-step left a worktree behind"
+    [ -z "$(ls -A "$T/tmp")" ] || fail "ab-step left scratch behind: $(ls -A "$T/tmp")"
+fi
 exit 0
