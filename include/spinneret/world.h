@@ -318,6 +318,8 @@ typedef struct spn_step_report {
     double dt;            ///< outer step asked for
     int substeps;         ///< sub-steps taken (adaptive; 1 otherwise)
     int halvings;         ///< times a sub-step was halved (adaptive)
+    int floored;          ///< adaptive: sub-steps taken at def.dt_min although they gained energy
+                          ///< (many, and a blow-up: the floor lies above the web's stable step)
     int cg_iterations;    ///< implicit: CG iterations summed over sub-steps
     int breaks;           ///< springs broken in this step
     int blocked;          ///< spn_world_advance: steps taken several to a pass over memory

@@ -5,7 +5,8 @@
  *   dE = dKE + dPE_gravity + dE_elastic <= W_external  (+ a round-off margin).
  * A sub-step that gains more is undone and retried with the step divided by
  * def.dt_factor, down to def.dt_min (the floor: that sub-step is then taken
- * as it is). After an accepted sub-step the next one tries the step times
+ * as it is, and counted in spn_step_report.floored, so that a blow-up it
+ * leads to can say that the floor, not the outer step, is too long). After an accepted sub-step the next one tries the step times
  * dt_factor, and the last accepted size carries over to the next outer step.
  *
  * Why symplectic Euler: its energy change for a spring is
@@ -100,7 +101,7 @@ spn_status spn__step_adaptive(spn_world *w, double dt, spn__step_result *r)
     const double floor = w->def.dt_min > 0 ? w->def.dt_min : 1e-12 * dt;
     double h = w->adaptive_dt > 0 ? w->adaptive_dt : dt;
     double done = 0, gain_kp = 0, work = 0, lost = 0;
-    int substeps = 0, halvings = 0;
+    int substeps = 0, halvings = 0, floored = 0;
     while (done < dt) {
         bool capped = h >= dt - done;
         double hh = capped ? dt - done : h;
@@ -117,6 +118,7 @@ spn_status spn__step_adaptive(spn_world *w, double dt, spn__step_result *r)
             halvings++;
             continue;
         }
+        if (!(gain <= margin)) floored++;
         swap_buf(&w->f, &w->tmp[SPN_TMP_C]);
         gain_kp += dkp;
         work += wk;
@@ -130,6 +132,7 @@ spn_status spn__step_adaptive(spn_world *w, double dt, spn__step_result *r)
     w->adaptive_dt = h;
     w->last.substeps = substeps;
     w->last.halvings = halvings;
+    w->last.floored = floored;
     r->gain_kp = gain_kp;
     r->work = work;
     r->dissipated = lost;

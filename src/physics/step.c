@@ -52,13 +52,21 @@ static spn_status blew_up(spn_world *w, double dt, double gain)
         return spn_error(SPN_ERR_UNSTABLE,
                          "simulation blew up at step %llu (t = %g s, %s, dt = %g s): particle %u is not finite",
                          (unsigned long long)w->steps + 1, w->t + dt, spn_integrator_name(w->def.integrator), dt, i);
-    char jump[64];
+    char jump[64], advice[224];
     if (isfinite(gain)) snprintf(jump, sizeof jump, "energy jumped by %g J", gain);
     else snprintf(jump, sizeof jump, "energy overflowed");
+    /* The adaptive stepper shortens its sub-steps by itself: if it blew up,
+     * its floor was too long, and a shorter outer step would not help. */
+    if (w->def.integrator == SPN_INTEGRATOR_ADAPTIVE && w->last.floored > 0)
+        snprintf(advice, sizeof advice,
+                 "%d sub-steps gained energy at the adaptive stepper's floor dt_min = %g s: lower dt_min "
+                 "(under this web's stable step) or use the implicit solver",
+                 w->last.floored, w->def.dt_min > 0 ? w->def.dt_min : 1e-12 * dt);
+    else snprintf(advice, sizeof advice, "try a smaller step or the implicit solver");
     return spn_error(SPN_ERR_UNSTABLE,
-                     "simulation blew up at step %llu (t = %g s, %s, dt = %g s): %s, fastest particle %u; "
-                     "try a smaller step or the implicit solver",
-                     (unsigned long long)w->steps + 1, w->t + dt, spn_integrator_name(w->def.integrator), dt, jump, i);
+                     "simulation blew up at step %llu (t = %g s, %s, dt = %g s): %s, fastest particle %u; %s",
+                     (unsigned long long)w->steps + 1, w->t + dt, spn_integrator_name(w->def.integrator), dt, jump, i,
+                     advice);
 }
 
 static spn_status integrate(spn_world *w, double dt, spn__step_result *r)
@@ -164,6 +172,7 @@ static void add_step(spn_step_report *total, const spn_step_report *last)
 {
     total->substeps += last->substeps;
     total->halvings += last->halvings;
+    total->floored += last->floored;
     total->cg_iterations += last->cg_iterations;
     total->breaks += last->breaks;
 }
@@ -180,7 +189,7 @@ spn_status spn_world_advance(spn_world *w, double dt, int n)
     if (n < 1) return spn_error(SPN_ERR_INVALID, "spn_world_advance: step count must be at least 1, not %d", n);
     st = spn_world_compile(w);
     if (st != SPN_OK) return st;
-    spn_step_report total = {dt, 0, 0, 0, 0, 0};
+    spn_step_report total = {.dt = dt};
     const bool replay = n > 1 && replayable(w);
     const double t0 = w->t, work0 = w->external_work, diss0 = w->dissipated;
     const uint64_t steps0 = w->steps;
