@@ -29,7 +29,7 @@
  * on its first call of that kind and no later one. A lone step takes the
  * float64 path, so a float32 world's first call allocates and fills its
  * float32 state and spring slots (about 80 MB for the 1M web): on this
- * guest that first touch of fresh memory took 0.2 s, twice the 12 RK4
+ * guest that first touch of fresh memory took 0.2 s, as long as the 12 RK4
  * steps themselves. (Until the twenty-seventh session only that first
  * call was timed, which charged the float32 rows, and no float64 row, with
  * their one-time allocation.) "ns_per_spring_step" and
