@@ -98,8 +98,6 @@ static void test_adaptive_never_gains(void **state)
     spn_world_destroy(w);
 }
 
-/* Energy + dissipated - external work is conserved (to the integrator's
- * accuracy) with damping, drag, a force callback and a bounce on a plane. */
 /* A chain too stiff for the adaptive stepper's default floor: k/m = 1e16
  * s^-2, so a symplectic Euler sub-step is stable below about 1e-8 s
  * and the floor (1e-7 s) gains energy every time. The blow-up names the
@@ -159,6 +157,8 @@ static void test_adaptive_floor_named(void **state)
     spn_world_destroy(w);
 }
 
+/* Energy + dissipated - external work is conserved (to the integrator's
+ * accuracy) with damping, drag, a force callback and a bounce on a plane. */
 static void test_accounting(void **state)
 {
     (void)state;

@@ -6,8 +6,9 @@
  * A sub-step that gains more is undone and retried with the step divided by
  * def.dt_factor, down to def.dt_min (the floor: that sub-step is then taken
  * as it is, and counted in spn_step_report.floored, so that a blow-up it
- * leads to can say that the floor, not the outer step, is too long). After an accepted sub-step the next one tries the step times
- * dt_factor, and the last accepted size carries over to the next outer step.
+ * leads to can say that the floor, not the outer step, is too long). After
+ * an accepted sub-step the next one tries the step times dt_factor, and the
+ * last accepted size carries over to the next outer step.
  *
  * Why symplectic Euler: its energy change for a spring is
  * 1/2 k h^2 (v'^2 - w^2 x^2)-like, negative near the turning points and
@@ -86,6 +87,8 @@ static bool eval_spare(spn_world *w, double t, spn__eval *e)
     return ext;
 }
 
+double spn__adaptive_floor(const spn_world *w, double dt) { return w->def.dt_min > 0 ? w->def.dt_min : 1e-12 * dt; }
+
 spn_status spn__step_adaptive(spn_world *w, double dt, spn__step_result *r)
 {
     spn_status st = spn__scratch(w, 4);
@@ -98,7 +101,7 @@ spn_status spn__step_adaptive(spn_world *w, double dt, spn__step_result *r)
     r->e_before = cur.kinetic + cur.elastic;
     r->elastic = cur.elastic;
     const double factor = w->def.dt_factor > 1 ? w->def.dt_factor : 2;
-    const double floor = w->def.dt_min > 0 ? w->def.dt_min : 1e-12 * dt;
+    const double floor = spn__adaptive_floor(w, dt);
     double h = w->adaptive_dt > 0 ? w->adaptive_dt : dt;
     double done = 0, gain_kp = 0, work = 0, lost = 0;
     int substeps = 0, halvings = 0, floored = 0;

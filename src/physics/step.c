@@ -55,13 +55,14 @@ static spn_status blew_up(spn_world *w, double dt, double gain)
     char jump[64], advice[224];
     if (isfinite(gain)) snprintf(jump, sizeof jump, "energy jumped by %g J", gain);
     else snprintf(jump, sizeof jump, "energy overflowed");
-    /* The adaptive stepper shortens its sub-steps by itself: if it blew up,
-     * its floor was too long, and a shorter outer step would not help. */
-    if (w->def.integrator == SPN_INTEGRATOR_ADAPTIVE && w->last.floored > 0)
+    /* The adaptive stepper shortens its sub-steps by itself: if it blew up
+     * after sub-steps at its floor (only it counts them), the floor was too
+     * long, and a shorter outer step would not help. */
+    if (w->last.floored > 0)
         snprintf(advice, sizeof advice,
                  "%d sub-steps gained energy at the adaptive stepper's floor dt_min = %g s: lower dt_min "
                  "(under this web's stable step) or use the implicit solver",
-                 w->last.floored, w->def.dt_min > 0 ? w->def.dt_min : 1e-12 * dt);
+                 w->last.floored, spn__adaptive_floor(w, dt));
     else snprintf(advice, sizeof advice, "try a smaller step or the implicit solver");
     return spn_error(SPN_ERR_UNSTABLE,
                      "simulation blew up at step %llu (t = %g s, %s, dt = %g s): %s, fastest particle %u; %s",

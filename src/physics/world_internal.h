@@ -352,6 +352,9 @@ void spn__lattice_discard(spn_world *w);
 void spn__step_explicit(spn_world *w, double dt, bool symplectic, spn__step_result *r);
 spn_status spn__step_rk4(spn_world *w, double dt, spn__step_result *r);
 spn_status spn__step_adaptive(spn_world *w, double dt, spn__step_result *r);
+/* The adaptive stepper's shortest sub-step for an outer step dt: def.dt_min,
+ * or 1e-12 dt when that is not positive. */
+double spn__adaptive_floor(const spn_world *w, double dt);
 spn_status spn__step_implicit(spn_world *w, double dt, spn__step_result *r);
 
 /* ---- hysteresis.c, contact.c ---- */
