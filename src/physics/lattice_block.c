@@ -74,8 +74,11 @@ bool spn__lattice_cols_alloc(spn__lattice *L, int threads)
  * the minimum of six alternating runs; on two threads no difference stood
  * out of the host's noise), while the explicit passes ran a tenth faster
  * in AVX-512 (symplectic 5.27 -> 4.76), so only RK4 is moved. On AMD's Zen 4
- * the two were not compared, and it keeps AVX-512 as in its `make bench`
- * figures. SPN_RK4_AVX2=1 or 0 in the environment (read at each pass)
+ * (family 25, model 17; 2026-12-04) AVX-512 is the faster: 1M RK4 float64,
+ * CPU ns a spring-step, minimum of four alternating runs, 17.7 against
+ * AVX2's 18.8 on one thread, 18.5 against 21.7 on two (wall 9.3 against
+ * 10.9); and the 5k symplectic step in a build without the AVX-512 clones
+ * took 3.43 against 2.97. So AMD keeps it. SPN_RK4_AVX2=1 or 0 in the environment (read at each pass)
  * overrides the choice on any processor with AVX2, to compare the two
  * there; every version gives the same bits (tests/test_physics_lattice.c). */
 bool spn__lattice_rk4_avx2(void)
