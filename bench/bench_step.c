@@ -121,12 +121,6 @@ static int bench_one(const size_case *c, spn_integrator integ, int threads, bool
     def.integrator = integ;
     def.threads = threads;
     def.cg_tolerance = 1e-8;
-    /* The adaptive stepper's default floor (1e-7 s) is above the 1M web's
-     * stability limit (a third of it): there it takes unstable sub-steps at
-     * the floor and blows up by the fourth outer step, so a run long enough
-     * to time several calls needs a lower floor. Webs whose sub-steps stay
-     * above 1e-7 s are unaffected. */
-    if (integ == SPN_INTEGRATOR_ADAPTIVE) def.dt_min = 1e-9;
     spn_orb_scene_def od = spn_orb_scene_def_default();
     od.rings = c->rings;
     od.radials = c->radials;

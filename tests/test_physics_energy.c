@@ -98,13 +98,10 @@ static void test_adaptive_never_gains(void **state)
     spn_world_destroy(w);
 }
 
-/* A chain too stiff for the adaptive stepper's default floor: k/m = 1e16
- * s^-2, so a symplectic Euler sub-step is stable below about 1e-8 s
- * and the floor (1e-7 s) gains energy every time. The blow-up names the
- * floor, not the outer step; with dt_min lowered the same run does not
- * gain energy. (Sub-steps still meet the lower floor: a symplectic Euler
- * step gains a little near turning points at any length, more than the
- * stepper's 1e-12 margin, and such gains are then taken at the floor.) */
+/* A chain of ten segments between fixed ends, k/m = 1e16 s^-2 for its
+ * nine free particles (m = 1e-8 kg, k = 1e8 N/m), undamped, no gravity: a
+ * symplectic Euler step is stable below about 1e-8 s, under the adaptive
+ * stepper's default dt_min of 1e-7 s. */
 static spn_world *too_stiff_chain(spn_integrator integ, double dt_min)
 {
     spn_world_def def = spn_world_def_default();
@@ -119,33 +116,93 @@ static spn_world *too_stiff_chain(spn_integrator integ, double dt_min)
     return w;
 }
 
+/* A tether of stiffness 1e9 N/m pulling each particle back to x = 0.1 i: a
+ * force stiffer than the chain's springs that the springs' stable-step
+ * bound does not see (with it a step is stable under about 5e-9 s, below
+ * the floor the springs alone give, 0.8e-8 s). */
+static void stiff_tether(void *user, const spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v, spn_vec3 *f)
+{
+    (void)user, (void)t, (void)v;
+    for (uint32_t i = 0; i < spn_world_particle_count(w); i++)
+        f[i] = spn_v3_add(f[i], spn_v3_scale(spn_v3_sub(x[i], spn_v3(0.1 * i, 0, 0)), -1e9));
+}
+
+/* The springs' stable step (spn_world_stable_step) against the chain's
+ * normal modes: the bound 2 sqrt(k/m) on its highest angular frequency
+ * gives 1 / sqrt(k/m) = 1e-8 s, under the true limit 2 / omega_max with
+ * omega_max = 2 sqrt(k/m) sin(9 pi / 22). */
+static void test_stable_step_bound(void **state)
+{
+    (void)state;
+    spn_world *w = too_stiff_chain(SPN_INTEGRATOR_SYMPLECTIC, 1e-7);
+    const double bound = spn_world_stable_step(w, 0), exact = 2 / (2e8 * sin(9 * SPN_PI / 22));
+    print_message("stable step: bound %.6g s, normal modes %.6g s\n", bound, exact);
+    assert_true(fabs(bound - 1e-8) <= 1e-15 * 1e-8 * 10);
+    assert_true(bound < exact && bound > 0.95 * exact);
+    /* extra stiffness per particle adds to the springs' */
+    assert_true(fabs(spn_world_stable_step(w, 2e8) - 2 / sqrt(8e16)) <= 1e-14 * 1e-8);
+    /* below the bound the chain keeps its energy; at twice it, it blows up */
+    const double e0 = spn_world_total_energy(w);
+    for (int i = 0; i < 20000; i++) assert_int_equal(spn_world_step(w, 0.9 * bound), SPN_OK);
+    assert_true(fabs(spn_world_total_energy(w) - e0) <= 0.5 * e0);
+    spn_world_destroy(w);
+    w = too_stiff_chain(SPN_INTEGRATOR_SYMPLECTIC, 1e-7);
+    spn_status st = SPN_OK;
+    for (int i = 0; i < 20000 && st == SPN_OK; i++) st = spn_world_step(w, 2.2 * bound);
+    assert_int_equal(st, SPN_ERR_UNSTABLE);
+    spn_world_destroy(w);
+    /* no free particle held: no bound */
+    w = spn_world_create(NULL);
+    spn_particle_def p = spn_particle_def_default();
+    spn_world_add_particle(w, &p, NULL);
+    assert_true(isinf(spn_world_stable_step(w, 0)));
+    spn_world_destroy(w);
+}
+
+/* The adaptive stepper's floor follows the springs: on the chain above, the
+ * default dt_min (1e-7 s, ten times the stable step) no longer decides, and
+ * ten outer steps run with sub-steps under 1e-8 s. A stiffer force that
+ * the springs' bound does not see (a callback) still gains energy at the
+ * floor; the blow-up then names the floor and dt_min, not the outer step,
+ * and with dt_min lowered the same run goes through. */
 static void test_adaptive_floor_named(void **state)
 {
     (void)state;
     const double dt = 1e-6;
     spn_world *w = too_stiff_chain(SPN_INTEGRATOR_ADAPTIVE, 1e-7);
-    spn_status st = SPN_OK;
-    int steps = 0;
-    while (st == SPN_OK && steps < 50) st = spn_world_step(w, dt), steps += st == SPN_OK;
-    assert_int_equal(st, SPN_ERR_UNSTABLE);
-    assert_true(spn_world_last_step(w).floored > 0);
-    print_message("default floor: %s\n", spn_last_error());
-    assert_non_null(strstr(spn_last_error(), "dt_min = 1e-07 s"));
-    assert_null(strstr(spn_last_error(), "smaller step"));
-    spn_world_destroy(w);
-
-    w = too_stiff_chain(SPN_INTEGRATOR_ADAPTIVE, 1e-10);
-    const double e0 = spn_world_total_energy(w);
+    double e0 = spn_world_total_energy(w);
     long floored = 0, substeps = 0; /* floored: printed only (see above) */
     for (int i = 0; i < 10; i++) {
         assert_int_equal(spn_world_step(w, dt), SPN_OK);
         floored += spn_world_last_step(w).floored;
         substeps += spn_world_last_step(w).substeps;
     }
-    print_message("dt_min 1e-10: %ld sub-steps in 10 steps, %ld at the floor, energy %.6g -> %.6g J\n", substeps,
+    print_message("default dt_min: %ld sub-steps in 10 steps, %ld at the floor, energy %.6g -> %.6g J\n", substeps,
                   floored, e0, spn_world_total_energy(w));
     assert_true(substeps > 10 * 100); /* sub-steps under 1e-8 s */
-    assert_true(spn_world_total_energy(w) <= e0 * (1 + 1e-9));
+    assert_true(spn_world_total_energy(w) <= e0 * 1.01);
+    spn_world_destroy(w);
+
+    w = too_stiff_chain(SPN_INTEGRATOR_ADAPTIVE, 1e-7);
+    spn_world_set_force_callback(w, stiff_tether, NULL);
+    spn_status st = SPN_OK;
+    int steps = 0;
+    while (st == SPN_OK && steps < 50) st = spn_world_step(w, dt), steps += st == SPN_OK;
+    assert_int_equal(st, SPN_ERR_UNSTABLE);
+    assert_true(spn_world_last_step(w).floored > 0);
+    print_message("stiff callback, default floor: %s\n", spn_last_error());
+    assert_non_null(strstr(spn_last_error(), "floor of "));
+    assert_non_null(strstr(spn_last_error(), "set dt_min under"));
+    assert_null(strstr(spn_last_error(), "smaller step"));
+    spn_world_destroy(w);
+
+    w = too_stiff_chain(SPN_INTEGRATOR_ADAPTIVE, 1e-10);
+    spn_world_set_force_callback(w, stiff_tether, NULL);
+    for (int i = 0; i < 10; i++) {
+        st = spn_world_step(w, dt);
+        if (st != SPN_OK) print_message("%s\n", spn_last_error());
+        assert_int_equal(st, SPN_OK);
+    }
     spn_world_destroy(w);
 
     /* a step that blows up for another reason keeps the old advice */
@@ -196,6 +253,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_symplectic_energy),
         cmocka_unit_test(test_adaptive_never_gains),
+        cmocka_unit_test(test_stable_step_bound),
         cmocka_unit_test(test_adaptive_floor_named),
         cmocka_unit_test(test_accounting),
     };

@@ -37,7 +37,8 @@ typedef struct spn_world_def {
     spn_vec3 gravity;          ///< m/s^2, default (0, -9.81, 0)
     double drag;               ///< viscous drag per unit mass [1/s]: f = -drag * m * v; default 0
     spn_integrator integrator; ///< default SPN_INTEGRATOR_SYMPLECTIC
-    double dt_min;             ///< adaptive: smallest sub-step [s], default 1e-7
+    double dt_min;             ///< adaptive: smallest sub-step [s], default 1e-7; the stepper goes under it
+                               ///< to 0.8 of the springs' stable step (spn_world_stable_step) where that is shorter
     double dt_factor;          ///< adaptive: growth / halving factor, default 2
     double energy_jump;        ///< blow-up bound: total energy may not grow by more than this
                                ///< factor (relative to the larger of |E| and the elastic scale) in one step; default 1e3
@@ -318,8 +319,9 @@ typedef struct spn_step_report {
     double dt;            ///< outer step asked for
     int substeps;         ///< sub-steps taken (adaptive; 1 otherwise)
     int halvings;         ///< times a sub-step was halved (adaptive)
-    int floored;          ///< adaptive: sub-steps taken at def.dt_min although they gained energy
-                          ///< (many, and a blow-up: the floor lies above the web's stable step)
+    int floored;          ///< adaptive: sub-steps taken at the floor (def.dt_min, or 0.8 of the springs'
+                          ///< stable step where shorter) although they gained energy (many, and a
+                          ///< blow-up: forces outside the springs need a lower dt_min)
     int cg_iterations;    ///< implicit: CG iterations summed over sub-steps
     int breaks;           ///< springs broken in this step
     int blocked;          ///< spn_world_advance: steps taken several to a pass over memory
@@ -338,6 +340,13 @@ SPN_API spn_status spn_world_step(spn_world *w, double dt);
 /// does. spn_world_last_step() then sums the report over the steps taken.
 SPN_API spn_status spn_world_advance(spn_world *w, double dt, int n);
 SPN_API spn_step_report spn_world_last_step(const spn_world *w);
+/// The longest stable symplectic Euler step of the world's springs [s], by
+/// Gershgorin's bound on each free particle (omega^2 <= 2 (sum k + extra) / m,
+/// damping rate <= 2 sum kd / m + drag), with no margin: take a fraction of it.
+/// Forces from callbacks, air and colliders are not in it (pass a known
+/// stiffness of theirs per particle as extra_stiffness). INFINITY when nothing
+/// bounds it (no free particle with a spring or drag); 0 when out of memory.
+SPN_API double spn_world_stable_step(const spn_world *w, double extra_stiffness);
 /// The implicit solver's CG stop, changeable between steps (an interactive
 /// viewer wants a looser one): relative residual in (0, 1), iteration cap >= 1.
 SPN_API spn_status spn_world_set_solver_tolerance(spn_world *w, double cg_tolerance, int cg_max_iterations);

@@ -3,10 +3,18 @@
  * sub-step is a symplectic Euler step that must not gain energy beyond the
  * work of the external forces:
  *   dE = dKE + dPE_gravity + dE_elastic <= W_external  (+ a round-off margin).
+ * W_external is taken by the trapezoid rule, the external forces at the
+ * sub-step's start and at its end (which the energy check evaluates anyway)
+ * over its displacement. The original takes the forces at the start only,
+ * which overstates a restoring force's work by 1/2 K dx^2: a stiff
+ * conservative callback (a tether) then passes an unstable sub-step's gain
+ * off as work, and the stepper accepts it at any length. The trapezoid rule
+ * is exact for a force linear in position.
  * A sub-step that gains more is undone and retried with the step divided by
- * def.dt_factor, down to def.dt_min (the floor: that sub-step is then taken
- * as it is, and counted in spn_step_report.floored, so that a blow-up it
- * leads to can say that the floor, not the outer step, is too long). After
+ * def.dt_factor, down to a floor: def.dt_min, or less where the springs'
+ * stable step is shorter (spring_floor below). A sub-step at the floor is
+ * taken as it is, and counted in spn_step_report.floored, so that a blow-up
+ * it leads to can say that the floor, not the outer step, is too long. After
  * an accepted sub-step the next one tries the step times dt_factor, and the
  * last accepted size carries over to the next outer step.
  *
@@ -70,6 +78,27 @@ static void trial(spn_world *w, double h, bool ext, double *gain, double *work)
     *work = sum[S_WORK];
 }
 
+/* The work of the external forces at the end of a trial sub-step of size h
+ * (w->fext: the forces at its end state) over its displacement, as trial()
+ * formed it (v' h). With trial()'s work at the start, the trapezoid rule. */
+static double end_work(spn_world *w, double h)
+{
+    const spn_vec3 *v = w->v, *fext = w->fext;
+    const uint32_t np = w->np, nb = spn__blocks(np);
+    double *partial = w->partial;
+#pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
+    for (uint32_t blk = 0; blk < nb; blk++) {
+        const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < np ? lo + SPN_BLOCK : np;
+        double wk = 0;
+        for (uint32_t i = lo; i < hi; i++)
+            if (w->inv_mass[i] != 0) wk += spn_v3_dot(fext[i], spn_v3_scale(v[i], h));
+        partial[(size_t)blk * SPN_NSUMS + S_WORK] = wk;
+    }
+    double sum[SPN_NSUMS];
+    spn__sum_partials(w, nb, sum);
+    return sum[S_WORK];
+}
+
 static void undo(spn_world *w)
 {
     memcpy(w->x, w->tmp[SPN_TMP_A], w->np * sizeof *w->x);
@@ -87,7 +116,19 @@ static bool eval_spare(spn_world *w, double t, spn__eval *e)
     return ext;
 }
 
-double spn__adaptive_floor(const spn_world *w, double dt) { return w->def.dt_min > 0 ? w->def.dt_min : 1e-12 * dt; }
+/* The floor, once a sub-step would go under def.dt_min (or 1e-12 dt when
+ * that is not positive): the shorter of that and SPN__FLOOR_REACH of the
+ * springs' stable step (stable_step.c), so that sub-steps at the floor stay
+ * stable whatever dt_min says. SPN__FLOOR_REACH is the animation runner's
+ * margin for symplectic Euler. Computed at most once an outer step (a pass
+ * over springs and particles, no square roots of lengths), and only when the
+ * step gets that short. */
+#define SPN__FLOOR_REACH 0.8
+static double spring_floor(spn_world *w, double base)
+{
+    if (spn__scratch(w, SPN_TMP_E + 1) != SPN_OK) return base; /* the floor given, as before */
+    return fmin(base, spn__stable_step(w, SPN__FLOOR_REACH, 0, (double *)w->tmp[SPN_TMP_E]));
+}
 
 spn_status spn__step_adaptive(spn_world *w, double dt, spn__step_result *r)
 {
@@ -101,7 +142,8 @@ spn_status spn__step_adaptive(spn_world *w, double dt, spn__step_result *r)
     r->e_before = cur.kinetic + cur.elastic;
     r->elastic = cur.elastic;
     const double factor = w->def.dt_factor > 1 ? w->def.dt_factor : 2;
-    const double floor = spn__adaptive_floor(w, dt);
+    double floor = w->def.dt_min > 0 ? w->def.dt_min : 1e-12 * dt;
+    bool floor_known = false; /* floor is spring_floor's */
     double h = w->adaptive_dt > 0 ? w->adaptive_dt : dt;
     double done = 0, gain_kp = 0, work = 0, lost = 0;
     int substeps = 0, halvings = 0, floored = 0;
@@ -112,16 +154,20 @@ spn_status spn__step_adaptive(spn_world *w, double dt, spn__step_result *r)
         trial(w, hh, ext, &dkp, &wk);
         spn__eval next;
         eval_spare(w, w->t + done + hh, &next);
+        if (ext) wk = 0.5 * (wk + end_work(w, hh));
         double gain = dkp + (next.elastic - cur.elastic) - wk;
         double margin = 1e-12 * (cur.kinetic + cur.elastic + fabs(wk)) + 1e-300;
-        if (!(gain <= margin) && hh > floor) { /* also when gain is NaN */
-            undo(w);
-            swap_buf(&w->fext, &w->tmp[SPN_TMP_D]);
-            h = hh / factor > floor ? hh / factor : floor;
-            halvings++;
-            continue;
+        if (!(gain <= margin)) { /* also when gain is NaN */
+            if (!floor_known && hh / factor < floor) floor = spring_floor(w, floor), floor_known = true;
+            if (hh > floor) {
+                undo(w);
+                swap_buf(&w->fext, &w->tmp[SPN_TMP_D]);
+                h = hh / factor > floor ? hh / factor : floor;
+                halvings++;
+                continue;
+            }
+            floored++;
         }
-        if (!(gain <= margin)) floored++;
         swap_buf(&w->f, &w->tmp[SPN_TMP_C]);
         gain_kp += dkp;
         work += wk;
@@ -133,6 +179,7 @@ spn_status spn__step_adaptive(spn_world *w, double dt, spn__step_result *r)
         if (!capped) h = hh * factor;
     }
     w->adaptive_dt = h;
+    w->adaptive_floor = floor;
     w->last.substeps = substeps;
     w->last.halvings = halvings;
     w->last.floored = floored;

@@ -52,7 +52,7 @@ static spn_status blew_up(spn_world *w, double dt, double gain)
         return spn_error(SPN_ERR_UNSTABLE,
                          "simulation blew up at step %llu (t = %g s, %s, dt = %g s): particle %u is not finite",
                          (unsigned long long)w->steps + 1, w->t + dt, spn_integrator_name(w->def.integrator), dt, i);
-    char jump[64], advice[224];
+    char jump[64], advice[320];
     if (isfinite(gain)) snprintf(jump, sizeof jump, "energy jumped by %g J", gain);
     else snprintf(jump, sizeof jump, "energy overflowed");
     /* The adaptive stepper shortens its sub-steps by itself: if it blew up
@@ -60,9 +60,10 @@ static spn_status blew_up(spn_world *w, double dt, double gain)
      * long, and a shorter outer step would not help. */
     if (w->last.floored > 0)
         snprintf(advice, sizeof advice,
-                 "%d sub-steps gained energy at the adaptive stepper's floor dt_min = %g s: lower dt_min "
-                 "(under this web's stable step) or use the implicit solver",
-                 w->last.floored, spn__adaptive_floor(w, dt));
+                 "%d sub-steps gained energy at the adaptive stepper's floor of %g s (dt_min, or the springs' "
+                 "stable step where shorter; callback, air and collider forces are not in that bound): "
+                 "set dt_min under %g s or use the implicit solver",
+                 w->last.floored, w->adaptive_floor, w->adaptive_floor);
     else snprintf(advice, sizeof advice, "try a smaller step or the implicit solver");
     return spn_error(SPN_ERR_UNSTABLE,
                      "simulation blew up at step %llu (t = %g s, %s, dt = %g s): %s, fastest particle %u; %s",

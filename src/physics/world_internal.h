@@ -169,6 +169,7 @@ struct spn_world {
     spn_step_report last;
     double external_work, dissipated;
     double adaptive_dt;   /* next sub-step the adaptive stepper tries (0: the outer step) */
+    double adaptive_floor; /* the adaptive stepper's floor in its last outer step (adaptive.c) */
 
     /* callbacks */
     spn_force_fn force_fn;
@@ -352,9 +353,11 @@ void spn__lattice_discard(spn_world *w);
 void spn__step_explicit(spn_world *w, double dt, bool symplectic, spn__step_result *r);
 spn_status spn__step_rk4(spn_world *w, double dt, spn__step_result *r);
 spn_status spn__step_adaptive(spn_world *w, double dt, spn__step_result *r);
-/* The adaptive stepper's shortest sub-step for an outer step dt: def.dt_min,
- * or 1e-12 dt when that is not positive. */
-double spn__adaptive_floor(const spn_world *w, double dt);
+/* The longest stable step of the world's springs (stable_step.c), times
+ * reach (1: the bound itself), with `extra_stiffness` added per particle;
+ * sums: 2 np doubles of scratch. INFINITY when nothing bounds it (no
+ * free particle with a spring or drag). */
+double spn__stable_step(const spn_world *w, double reach, double extra_stiffness, double *sums);
 spn_status spn__step_implicit(spn_world *w, double dt, spn__step_result *r);
 
 /* ---- hysteresis.c, contact.c ---- */
