@@ -17,7 +17,8 @@ static void usage(FILE *out)
 {
     fprintf(out, "usage: spinneret info FILE [--json]\n"
                  "Describe a web file: counts, fixed particles, broken springs, mass, bounding box,\n"
-                 "energies, the largest residual force and springs per thread kind.\n"
+                 "energies, the largest residual force, springs per thread kind, and the world's\n"
+                 "settings with its stable step (the longest stable explicit step of its springs).\n"
                  "All values are SI (m, kg, s, N, J).\n\n"
                  "  --json    print the measures as one JSON object on stdout\n"
                  "  --help    this text\n");
@@ -118,6 +119,12 @@ static void settings(cJSON *info, const spn_world *w)
     cJSON_AddItemToObject(obj, "gravity", vec3_json(d->gravity));
     cJSON_AddNumberToObject(obj, "drag", d->drag);
     cJSON_AddNumberToObject(obj, "time", spn_world_time(w));
+    /* the longest stable symplectic Euler step of the springs (and drag), no
+     * margin: what an explicit solver's substeps are chosen from; null when
+     * nothing bounds it */
+    const double stable = spn_world_stable_step(w, 0);
+    if (isfinite(stable)) cJSON_AddNumberToObject(obj, "stable_step", stable);
+    else cJSON_AddNullToObject(obj, "stable_step");
     cJSON *meta = cJSON_Parse(spn_world_metadata(w));
     if (meta) cJSON_AddItemToObject(info, "metadata", meta);
 }
@@ -161,7 +168,7 @@ static const char *unit_of(const char *key)
                                            {"elastic", "J"},     {"gravitational", "J"}, {"total", "J"},
                                            {"force", "N"},       {"min", "m"},          {"max", "m"},
                                            {"size", "m"},        {"drag", "1/s"},       {"gravity", "m/s^2"},
-                                           {"time", "s"}};
+                                           {"time", "s"},        {"stable_step", "s"}};
     for (size_t i = 0; i < sizeof units / sizeof units[0]; i++)
         if (strcmp(units[i][0], key) == 0) return units[i][1];
     return NULL;

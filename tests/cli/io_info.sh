@@ -28,7 +28,13 @@ assert near(d["max_residual"]["force"], math.hypot(20 * 0.004, 0.001 * 9.81)), d
 assert d["max_residual"]["particle"] in (1, 2)
 assert d["springs_by_kind"] == {"anchor": 2, "capture": 1}, d["springs_by_kind"]
 assert d["metadata"]["builder"] == "hand-written"
+# Stable step: particles 1 and 2 (m 0.001) each hold two springs of k 20,
+# kd 0.02, and drag is 2/s: omega^2 = 2 * 40 / m, c = 2 * 0.04 / m + 2,
+# dt = 2 / (c/2 + sqrt(c^2/4 + omega^2)) = 6.11997e-3 s.
+om2, c = 2 * 40 / 0.001, 2 * 0.04 / 0.001 + 2
+assert near(d["world"]["stable_step"], 2 / (c / 2 + math.sqrt(c * c / 4 + om2))), d["world"]
 PY
+grep -qF 'stable_step: 0.00611997 s' "$T/out" || fail "info text lacks the stable step: $(grep stable "$T/out")"
 
 "$SPN" info --help | grep -q 'usage: spinneret info' || fail "--help"
 
