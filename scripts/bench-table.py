@@ -39,7 +39,10 @@ KNOWN = {
         ("spinneret_path", "Spinneret path"), ("equal_accuracy_reached", "Bullet reaches our error"),
         ("equal_accuracy_bullet_refine", "Bullet step divisor tried"),
         ("equal_accuracy_bullet_strain_error", "its strain error"),
-        ("equal_accuracy_cpu_ratio", "CPU ratio at that divisor")]),
+        ("equal_accuracy_cpu_ratio", "CPU ratio at that divisor"),
+        ("spinneret_float32_ns_per_spring_step", "Spinneret float32 ns/spring/step"),
+        ("float32_cpu_ratio", "CPU ratio in float32 (Bullet's precision)"),
+        ("spinneret_float32_strain_error", "Spinneret float32 strain error")]),
     "mg_rates": ("Equilibrium preconditioners as stationary iterations: energy-norm contraction per cycle, "
                  "the rate of cycles 25-32 (bench/bench_mg_rates.c; the same on any machine)", [
         ("scene", "scene"), ("system", "Newton system"), ("precond", "preconditioner"),

@@ -63,20 +63,29 @@ def equal_accuracy(r):
             f"{r['equal_accuracy_bullet_strain_error']:.2g} at dt/{r['equal_accuracy_bullet_refine']}")
 
 
+def float32_cells(r):
+    """Our float32 run beside Bullet (float32 as Debian builds it); runs
+    before the twenty-eighth session have none."""
+    if "float32_cpu_ratio" not in r:
+        return "–"
+    return (f"{r['spinneret_float32_cpu_ns_per_spring_step']:.2f}, {r['float32_cpu_ratio']:.1f}×, "
+            f"{r['spinneret_float32_strain_error']:.2g}")
+
+
 def peer_table(rows):
     peer = [r for r in rows if r.get("bench") == "peer_bullet_softbody"]
     if not peer:
         return ""
     out = ["| particles | Bullet CPU (wall) | Spinneret CPU (wall) | ratio CPU (wall) | strain error Bullet / ours "
-           "| CPU ratio at equal accuracy |",
-           "|---:|---:|---:|---:|---:|---:|"]
+           "| CPU ratio at equal accuracy | in float32, Bullet's precision: CPU, ratio, strain error |",
+           "|---:|---:|---:|---:|---:|---:|---:|"]
     for r in peer:
         out.append(f"| {r['particles']:,} | {r.get('bullet_cpu_ns_per_spring_step', float('nan')):.1f} "
                    f"({r['bullet_ns_per_spring_step']:.0f}) | "
                    f"{r.get('spinneret_cpu_ns_per_spring_step', float('nan')):.1f} "
                    f"({r['spinneret_ns_per_spring_step']:.0f}) | {r.get('cpu_ratio', float('nan')):.1f} "
                    f"({r['ratio']:.1f}) | {r['bullet_strain_error']:.2g} / {r['spinneret_strain_error']:.2g} | "
-                   f"{equal_accuracy(r)} |")
+                   f"{equal_accuracy(r)} | {float32_cells(r)} |")
     return "\n".join(out)
 
 

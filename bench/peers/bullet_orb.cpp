@@ -149,16 +149,19 @@ static bullet_run run_bullet(const spn_world *w, double dt, int steps, const std
     return r;
 }
 
-// Wall and CPU ns per spring-step of our symplectic Euler (one advance call).
+// Wall and CPU ns per spring-step of our symplectic Euler (one advance call)
+// in `precision` (float32: Bullet's own precision, as Debian builds it).
 // *path: "lattice" (the stencil step of a regular web) or "general". Set-up
 // is not timed, as Bullet's (its soft body built, updateConstants) is not:
 // the world is compiled and one short call takes the path the timed one
 // will (allocating the lattice's arrays: on the 1M web tens of MB, touched
 // for the first time), then its particles are put back where they were, so
 // the timed call starts from w's state as Bullet's run does.
-static void run_spinneret(spn_world *w, double dt, int steps, double *wall, double *cpu, const char **path)
+static void run_spinneret(spn_world *w, double dt, int steps, spn_precision precision, double *wall, double *cpu,
+                          const char **path)
 {
     spn_world_set_integrator(w, SPN_INTEGRATOR_SYMPLECTIC);
+    spn_world_set_precision(w, precision);
     spn_world_compile(w);
     const uint32_t np = spn_world_particle_count(w);
     std::vector<spn_vec3> x(np), v(np);
@@ -268,8 +271,16 @@ int main(int argc, char **argv)
         spn_world *w = spn_world_clone(w0);
         double ours, ours_cpu;
         const char *path;
-        run_spinneret(w, dt, sz.steps, &ours, &ours_cpu, &path);
+        run_spinneret(w, dt, sz.steps, SPN_PRECISION_FLOAT64, &ours, &ours_cpu, &path);
         const double our_error = strain_error(w, ref);
+        // the same run in float32, Bullet's precision: a like-for-like figure
+        // beside the float64 one (which the ratio is about)
+        spn_world *w32 = spn_world_clone(w0);
+        double ours32, ours32_cpu;
+        const char *path32;
+        run_spinneret(w32, dt, sz.steps, SPN_PRECISION_FLOAT32, &ours32, &ours32_cpu, &path32);
+        const double our_error32 = strain_error(w32, ref);
+        spn_world_destroy(w32);
         const double spring_steps = (double)spn_world_spring_count(w) * sz.steps;
         equal_accuracy e = bullet_equal_accuracy(w0, dt, sz.steps, ref, our_error, b, budget);
         std::printf("{\"bench\":\"peer_bullet_softbody\",\"particles\":%u,\"springs\":%u,\"dt\":%g,\"steps\":%d,"
@@ -278,12 +289,15 @@ int main(int argc, char **argv)
                     "\"cpu_ratio\":%.2f,\"bullet_strain_error\":%.3g,\"spinneret_strain_error\":%.3g,"
                     "\"spinneret_path\":\"%s\",\"equal_accuracy_bullet_refine\":%d,"
                     "\"equal_accuracy_bullet_strain_error\":%.3g,\"equal_accuracy_reached\":%s,"
-                    "\"equal_accuracy_cpu_ratio\":%.2f,\"bullet_best_refine\":%d,\"bullet_best_strain_error\":%.3g}\n",
+                    "\"equal_accuracy_cpu_ratio\":%.2f,\"bullet_best_refine\":%d,\"bullet_best_strain_error\":%.3g,"
+                    "\"spinneret_float32_ns_per_spring_step\":%.3f,\"spinneret_float32_cpu_ns_per_spring_step\":%.3f,"
+                    "\"float32_cpu_ratio\":%.2f,\"spinneret_float32_strain_error\":%.3g}\n",
                     spn_world_particle_count(w), spn_world_spring_count(w), dt, sz.steps, b.ns_per_spring_step, ours,
                     b.ns_per_spring_step / ours, b.cpu_ns_per_spring_step, ours_cpu,
                     b.cpu_ns_per_spring_step / ours_cpu, b.strain_error, our_error, path, e.refine,
                     e.strain_error, e.reached ? "true" : "false", e.cpu_seconds / (ours_cpu * spring_steps * 1e-9),
-                    e.best_refine, e.best_error);
+                    e.best_refine, e.best_error, ours32, ours32_cpu, b.cpu_ns_per_spring_step / ours32_cpu,
+                    our_error32);
         std::fflush(stdout);
         spn_world_destroy(w);
         spn_world_destroy(w0);
