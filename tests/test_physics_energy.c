@@ -137,7 +137,7 @@ static void test_stable_step_bound(void **state)
     spn_world *w = too_stiff_chain(SPN_INTEGRATOR_SYMPLECTIC, 1e-7);
     const double bound = spn_world_stable_step(w, 0), exact = 2 / (2e8 * sin(9 * SPN_PI / 22));
     print_message("stable step: bound %.6g s, normal modes %.6g s\n", bound, exact);
-    assert_true(fabs(bound - 1e-8) <= 1e-15 * 1e-8 * 10);
+    assert_true(fabs(bound - 1e-8) <= 1e-14 * 1e-8);
     assert_true(bound < exact && bound > 0.95 * exact);
     /* extra stiffness per particle adds to the springs' */
     assert_true(fabs(spn_world_stable_step(w, 2e8) - 2 / sqrt(8e16)) <= 1e-14 * 1e-8);
@@ -171,7 +171,9 @@ static void test_adaptive_floor_named(void **state)
     const double dt = 1e-6;
     spn_world *w = too_stiff_chain(SPN_INTEGRATOR_ADAPTIVE, 1e-7);
     double e0 = spn_world_total_energy(w);
-    long floored = 0, substeps = 0; /* floored: printed only (see above) */
+    /* floored is printed, not asserted: symplectic Euler's own energy swing
+     * ends some sub-steps at the floor even under the stable step */
+    long floored = 0, substeps = 0;
     for (int i = 0; i < 10; i++) {
         assert_int_equal(spn_world_step(w, dt), SPN_OK);
         floored += spn_world_last_step(w).floored;

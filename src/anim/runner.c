@@ -12,7 +12,6 @@
 #include "anim_internal.h"
 
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 typedef struct runner {
