@@ -3,7 +3,10 @@
  * 4.16-4.19), the thesis' method.
  *
  * Euler and symplectic Euler are one spring pass and one fused particle pass
- * that gathers the force, updates v and x in place, keeps the old state for a
+ * that gathers the force, updates v and x in place (gravity and drag, v' and
+ * x' each one fused multiply-add, fma: one rounding, the same bits on every
+ * processor, and about 3% off the lattice step, docs/physics-lattice.md),
+ * keeps the old state for a
  * blow-up restore (unless w->no_backup: spn_world_advance keeps one copy per
  * call and replays instead, see step.c), and sums the energy terms the step
  * driver checks. Energy
@@ -34,10 +37,10 @@ static inline __attribute__((always_inline)) void explicit_block(
         if (backup) x0[i] = xi, v0[i] = vi;
         const double im = c->inv_mass[i];
         if (im == 0) continue;
-        const spn_vec3 fi = spn__force_on(c, i, vi, ext);
-        const spn_vec3 vn = spn_v3_add(vi, spn_v3_scale(fi, dt * im));
-        const spn_vec3 dx = spn_v3_scale(symplectic ? vn : vi, dt);
-        x[i] = spn_v3_add(xi, dx);
+        const spn_vec3 fi = spn__force_on(c, i, vi, ext, true);
+        const spn_vec3 vn = spn__fma_v3(fi, dt * im, vi), vm = symplectic ? vn : vi;
+        const spn_vec3 dx = spn_v3_scale(vm, dt);
+        x[i] = spn__fma_v3(vm, dt, xi);
         v[i] = vn;
         const double m = c->mass[i];
         ke_old += m * spn_v3_dot(vi, vi);
@@ -119,7 +122,7 @@ static void rk4_block(const rk4_ctx *k, uint32_t lo, uint32_t hi, double *p)
             k->xt[i] = k->x[i], k->vt[i] = k->v[i];
             continue;
         }
-        const spn_vec3 f = spn__force_on(c, i, vi, k->ext);
+        const spn_vec3 f = spn__force_on(c, i, vi, k->ext, false);
         ke += c->mass[i] * spn_v3_dot(vi, vi);
         if (k->ext) ep += spn_v3_dot(c->fext[i], vi);
         if (k->stage == 0) {
@@ -148,7 +151,7 @@ static void rk4_last_block(const rk4_ctx *k, spn_vec3 *restrict x, spn_vec3 *res
         if (backup) x0[i] = xi, v0[i] = vi;
         const double im = c->inv_mass[i];
         if (im == 0) continue;
-        const spn_vec3 f = spn__force_on(c, i, v3, k->ext);
+        const spn_vec3 f = spn__force_on(c, i, v3, k->ext, false);
         const double m = c->mass[i];
         ke += m * spn_v3_dot(v3, v3);
         if (k->ext) ep += spn_v3_dot(c->fext[i], v3);

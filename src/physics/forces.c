@@ -183,7 +183,7 @@ void spn__gather(spn_world *w, const spn_vec3 *x, const spn_vec3 *v, bool has_ex
         double ke = 0, dp = 0, ep = 0;
         for (uint32_t i = lo; i < hi; i++) {
             const spn_vec3 vi = v[i];
-            f[i] = spn__force_on(&c, i, vi, has_ext);
+            f[i] = spn__force_on(&c, i, vi, has_ext, false);
             if (w->inv_mass[i] == 0) continue;
             const double v2 = spn_v3_dot(vi, vi), m = w->mass[i];
             ke += 0.5 * m * v2;

@@ -230,7 +230,7 @@ static void hub(const lat_args *a, double *const *rad, const lat_cols *cs)
     }
     const double v[3] = {a->ev[0][0], a->ev[1][0], a->ev[2][0]};
     double f[3];
-    hub_force64(L->radials, a->mass[0], a->drag, a->g, v, rad, f);
+    hub_force64(false, L->radials, a->mass[0], a->drag, a->g, v, rad, f);
     double *Fp[3] = {f, f + 1, f + 2};
     rk4_update(a, 0, 1, Fp, cs);
 }

@@ -79,12 +79,12 @@ bool spn__lattice_cols_alloc(spn__lattice *L, int threads)
  * AVX2's 18.8 on one thread, 18.5 against 21.7 on two (wall 9.3 against
  * 10.9); and the 5k symplectic step in a build without the AVX-512 clones
  * took 3.43 against 2.97. So AMD keeps it. SPN_RK4_AVX2=1 or 0 in the environment (read at each pass)
- * overrides the choice on any processor with AVX2, to compare the two
+ * overrides the choice on any processor with AVX2 and FMA, to compare the two
  * there; every version gives the same bits (tests/test_physics_lattice.c). */
 bool spn__lattice_rk4_avx2(void)
 {
 #if defined(SPN__AVX2)
-    if (!__builtin_cpu_supports("avx2")) return false;
+    if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("fma")) return false;
     const char *e = getenv("SPN_RK4_AVX2");
     if (e && (strcmp(e, "0") == 0 || strcmp(e, "1") == 0)) return e[0] == '1';
     return __builtin_cpu_supports("avx512f") && __builtin_cpu_is("intel");

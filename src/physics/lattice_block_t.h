@@ -143,7 +143,7 @@ LAT_INLINE void LK(block_hub)(LK(block) *B, uint32_t s, LK_T *const *X, LK_T *co
         return;
     }
     LK_T f[3], *Fp[3] = {f, f + 1, f + 2};
-    LK(hub_force)(n, B->mass[0], a->drag, a->g, hv, rad, f);
+    LK(hub_force)(false, n, B->mass[0], a->drag, a->g, hv, rad, f);
     LK(rk4_rows) R;
     for (int c = 0; c < 3; c++) {
         R.V[c] = &hv[c], R.xb[c] = &B->X[c][0], R.vb[c] = &B->V[c][0];

@@ -31,8 +31,10 @@
  * stages) go to one pass over memory as in float64, from the same source
  * again (lattice_block_t.h); a pass never spans a rebase, so its bits are
  * those of single steps. Every operation is a correctly rounded float32 or
- * float64 operation (no FMA: -ffp-contract=off, no approximate reciprocal),
- * so the bits are the same on any thread count and vector width. */
+ * float64 operation (the fused multiply-adds of the update are written out,
+ * fmaf, one rounding each; the compiler fuses nothing else:
+ * -ffp-contract=off; no approximate reciprocal), so the bits are the same
+ * on any thread count and vector width. */
 #include "lattice_rows32.h"
 #include "world_internal.h"
 
@@ -138,7 +140,7 @@ static void hub32(const a32 *a, float *const *rad, const lat_cols *cs)
     }
     const float v[3] = {a->eu[0][0], a->eu[1][0], a->eu[2][0]};
     float f[3], *Fp[3] = {f, f + 1, f + 2};
-    hub_force32(n, F->mass[0], a->drag, a->g, v, rad, f);
+    hub_force32(false, n, F->mass[0], a->drag, a->g, v, rad, f);
     rk4_update(a, 0, 1, Fp, cs);
 }
 

@@ -137,9 +137,11 @@ typedef struct lat_args {
 #define LK_T double
 #define LK_U uint64_t
 #define LK(name) name##64
+#define LK_FMA fma /* a b + c, one rounding */
 #define LK_SCRATCH 0
 #include "lattice_rows_t.h"
 #undef LK_SCRATCH
+#undef LK_FMA
 #undef LK_U
 #undef LK
 #undef LK_T

@@ -15,9 +15,11 @@
 #define LK_T float
 #define LK_U uint32_t
 #define LK(name) name##32
+#define LK_FMA fmaf /* a b + c, one rounding */
 #define LK_SCRATCH 1
 #include "lattice_rows_t.h"
 #undef LK_SCRATCH
+#undef LK_FMA
 #undef LK_U
 #undef LK
 #undef LK_T

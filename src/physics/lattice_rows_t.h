@@ -18,19 +18,20 @@
 #error "define LK_T, LK_U, LK(name) and LK_SCRATCH before including lattice_rows_t.h"
 #endif
 
-/* The per-particle sum terms: float64 adds them straight into the sum
- * columns (LK_S double, LK_ACC +=); float32 stores them in its float
- * scratch (lat_cols.scr) and adds them into the columns after the loop
- * (col_addf), so that the loop stays float32. LK_TERMS: the array a
- * kernel writes; LK_DONE: that addition. */
+/* The per-particle sum terms m q (LK_ACC(a, m, q)): float64 adds them
+ * straight into the sum columns (LK_S double, a += m q as one fused
+ * multiply-add); float32 stores them in its float scratch (lat_cols.scr)
+ * and adds them into the columns after the loop (col_addf), so that the
+ * loop stays float32. LK_TERMS: the array a kernel writes; LK_DONE: that
+ * addition. */
 #if LK_SCRATCH
 #define LK_S float
-#define LK_ACC(a, v) ((a) = (v))
+#define LK_ACC(a, m, q) ((a) = (m) * (q))
 #define LK_TERMS(cs, k) ((cs)->scr[k])
 #define LK_DONE(cs, k, n) col_addf((cs)->c[k], (cs)->scr[k], (n))
 #else
 #define LK_S double
-#define LK_ACC(a, v) ((a) += (v))
+#define LK_ACC(a, m, q) ((a) = fma((m), (q), (a)))
 #define LK_TERMS(cs, k) ((cs)->c[k])
 #define LK_DONE(cs, k, n) ((void)0)
 #endif
@@ -54,26 +55,33 @@ LAT_INLINE LK_T LK(pick)(bool c, LK_T a, LK_T b)
     return d;
 }
 
+/* A particle moved: its state and its sum terms, each mf q (mf: its mass,
+ * 0 when fixed). */
 typedef struct LK(moved) {
-    LK_T x[3], v[3], mv2, gain, mvn2;
+    LK_T x[3], v[3], mf, mv2, gain, mvn2;
 } LK(moved);
 
-/* One particle of an Euler (sym false) or symplectic Euler step. */
+/* One particle of an Euler (sym false) or symplectic Euler step. The
+ * update is explicit.c's, with its fused multiply-adds: v' = v + f (dt/m)
+ * and x' = x + w dt (w: v' or v) one rounding each. The sum terms use them
+ * too (they need not match the general path's bits, only its values), in
+ * the order the components are ready. */
 LAT_INLINE LK(moved) LK(one)(LK_T fx, LK_T fy, LK_T fz, LK_T im, LK_T m, LK_T xx, LK_T xy, LK_T xz, LK_T vx,
                              LK_T vy, LK_T vz, bool sym, LK_T dt, const LK_T *g)
 {
     LK(moved) o;
     const LK_T s = dt * im;
     const bool fr = im != 0;
-    const LK_T mf = fr ? m : (LK_T)0;
-    const LK_T nx = vx + fx * s, ny = vy + fy * s, nz = vz + fz * s;
-    const LK_T dx = (sym ? nx : vx) * dt, dy = (sym ? ny : vy) * dt, dz = (sym ? nz : vz) * dt;
-    o.x[0] = fr ? xx + dx : xx, o.x[1] = fr ? xy + dy : xy, o.x[2] = fr ? xz + dz : xz;
+    o.mf = fr ? m : (LK_T)0;
+    const LK_T nx = LK_FMA(fx, s, vx), ny = LK_FMA(fy, s, vy), nz = LK_FMA(fz, s, vz);
+    const LK_T wx = sym ? nx : vx, wy = sym ? ny : vy, wz = sym ? nz : vz;
+    const LK_T dx = wx * dt, dy = wy * dt, dz = wz * dt;
+    o.x[0] = fr ? LK_FMA(wx, dt, xx) : xx, o.x[1] = fr ? LK_FMA(wy, dt, xy) : xy, o.x[2] = fr ? LK_FMA(wz, dt, xz) : xz;
     o.v[0] = fr ? nx : vx, o.v[1] = fr ? ny : vy, o.v[2] = fr ? nz : vz;
-    o.mv2 = mf * (vx * vx + vy * vy + vz * vz);
-    o.mvn2 = mf * (nx * nx + ny * ny + nz * nz);
-    o.gain = mf * ((LK_T)0.5 * ((nx - vx) * (nx + vx) + (ny - vy) * (ny + vy) + (nz - vz) * (nz + vz)) -
-                   (g[0] * dx + g[1] * dy + g[2] * dz));
+    o.mv2 = LK_FMA(vz, vz, LK_FMA(vy, vy, vx * vx));
+    o.mvn2 = LK_FMA(nz, nz, LK_FMA(ny, ny, nx * nx));
+    o.gain = LK_FMA((LK_T)0.5, LK_FMA(nz - vz, nz + vz, LK_FMA(ny - vy, ny + vy, (nx - vx) * (nx + vx))),
+                    -LK_FMA(g[2], dz, LK_FMA(g[1], dy, g[0] * dx)));
     return o;
 }
 
@@ -94,32 +102,33 @@ LAT_INLINE void LK(row)(uint32_t n, bool sym, LK_T dt, const LK_T *g, LK_T drag,
     LK_T e0[3], el[3];
     const LK_T *V[3] = {vx, vy, vz}, *I[3] = {ix, iy, iz}, *R[3] = {rx, ry, rz}, *O[3] = {ox, oy, oz};
     for (int c = 0; c < 3; c++) {
-        LK_T f0 = mass[0] * g[c] - (drag * mass[0]) * V[c][0], fl = mass[l] * g[c] - (drag * mass[l]) * V[c][l];
+        LK_T f0 = LK_FMA(-(drag * mass[0]), V[c][0], mass[0] * g[c]);
+        LK_T fl = LK_FMA(-(drag * mass[l]), V[c][l], mass[l] * g[c]);
         if (ox) f0 += O[c][0], fl += O[c][l];
         e0[c] = ((f0 + R[c][0]) + R[c][l]) - I[c][0];
         el[c] = ((fl - I[c][l]) - R[c][l]) - R[c][l - 1];
     }
-#define LK_STORE(i, o)                                                                                          \
-    do {                                                                                                        \
-        xx[i] = (o).x[0], xy[i] = (o).x[1], xz[i] = (o).x[2];                                                   \
-        vx[i] = (o).v[0], vy[i] = (o).v[1], vz[i] = (o).v[2];                                                   \
-        LK_ACC(t_mv2[i], (o).mv2), LK_ACC(t_gain[i], (o).gain), LK_ACC(t_mvn2[i], (o).mvn2);                   \
+#define LK_STORE(i, o)                                                                                                 \
+    do {                                                                                                               \
+        xx[i] = (o).x[0], xy[i] = (o).x[1], xz[i] = (o).x[2];                                                          \
+        vx[i] = (o).v[0], vy[i] = (o).v[1], vz[i] = (o).v[2];                                                          \
+        LK_ACC(t_mv2[i], (o).mf, (o).mv2), LK_ACC(t_gain[i], (o).mf, (o).gain), LK_ACC(t_mvn2[i], (o).mf, (o).mvn2);   \
     } while (0)
     if (ox)
         for (uint32_t i = 1; i < l; i++) {
             const LK_T m = mass[i], dm = drag * m;
-            const LK_T fx = ((((m * g[0] - dm * vx[i]) + ox[i]) + rx[i]) - ix[i]) - rx[i - 1];
-            const LK_T fy = ((((m * g[1] - dm * vy[i]) + oy[i]) + ry[i]) - iy[i]) - ry[i - 1];
-            const LK_T fz = ((((m * g[2] - dm * vz[i]) + oz[i]) + rz[i]) - iz[i]) - rz[i - 1];
+            const LK_T fx = (((LK_FMA(-dm, vx[i], m * g[0]) + ox[i]) + rx[i]) - ix[i]) - rx[i - 1];
+            const LK_T fy = (((LK_FMA(-dm, vy[i], m * g[1]) + oy[i]) + ry[i]) - iy[i]) - ry[i - 1];
+            const LK_T fz = (((LK_FMA(-dm, vz[i], m * g[2]) + oz[i]) + rz[i]) - iz[i]) - rz[i - 1];
             const LK(moved) o = LK(one)(fx, fy, fz, inv_mass[i], m, xx[i], xy[i], xz[i], vx[i], vy[i], vz[i], sym, dt, g);
             LK_STORE(i, o);
         }
     else
         for (uint32_t i = 1; i < l; i++) {
             const LK_T m = mass[i], dm = drag * m;
-            const LK_T fx = (((m * g[0] - dm * vx[i]) + rx[i]) - ix[i]) - rx[i - 1];
-            const LK_T fy = (((m * g[1] - dm * vy[i]) + ry[i]) - iy[i]) - ry[i - 1];
-            const LK_T fz = (((m * g[2] - dm * vz[i]) + rz[i]) - iz[i]) - rz[i - 1];
+            const LK_T fx = ((LK_FMA(-dm, vx[i], m * g[0]) + rx[i]) - ix[i]) - rx[i - 1];
+            const LK_T fy = ((LK_FMA(-dm, vy[i], m * g[1]) + ry[i]) - iy[i]) - ry[i - 1];
+            const LK_T fz = ((LK_FMA(-dm, vz[i], m * g[2]) + rz[i]) - iz[i]) - rz[i - 1];
             const LK(moved) o = LK(one)(fx, fy, fz, inv_mass[i], m, xx[i], xy[i], xz[i], vx[i], vy[i], vz[i], sym, dt, g);
             LK_STORE(i, o);
         }
@@ -180,7 +189,7 @@ LAT_INLINE void LK(rk4_kin)(uint32_t n, const LK_T *restrict mass, const LK_T *r
 {
     for (uint32_t i = 0; i < n; i++) {
         const LK_T mf = LK(pick)(inv_mass[i] != 0, mass[i], (LK_T)0);
-        LK_ACC(t_mv2[i], mf * (Vx[i] * Vx[i] + Vy[i] * Vy[i] + Vz[i] * Vz[i]));
+        LK_ACC(t_mv2[i], mf, Vx[i] * Vx[i] + Vy[i] * Vy[i] + Vz[i] * Vz[i]);
     }
 }
 
@@ -233,10 +242,11 @@ LAT_INLINE void LK(rk4_sums)(uint32_t n, LK_T h6, const LK_T *g, const LK_T *res
         const LK_T vx = Vx[i], vy = Vy[i], vz = Vz[i], wx = ux[i], wy = uy[i], wz = uz[i];
         const LK_T ex = (axx[i] + vx) * h6, ey = (axy[i] + vy) * h6, ez = (axz[i] + vz) * h6;
         const LK_T nx = wx + (avx[i] + Fx[i]) * s, ny = wy + (avy[i] + Fy[i]) * s, nz = wz + (avz[i] + Fz[i]) * s;
-        LK_ACC(t_mv2[i], mf * (vx * vx + vy * vy + vz * vz));
-        LK_ACC(t_mvn2[i], mf * (nx * nx + ny * ny + nz * nz));
-        LK_ACC(t_gain[i], mf * ((LK_T)0.5 * ((nx - wx) * (nx + wx) + (ny - wy) * (ny + wy) + (nz - wz) * (nz + wz)) -
-                                (g[0] * ex + g[1] * ey + g[2] * ez)));
+        LK_ACC(t_mv2[i], mf, vx * vx + vy * vy + vz * vz);
+        LK_ACC(t_mvn2[i], mf, nx * nx + ny * ny + nz * nz);
+        LK_ACC(t_gain[i], mf,
+               (LK_T)0.5 * ((nx - wx) * (nx + wx) + (ny - wy) * (ny + wy) + (nz - wz) * (nz + wz)) -
+                   (g[0] * ex + g[1] * ey + g[2] * ez));
     }
 }
 
@@ -259,14 +269,15 @@ LAT_INLINE void LK(rk4_last)(uint32_t n, LK_T h6, const LK_T *restrict inv_mass,
 /* ---- a row or the hub moved, with its sum terms (the sweeps of both
  * precisions and the blocked passes; MODE_* from lattice_rows.h) ---- */
 
-/* The hub's force: gravity and drag at its evaluated velocity v, then its
- * radial forces in radial order. */
-LAT_INLINE void LK(hub_force)(uint32_t n, LK_T m, LK_T drag, const LK_T *g, const LK_T *v, LK_T *const *rad,
-                              LK_T *f)
+/* The hub's force: gravity and drag at its evaluated velocity v (one fused
+ * multiply-add when `fused`: the explicit steps, as spn__force_on), then
+ * its radial forces in radial order. */
+LAT_INLINE void LK(hub_force)(bool fused, uint32_t n, LK_T m, LK_T drag, const LK_T *g, const LK_T *v,
+                              LK_T *const *rad, LK_T *f)
 {
     const LK_T dm = drag * m;
     for (int c = 0; c < 3; c++) {
-        f[c] = m * g[c] - dm * v[c];
+        f[c] = fused ? LK_FMA(-dm, v[c], m * g[c]) : m * g[c] - dm * v[c];
         for (uint32_t i = 0; i < n; i++) f[c] += rad[c][i];
     }
 }
@@ -279,10 +290,11 @@ LAT_INLINE void LK(hub_move)(uint32_t n, bool sym, LK_T dt, const LK_T *g, LK_T 
 {
     const LK_T v[3] = {V[0][0], V[1][0], V[2][0]};
     LK_T f[3];
-    LK(hub_force)(n, m, drag, g, v, rad, f);
+    LK(hub_force)(true, n, m, drag, g, v, rad, f);
     const LK(moved) o = LK(one)(f[0], f[1], f[2], im, m, X[0][0], X[1][0], X[2][0], v[0], v[1], v[2], sym, dt, g);
     for (int c = 0; c < 3; c++) X[c][0] = o.x[c], V[c][0] = o.v[c];
-    cs->c[L_MV2][0] += o.mv2, cs->c[L_GAIN][0] += o.gain, cs->c[L_MVN2][0] += o.mvn2;
+    cs->c[L_MV2][0] = fma(o.mf, o.mv2, cs->c[L_MV2][0]), cs->c[L_GAIN][0] = fma(o.mf, o.gain, cs->c[L_GAIN][0]);
+    cs->c[L_MVN2][0] = fma(o.mf, o.mvn2, cs->c[L_MVN2][0]);
 }
 
 /* An explicit row (n particles, state rows X, V, masses from mass and

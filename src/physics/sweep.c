@@ -120,11 +120,11 @@ static inline void move(const sweep_args *s, uint32_t i, uint32_t end, double *p
         if (im == 0) continue;
         const double m = s->mass[i], dm = s->drag * m;
         const spn_vec3 fa = s->facc[i];
-        const spn_vec3 f = {(m * s->g.x - dm * vi.x) + fa.x, (m * s->g.y - dm * vi.y) + fa.y,
-                            (m * s->g.z - dm * vi.z) + fa.z};
-        const spn_vec3 vn = spn_v3_add(vi, spn_v3_scale(f, s->dt * im));
-        const spn_vec3 dx = spn_v3_scale(s->symplectic ? vn : vi, s->dt);
-        s->x[i] = spn_v3_add(xi, dx);
+        const spn_vec3 f = {fma(-dm, vi.x, m * s->g.x) + fa.x, fma(-dm, vi.y, m * s->g.y) + fa.y,
+                            fma(-dm, vi.z, m * s->g.z) + fa.z};
+        const spn_vec3 vn = spn__fma_v3(f, s->dt * im, vi), vm = s->symplectic ? vn : vi;
+        const spn_vec3 dx = spn_v3_scale(vm, s->dt);
+        s->x[i] = spn__fma_v3(vm, s->dt, xi);
         s->v[i] = vn;
         p[W_MV2] += m * spn_v3_dot(vi, vi);
         p[W_MVN2] += m * spn_v3_dot(vn, vn);

@@ -13,6 +13,8 @@
 
 #include "spinneret/world.h"
 
+#include <math.h>
+
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -197,15 +199,20 @@ struct spn_world {
     char *metadata;
 };
 
-/* A kernel also compiled for AVX-512 and AVX2, chosen when the program loads
- * (GCC on x86-64 with ifunc support). -ffp-contract=off keeps FMA out, and every
+/* A kernel also compiled for AVX-512 and for AVX2 with FMA (x86-64-v3),
+ * chosen when the program loads (GCC on x86-64 with ifunc support). Every
  * operation is correctly rounded at any vector width, so all versions give
- * the same bits. */
+ * the same bits: -ffp-contract=off keeps the compiler from fusing a multiply
+ * and an add on its own, and the fused multiply-adds the source asks for
+ * (fma(), the explicit steps' particle update) are exact roundings too. The
+ * two clones do them in one instruction; the default version calls libm's
+ * fma, correct and slow, on the processors from before 2013 that lack it. */
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && !defined(SPN_NO_CLONES)
-#define SPN__KERNEL __attribute__((target_clones("avx512f", "avx2", "default")))
+#define SPN__KERNEL __attribute__((target_clones("avx512f", "arch=x86-64-v3", "default")))
 /* One version of a kernel, for code that picks the version itself at run
- * time (spn__lattice_rk4_avx2): SPN__AVX2 compiles a function for AVX2. */
-#define SPN__AVX2 __attribute__((target("avx2")))
+ * time (spn__lattice_rk4_avx2): SPN__AVX2 compiles a function for AVX2 and
+ * FMA. */
+#define SPN__AVX2 __attribute__((target("avx2,fma")))
 #else
 #define SPN__KERNEL
 #endif
@@ -263,6 +270,13 @@ double spn__gravity_energy(const spn_world *w, const spn_vec3 *x);
 /* What the gather reads, copied out of the world into locals so the
  * compiler knows stores to positions and velocities cannot change them
  * (otherwise it reloads every pointer from the world on every particle). */
+/* a s + b, each component one fused multiply-add (the explicit steps'
+ * update: v' = v + f dt/m, x' = x + v' dt). */
+static inline spn_vec3 spn__fma_v3(spn_vec3 a, double s, spn_vec3 b)
+{
+    return spn_v3(fma(a.x, s, b.x), fma(a.y, s, b.y), fma(a.z, s, b.z));
+}
+
 typedef struct spn__gather_ctx {
     const uint32_t *restrict a_start, *restrict b_start, *restrict b_adj;
     const spn_vec3 *restrict fs, *restrict fext;
@@ -279,11 +293,18 @@ static inline spn__gather_ctx spn__gather_ctx_of(const spn_world *w)
 
 /* Net force on particle i: gravity, viscous drag, its springs (from fs: first
  * those it is end a of, a contiguous run, then those it is end b of, in
- * internal order) and, when `has_ext`, fext[i]. */
-static inline spn_vec3 spn__force_on(const spn__gather_ctx *c, uint32_t i, spn_vec3 vi, bool has_ext)
+ * internal order) and, when `has_ext`, fext[i]. Gravity and drag,
+ * m g - (drag m) v, are one fused multiply-add when `fused` (the explicit
+ * steps, explicit.c; the lattice's explicit rows give the same bits), two
+ * roundings otherwise (RK4, the evaluations of the other steppers). */
+static inline spn_vec3 spn__force_on(const spn__gather_ctx *c, uint32_t i, spn_vec3 vi, bool has_ext, bool fused)
 {
     const double m = c->mass[i], dm = c->drag * m;
-    spn_vec3 fi = {m * c->g.x - dm * vi.x, m * c->g.y - dm * vi.y, m * c->g.z - dm * vi.z};
+    spn_vec3 fi;
+    if (fused)
+        fi = spn_v3(fma(-dm, vi.x, m * c->g.x), fma(-dm, vi.y, m * c->g.y), fma(-dm, vi.z, m * c->g.z));
+    else
+        fi = spn_v3(m * c->g.x - dm * vi.x, m * c->g.y - dm * vi.y, m * c->g.z - dm * vi.z);
     for (uint32_t s = c->a_start[i], end = c->a_start[i + 1]; s < end; s++) {
         const spn_vec3 fe = c->fs[s];
         fi.x += fe.x, fi.y += fe.y, fi.z += fe.z;
