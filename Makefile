@@ -8,7 +8,8 @@
 #   make fuzz     run every libFuzzer harness FUZZ_SECONDS each (default 60; build-fuzz/)
 #   make test-valgrind  the suite under valgrind memcheck (build/; not in CI: see docs/hostile-input.md)
 #   make soak     a long run of a 20,000-particle web, SOAK_SECONDS (default 600); not in CI
-#   make determinism  same bytes from build/ and build-asan/ with 1 and 2 threads
+#   make determinism  same bytes from build/, build-asan/ and the kernels' other versions
+#                     (build-noclones/, build-v3/), with 1 and 2 threads
 #   make install  install into PREFIX (default /usr/local)
 
 PREFIX ?= /usr/local
@@ -75,9 +76,22 @@ test-valgrind: build
 soak: build
 	SOAK_SECONDS=$(or $(SOAK_SECONDS),600) scripts/soak.sh build
 
-determinism: build build-asan/CMakeCache.txt
+# The physics kernels' other versions, run here: build-noclones has no
+# target_clones (baseline x86-64, libm's fma: what a processor without AVX2
+# and FMA runs), build-v3 the same for x86-64-v3 (the AVX2 clone's
+# instructions), on a processor that has them. docs/determinism.md.
+DET_V3 := $(shell grep -qw avx2 /proc/cpuinfo 2>/dev/null && grep -qw fma /proc/cpuinfo && echo build-v3)
+build-noclones/CMakeCache.txt:
+	cmake -S . -B build-noclones -DCMAKE_BUILD_TYPE=Release -DSPN_TESTS=OFF -DSPN_VIEWER=OFF \
+	  -DCMAKE_C_FLAGS=-DSPN_NO_CLONES $(CMAKE_FLAGS)
+build-v3/CMakeCache.txt:
+	cmake -S . -B build-v3 -DCMAKE_BUILD_TYPE=Release -DSPN_TESTS=OFF -DSPN_VIEWER=OFF \
+	  "-DCMAKE_C_FLAGS=-DSPN_NO_CLONES -march=x86-64-v3" $(CMAKE_FLAGS)
+
+determinism: build build-asan/CMakeCache.txt build-noclones/CMakeCache.txt $(DET_V3:%=%/CMakeCache.txt)
 	cmake --build build-asan -j $(JOBS)
-	scripts/determinism.sh build build-asan
+	for b in build-noclones $(DET_V3); do cmake --build $$b -j $(JOBS) --target spinneret || exit 1; done
+	scripts/determinism.sh build build-asan build-noclones $(DET_V3)
 
 demo: deps-demo build
 	@scripts/demo.sh build/spinneret out
