@@ -120,8 +120,7 @@ static inline void move(const sweep_args *s, uint32_t i, uint32_t end, double *p
         if (im == 0) continue;
         const double m = s->mass[i], dm = s->drag * m;
         const spn_vec3 fa = s->facc[i];
-        const spn_vec3 f = {fma(-dm, vi.x, m * s->g.x) + fa.x, fma(-dm, vi.y, m * s->g.y) + fa.y,
-                            fma(-dm, vi.z, m * s->g.z) + fa.z};
+        const spn_vec3 f = spn_v3_add(spn__gravity_drag(m, dm, s->g, vi, true), fa);
         const spn_vec3 vn = spn__fma_v3(f, s->dt * im, vi), vm = s->symplectic ? vn : vi;
         const spn_vec3 dx = spn_v3_scale(vm, s->dt);
         s->x[i] = spn__fma_v3(vm, s->dt, xi);

@@ -291,20 +291,25 @@ static inline spn__gather_ctx spn__gather_ctx_of(const spn_world *w)
     return c;
 }
 
-/* Net force on particle i: gravity, viscous drag, its springs (from fs: first
- * those it is end a of, a contiguous run, then those it is end b of, in
- * internal order) and, when `has_ext`, fext[i]. Gravity and drag,
- * m g - (drag m) v, are one fused multiply-add when `fused` (the explicit
- * steps, explicit.c; the lattice's explicit rows give the same bits), two
- * roundings otherwise (RK4, the evaluations of the other steppers). */
+/* Gravity and viscous drag on a particle of mass m at velocity v,
+ * m g - (drag m) v (dm = drag m): one fused multiply-add a component when
+ * `fused` (the explicit steps: explicit.c, sweep.c; the lattice's explicit
+ * rows give the same bits), two roundings otherwise (RK4, the evaluations
+ * of the other steppers). */
+static inline spn_vec3 spn__gravity_drag(double m, double dm, spn_vec3 g, spn_vec3 v, bool fused)
+{
+    if (fused) return spn_v3(fma(-dm, v.x, m * g.x), fma(-dm, v.y, m * g.y), fma(-dm, v.z, m * g.z));
+    return spn_v3(m * g.x - dm * v.x, m * g.y - dm * v.y, m * g.z - dm * v.z);
+}
+
+/* Net force on particle i: gravity and viscous drag (spn__gravity_drag,
+ * fused or not), its springs (from fs: first those it is end a of, a
+ * contiguous run, then those it is end b of, in internal order) and, when
+ * `has_ext`, fext[i]. */
 static inline spn_vec3 spn__force_on(const spn__gather_ctx *c, uint32_t i, spn_vec3 vi, bool has_ext, bool fused)
 {
-    const double m = c->mass[i], dm = c->drag * m;
-    spn_vec3 fi;
-    if (fused)
-        fi = spn_v3(fma(-dm, vi.x, m * c->g.x), fma(-dm, vi.y, m * c->g.y), fma(-dm, vi.z, m * c->g.z));
-    else
-        fi = spn_v3(m * c->g.x - dm * vi.x, m * c->g.y - dm * vi.y, m * c->g.z - dm * vi.z);
+    const double m = c->mass[i];
+    spn_vec3 fi = spn__gravity_drag(m, c->drag * m, c->g, vi, fused);
     for (uint32_t s = c->a_start[i], end = c->a_start[i + 1]; s < end; s++) {
         const spn_vec3 fe = c->fs[s];
         fi.x += fe.x, fi.y += fe.y, fi.z += fe.z;
