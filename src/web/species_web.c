@@ -272,6 +272,10 @@ static void lay_stabilimentum(sweb *w, double toward)
         if (cos(w->angle[r] - toward) > cos(w->angle[best] - toward)) best = r;
     int a = (best + w->nr - 1) % w->nr, b = (best + 1) % w->nr;
     double from = w->d->hub_radius * 1.2, to = fmin(w->len[a], w->len[b]) * 0.55, step = w->d->mesh_inner * 0.7;
+    /* A web too small for a band beside its hub gets none (until 2026-12-05
+     * the negative count went to malloc as a size, and Argiope webs under
+     * 5.5 cm failed with "out of memory"). */
+    if (!(to > from)) return;
     size_t n = 0, cap = (size_t)((to - from) / step) + 2;
     uint32_t *zz = malloc(cap * sizeof *zz);
     if (!zz) {
