@@ -25,16 +25,7 @@ static void settle_or_skip(spn_world *w, double max_time)
 static void test_physical_silk(void **state)
 {
     (void)state;
-    static const spn_vec3 an[4] = {{-0.14, 0.15, 0}, {0.15, 0.13, 0}, {0.13, -0.15, 0}, {-0.15, -0.12, 0}};
-    spn_physical_def d = spn_physical_def_default();
-    d.anchors = an;
-    d.anchor_count = 4;
-    d.move_outer = 0.02;
-    d.materials = spn_web_materials_preset(SPN_MATERIAL_SILK);
-    d.outer_rest = d.outer_placement / 1.10;
-    d.frame_rest = d.frame_placement / 1.08;
-    d.spoke_rest = d.spoke_placement / 1.02;
-    d.spiral_extension = 0.3;
+    spn_physical_def d = web_physical_30cm(true);
     spn_world *w = NULL;
     assert_int_equal(spn_web_build_physical(&d, &w), SPN_OK);
     settle_or_skip(w, 3);

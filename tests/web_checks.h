@@ -189,4 +189,24 @@ static inline int web_capture_off_neighbours(const spn_world *w)
     return bad;
 }
 
+/* Mehla's physical web 30 cm across, with the thesis' threads or (silk) with
+ * silk laid at a silk web's pre-strains, as `spinneret build --method physical
+ * --preset silk` lays it. */
+static inline spn_physical_def web_physical_30cm(bool silk)
+{
+    static const spn_vec3 an[4] = {{-0.14, 0.15, 0}, {0.15, 0.13, 0}, {0.13, -0.15, 0}, {-0.15, -0.12, 0}};
+    spn_physical_def d = spn_physical_def_default();
+    d.anchors = an;
+    d.anchor_count = 4;
+    d.move_outer = 0.02;
+    if (silk) {
+        d.materials = spn_web_materials_preset(SPN_MATERIAL_SILK);
+        d.outer_rest = d.outer_placement / 1.10;
+        d.frame_rest = d.frame_placement / 1.08;
+        d.spoke_rest = d.spoke_placement / 1.02;
+        d.spiral_extension = 0.3;
+    }
+    return d;
+}
+
 #endif

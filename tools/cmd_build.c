@@ -343,8 +343,16 @@ int cmd_build(int argc, char **argv)
             spn_world_destroy(w);
             return cli_fail(CMD, "settling failed: %s", spn_last_error());
         }
-        fprintf(stderr, "spinneret build: settled %s after %.3g s (largest residual %.3g N)\n",
-                rep.reason == SPN_SETTLE_CONVERGED ? "to rest" : "(time out)", rep.time, rep.residual);
+        if (rep.reason == SPN_SETTLE_CONVERGED && rep.steps == 0)
+            fprintf(stderr,
+                    "spinneret build: settled to rest as its static equilibrium (%d Newton steps; largest residual "
+                    "%.3g N)\n",
+                    rep.newton_steps, rep.residual);
+        else
+            fprintf(stderr, "spinneret build: settled %s after %.3g s%s (largest residual %.3g N)\n",
+                    rep.reason == SPN_SETTLE_CONVERGED ? "to rest" : "(time out)", rep.time,
+                    rep.newton_steps ? " stepping in time (the static equilibrium fell short)" : "",
+                    rep.residual);
     }
     if (st == SPN_OK && o.png) {
         spn_render_def rd = spn_render_def_default();

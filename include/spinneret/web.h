@@ -196,11 +196,16 @@ SPN_API spn_status spn_web_build_species(const spn_species_def *def, spn_world *
 /// names the anchor by index.
 SPN_API spn_status spn_web_check_anchors(const spn_vec3 *anchors, int count);
 
-/// Settle a freshly built web: a time step the world's integrator can take
-/// (explicit ones: a fraction of the stiffest spring's period; implicit: 1 ms),
-/// extra air drag while settling (the drag is restored afterwards; it changes
-/// how fast the web comes to rest, not where), and thresholds relative to the
-/// web's own weight. At most `max_time` simulated seconds.
+/// Settle a freshly built web, to thresholds relative to the web's own weight
+/// and thread tensions. First the static equilibrium (spn_world_equilibrium:
+/// springs and gravity balanced, velocities 0; no time passes), when nothing
+/// else acts on the web (no force, air or collide callback, no collider, no
+/// Provot limit) and its rest state breaks no spring. Where that solve does
+/// not reach the threshold in 50 Newton steps, the web steps in time from as
+/// it was built: a time step the world's integrator can take (explicit ones: a fraction of
+/// the stiffest spring's period; implicit: 5 ms), extra air drag while
+/// settling (restored afterwards; it changes how fast the web comes to rest,
+/// not where). At most `max_time` simulated seconds.
 SPN_API spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *report);
 
 /// The web as it stood when `fraction` (0..1) of its springs, in construction

@@ -391,6 +391,10 @@ typedef struct spn_settle_report {
     double kinetic;      ///< at the end [J]
     double residual;     ///< largest residual force at the end [N]
     double total_energy; ///< at the end [J]
+    /// spn_web_settle: Newton steps of the static equilibrium it solves for
+    /// first (0: none); `steps` 0 and reason CONVERGED: that solve found the
+    /// rest state, and no time was stepped
+    int newton_steps;
 } spn_settle_report;
 
 /// Step until at rest or out of time. SPN_OK on both outcomes (read the

@@ -1,11 +1,33 @@
 /* Settling a freshly built web. Strands are laid over-extended, so a new web
- * is far from rest; this picks a step the integrator can take, adds air drag
- * while the web comes to rest (drag changes the path, not the equilibrium:
- * at rest it exerts nothing) and stops when the largest residual force is a
- * small fraction of the lightest particle's weight. */
+ * is far from rest. The rest state is where the springs and gravity balance,
+ * so it is first solved for directly (spn_world_equilibrium, Newton on the
+ * potential). Where that solve does not reach the target, the web steps in
+ * time from as it was built: a step the integrator can take, air drag added
+ * while the web comes to rest (drag changes the path, not the equilibrium: at
+ * rest it exerts nothing), until the largest residual force is a small
+ * fraction of a mean particle's weight or thread tension and the kinetic
+ * energy is negligible.
+ *
+ * Why both (measured 2026-12-05, docs/web-builders.md, "Settling"): the solve
+ * takes the Araneus and the physical webs to rest in 0.03 to 0.25 s of CPU
+ * where stepping took 0.9 to 2.7 s, at the same rest state (1e-11 m apart on
+ * the Araneus web); on the other species webs and the geometric web (light
+ * particles between nearly slack threads, where the Newton model holds for
+ * steps of a few percent) it runs out of Newton steps or stalls. */
 #include "web_internal.h"
 
+#include "spinneret/equilibrium.h"
+
 #include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Newton steps the equilibrium solve may take before the web steps in time
+ * instead. Where it reaches rest it does so in under 20 (Newton converges
+ * quadratically there); where it does not it crawls (hundreds of steps cut to
+ * a few percent), and 50 bound what that costs (docs/web-builders.md,
+ * "Settling"). */
+#define SETTLE_NEWTON_STEPS 50
 
 static double stable_step(const spn_world *w)
 {
@@ -25,6 +47,61 @@ static double stable_step(const spn_world *w)
     return best;
 }
 
+/* Whether the static equilibrium is the rest state stepping would reach:
+ * nothing but springs, gravity and damping acts on the web. */
+static bool equilibrium_applies(const spn_world *w)
+{
+    void *user;
+    double rho, mu;
+    return !spn_world_force_callback(w, &user) && !spn_world_air(w, &user, &rho, &mu) &&
+           !spn_world_collide_callback(w, &user) && spn_world_collider_count(w) == 0 &&
+           !(spn_world_get_def(w)->provot_max_strain > 0);
+}
+
+/* Whether some intact spring lies outside its break limits (breakage on). */
+static bool would_break(const spn_world *w)
+{
+    if (!spn_world_get_def(w)->breakage) return false;
+    for (uint32_t s = 0; s < spn_world_spring_count(w); s++) {
+        spn_spring_info si = spn_world_spring(w, s);
+        if (!si.broken && !(si.length >= si.break_min && si.length <= si.break_max)) return true;
+    }
+    return false;
+}
+
+/* The static equilibrium at residual `target` [N]: *done when it is reached
+ * and breaks no spring (the web then at rest), else the web as it was. Not
+ * from where an unfinished solve stopped: on the Argiope web stepping from
+ * there had not come to rest after 13 minutes of CPU, against 8 s from the
+ * web as built. Only running out of memory is an error. */
+static spn_status solve_rest(spn_world *w, double target, bool *done, int *newton_steps)
+{
+    *done = false;
+    uint32_t np = spn_world_particle_count(w);
+    spn_vec3 *x = malloc((np ? np : 1) * sizeof *x), *v = malloc((np ? np : 1) * sizeof *v);
+    if (!x || !v) {
+        free(x), free(v);
+        return spn_error(SPN_ERR_NOMEM, "settle: out of memory");
+    }
+    for (uint32_t i = 0; i < np; i++) x[i] = spn_world_position(w, i), v[i] = spn_world_velocity(w, i);
+    spn_equilibrium_def d = spn_equilibrium_def_default();
+    d.tolerance = 0;
+    d.abs_tolerance = target;
+    d.max_iterations = SETTLE_NEWTON_STEPS;
+    spn_equilibrium_report rep;
+    spn_status st = spn_world_equilibrium(w, &d, &rep);
+    *newton_steps = rep.iterations;
+    if (st == SPN_ERR_NOMEM) {
+        free(x), free(v);
+        return st;
+    }
+    *done = st == SPN_OK && rep.reason == SPN_EQUILIBRIUM_CONVERGED && !would_break(w);
+    if (!*done)
+        for (uint32_t i = 0; i < np; i++) spn_world_set_position(w, i, x[i]), spn_world_set_velocity(w, i, v[i]);
+    free(x), free(v);
+    return SPN_OK;
+}
+
 spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *report)
 {
     double drag = spn_world_get_def(w)->drag, lightest = INFINITY;
@@ -39,6 +116,26 @@ spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *repo
     uint32_t ns = spn_world_spring_count(w);
     for (uint32_t s = 0; s < ns; s++) tension += spn_world_spring(w, s).tension;
     double floor_force = fmax(1e-3 * 9.81 * mass / (np ? np : 1), 1e-5 * tension / (ns ? ns : 1));
+    int newton_steps = 0;
+    /* The solve's target is also a hundredth of the lightest particle's
+     * weight: its velocities are 0, so no kinetic-energy test catches a
+     * particle that would still fall, and with the tension threshold alone
+     * (2e-8 N on the species webs, ten times a glue droplet's weight) it
+     * called the generic web at rest with three particles afloat between
+     * slack threads, 1 mm above where stepping hangs them. */
+    if (equilibrium_applies(w)) {
+        bool done;
+        spn_status st = solve_rest(w, fmin(floor_force, 1e-2 * 9.81 * lightest), &done, &newton_steps);
+        if (st != SPN_OK) return st;
+        if (done) {
+            memset(report, 0, sizeof *report);
+            report->reason = SPN_SETTLE_CONVERGED;
+            report->residual = spn_world_max_residual(w, NULL);
+            report->total_energy = spn_world_total_energy(w);
+            report->newton_steps = newton_steps;
+            return SPN_OK;
+        }
+    }
     spn_settle_def sd = spn_settle_def_default();
     sd.dt = stable_step(w);
     sd.max_time = max_time;
@@ -49,5 +146,6 @@ spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *repo
     spn_world_set_drag(w, fmax(drag, 20.0));
     spn_status st = spn_world_settle(w, &sd, report);
     spn_world_set_drag(w, drag);
+    report->newton_steps = newton_steps;
     return st;
 }

@@ -1,0 +1,154 @@
+/* spn_web_settle solves for the rest state before it steps in time: on a web
+ * where the static equilibrium converges it is the rest state that stepping
+ * reaches, no time passes and every particle is balanced to a hundredth of the
+ * lightest one's weight; where the solve falls short the web steps from as it
+ * was built, exactly as without the solve; and a web that something else acts
+ * on (a force callback, a collider) is never solved for. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include "web_checks.h"
+
+/* Adds nothing: a web with it is settled by stepping only. */
+static void no_force(void *user, const spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v, spn_vec3 *f)
+{
+    (void)user, (void)w, (void)t, (void)x, (void)v, (void)f;
+}
+
+/* A small species web as `spinneret build --settle` settles it (silk: implicit). */
+static spn_world *species_web(spn_species kind, double size)
+{
+    spn_species_def d = spn_species_def_preset(kind);
+    d.size = size;
+    d.world.integrator = SPN_INTEGRATOR_IMPLICIT;
+    spn_world *w = NULL;
+    assert_int_equal(spn_web_build_species(&d, &w), SPN_OK);
+    return w;
+}
+
+static spn_world *physical_web(bool silk)
+{
+    spn_physical_def d = web_physical_30cm(silk);
+    spn_world *w = NULL;
+    assert_int_equal(spn_web_build_physical(&d, &w), SPN_OK);
+    if (silk) spn_world_set_integrator(w, SPN_INTEGRATOR_IMPLICIT);
+    return w;
+}
+
+static double lightest_weight(const spn_world *w)
+{
+    double m = INFINITY;
+    for (uint32_t i = 0; i < spn_world_particle_count(w); i++)
+        if (!spn_world_is_fixed(w, i)) m = fmin(m, spn_world_mass(w, i));
+    return m * spn_v3_len(spn_world_get_def(w)->gravity);
+}
+
+static double largest_gap(const spn_world *a, const spn_world *b)
+{
+    double gap = 0;
+    for (uint32_t i = 0; i < spn_world_particle_count(a); i++)
+        gap = fmax(gap, spn_v3_len(spn_v3_sub(spn_world_position(a, i), spn_world_position(b, i))));
+    return gap;
+}
+
+/* The solve's rest state: every particle balanced to a hundredth of the
+ * lightest one's weight, at rest, and no time passed. */
+static void check_solved(spn_world *w, const spn_settle_report *r)
+{
+    const double weight = lightest_weight(w);
+    assert_int_equal(r->reason, SPN_SETTLE_CONVERGED);
+    assert_true(r->newton_steps > 0 && r->newton_steps <= 50);
+    assert_true(r->steps == 0 && r->time == 0 && r->kinetic == 0);
+    assert_true(r->residual <= 1e-2 * weight);
+    assert_true(spn_world_max_residual(w, NULL) <= 1e-2 * weight);
+    for (uint32_t i = 0; i < spn_world_particle_count(w); i++)
+        assert_true(spn_v3_len(spn_world_velocity(w, i)) == 0);
+}
+
+/* The silk web solved, and stepped (a force callback that adds nothing
+ * keeps it from the solve): the same rest state. */
+static void test_solved_rest_is_stepped_rest(void **state)
+{
+    (void)state;
+    spn_world *solved = physical_web(true), *stepped = spn_world_clone(solved);
+    spn_world_set_force_callback(stepped, no_force, NULL);
+    spn_settle_report a, b;
+    assert_int_equal(spn_web_settle(solved, 20, &a), SPN_OK);
+    assert_int_equal(spn_web_settle(stepped, 20, &b), SPN_OK);
+    const double gap = largest_gap(solved, stepped);
+    print_message("solved: %d Newton steps, residual %.3g N; stepped: %.3g s, %llu steps, residual %.3g N; "
+                  "largest gap %.3g m\n",
+                  a.newton_steps, a.residual, b.time, (unsigned long long)b.steps, b.residual, gap);
+    check_solved(solved, &a);
+    assert_int_equal(b.reason, SPN_SETTLE_CONVERGED);
+    assert_int_equal(b.newton_steps, 0);
+    assert_true(b.steps > 0);
+    /* the same rest state: a micrometre on a web 30 cm across (measured
+     * 3e-12 m; the thesis' threads, stepped explicitly, 2e-7 m) */
+    assert_true(gap < 1e-6);
+    spn_world_destroy(solved);
+    spn_world_destroy(stepped);
+}
+
+/* The thesis' soft threads (an explicit integrator; stepping them to rest
+ * takes some 19,000 steps, too slow to repeat here under the sanitizers). */
+static void test_solved_rest_thesis_threads(void **state)
+{
+    (void)state;
+    spn_world *w = physical_web(false);
+    spn_settle_report r;
+    assert_int_equal(spn_web_settle(w, 20, &r), SPN_OK);
+    check_solved(w, &r);
+    spn_world_destroy(w);
+}
+
+/* A small generic species web, whose light particles between nearly slack
+ * threads the solve does not balance in its 50 Newton steps: the web is
+ * stepped from as it was built, bit for bit what stepping alone gives. (If
+ * the solver learns to settle this web, pick one it does not.) */
+static void test_unfinished_solve_steps_from_built(void **state)
+{
+    (void)state;
+    spn_world *w = species_web(SPN_SPECIES_GENERIC, 0.06), *alone = spn_world_clone(w);
+    spn_world_set_force_callback(alone, no_force, NULL);
+    spn_settle_report a, b;
+    assert_int_equal(spn_web_settle(w, 3, &a), SPN_OK);
+    assert_int_equal(spn_web_settle(alone, 3, &b), SPN_OK);
+    print_message("Newton steps %d, then %.3g s stepped (%llu steps); alone %.3g s\n", a.newton_steps, a.time,
+                  (unsigned long long)a.steps, b.time);
+    assert_int_equal(a.newton_steps, 50);
+    assert_int_equal(b.newton_steps, 0);
+    assert_int_equal(a.reason, SPN_SETTLE_CONVERGED);
+    assert_true(a.steps > 0 && a.steps == b.steps);
+    assert_true(largest_gap(w, alone) == 0);
+    spn_world_destroy(w);
+    spn_world_destroy(alone);
+}
+
+/* A collider acts on the web: never solved for. */
+static void test_collider_keeps_stepping(void **state)
+{
+    (void)state;
+    spn_world *w = physical_web(true);
+    assert_int_equal(spn_world_add_plane(w, spn_v3(0, 0, 1), -1, 0, 0), SPN_OK);
+    spn_settle_report r;
+    assert_int_equal(spn_web_settle(w, 20, &r), SPN_OK);
+    assert_int_equal(r.newton_steps, 0);
+    assert_true(r.steps > 0);
+    assert_int_equal(r.reason, SPN_SETTLE_CONVERGED);
+    spn_world_destroy(w);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_solved_rest_is_stepped_rest),
+        cmocka_unit_test(test_solved_rest_thesis_threads),
+        cmocka_unit_test(test_unfinished_solve_steps_from_built),
+        cmocka_unit_test(test_collider_keeps_stepping),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
