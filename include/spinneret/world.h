@@ -347,6 +347,11 @@ SPN_API spn_step_report spn_world_last_step(const spn_world *w);
 /// stiffness of theirs per particle as extra_stiffness). INFINITY when nothing
 /// bounds it (no free particle with a spring or drag); 0 when out of memory.
 SPN_API double spn_world_stable_step(const spn_world *w, double extra_stiffness);
+/// The fraction of spn_world_stable_step the library steps symplectic Euler
+/// at (the animation runner's sub-steps, the adaptive stepper's floor), and
+/// RK4, whose stability interval is 2.8 / 2 times as long.
+#define SPN_STABLE_REACH 0.8
+#define SPN_STABLE_REACH_RK4 1.4
 /// The implicit solver's CG stop, changeable between steps (an interactive
 /// viewer wants a looser one): relative residual in (0, 1), iteration cap >= 1.
 SPN_API spn_status spn_world_set_solver_tolerance(spn_world *w, double cg_tolerance, int cg_max_iterations);

@@ -49,9 +49,8 @@ int spn_anim_stable_substeps(const spn_world *w, double fps, spn_integrator solv
     double frame = 1 / fps;
     if (solver == SPN_INTEGRATOR_IMPLICIT) return (int)fmax(1, ceil(frame / 2e-3));
     if (solver == SPN_INTEGRATOR_ADAPTIVE) return (int)fmax(1, ceil(frame / 5e-3));
-    /* margin on the springs' bound (spn_world_stable_step): 0.8 of it, 1.4
-     * for RK4, whose stability interval is 2.8 / 2 times symplectic Euler's */
-    const double reach = solver == SPN_INTEGRATOR_RK4 ? 1.4 : 0.8;
+    /* margin on the springs' bound (spn_world_stable_step) */
+    const double reach = solver == SPN_INTEGRATOR_RK4 ? SPN_STABLE_REACH_RK4 : SPN_STABLE_REACH;
     const double stable = spn_world_stable_step(w, extra_stiffness);
     if (!(stable > 0)) return 1000; /* out of memory */
     const double dt = fmin(frame, reach * stable);

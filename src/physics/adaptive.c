@@ -117,17 +117,16 @@ static bool eval_spare(spn_world *w, double t, spn__eval *e)
 }
 
 /* The floor, once a sub-step would go under def.dt_min (or 1e-12 dt when
- * that is not positive): the shorter of that and SPN__FLOOR_REACH of the
- * springs' stable step (stable_step.c), so that sub-steps at the floor stay
- * stable whatever dt_min says. SPN__FLOOR_REACH is the animation runner's
- * margin for symplectic Euler. Computed at most once an outer step (a pass
- * over springs and particles, no square roots of lengths), and only when the
- * step gets that short. */
-#define SPN__FLOOR_REACH 0.8
+ * that is not positive): the shorter of that and SPN_STABLE_REACH of the
+ * springs' stable step (stable_step.c; the animation runner's margin for
+ * symplectic Euler), so that sub-steps at the floor stay stable whatever
+ * dt_min says. Computed at most once an outer step (a pass over springs and
+ * particles, no square roots of lengths), and only when the step gets that
+ * short. */
 static double spring_floor(spn_world *w, double base)
 {
     if (spn__scratch(w, SPN_TMP_E + 1) != SPN_OK) return base; /* the floor given, as before */
-    return fmin(base, spn__stable_step(w, SPN__FLOOR_REACH, 0, (double *)w->tmp[SPN_TMP_E]));
+    return fmin(base, spn__stable_step(w, SPN_STABLE_REACH, 0, (double *)w->tmp[SPN_TMP_E]));
 }
 
 spn_status spn__step_adaptive(spn_world *w, double dt, spn__step_result *r)
