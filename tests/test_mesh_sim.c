@@ -205,6 +205,34 @@ static void test_fast_cloth_does_not_tunnel_through_table(void **state)
     spn_mesh_scene_destroy(s);
 }
 
+/* The sub-step is 0.4 of the world's stable step, drag included: a scene
+ * in thick air (drag 1e5 s^-1, a damping rate far above the cloth's
+ * stiffness) steps shorter than the same scene in still air. (Until
+ * 2026-12-05 the scene had its own copy of the bound, without the drag.) */
+static double cloth_substep(double drag)
+{
+    spn_mesh_scene_def sd = spn_mesh_scene_def_default();
+    sd.world.drag = drag;
+    spn_mesh_scene *s;
+    assert_int_equal(spn_mesh_scene_create(&sd, &s), SPN_OK);
+    spn_mesh m = cloth(9, 0.5, 0, 1, 0);
+    spn_mesh_spring_def d = soft_cloth(0.2);
+    assert_int_equal(spn_mesh_scene_add(s, &m, &d, NULL), SPN_OK);
+    const double h = spn_mesh_scene_substep(s), stable = spn_world_stable_step(spn_mesh_scene_world(s), 0);
+    assert_true(h == fmin(sd.max_substep, 0.4 * stable));
+    spn_mesh_free(&m);
+    spn_mesh_scene_destroy(s);
+    return h;
+}
+
+static void test_substep_follows_stable_step(void **state)
+{
+    (void)state;
+    const double still = cloth_substep(0), thick = cloth_substep(1e5);
+    print_message("sub-step %g s in still air, %g s at drag 1e5\n", still, thick);
+    assert_true(thick < 0.5 * still);
+}
+
 static void test_free_cloth_lands_on_free_cloth(void **state)
 {
     (void)state;
@@ -243,6 +271,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cloth_hangs_from_two_corners),
+        cmocka_unit_test(test_substep_follows_stable_step),
         cmocka_unit_test(test_sphere_bounces_and_rests_on_floor),
         cmocka_unit_test(test_sphere_bounces_and_rests_on_mesh_floor),
         cmocka_unit_test(test_friction_on_a_slope),

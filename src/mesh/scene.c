@@ -124,29 +124,13 @@ spn_status spn_mesh_scene_object_mesh(const spn_mesh_scene *s, uint32_t object, 
 double spn_mesh_scene_substep(spn_mesh_scene *s)
 {
     if (s->substep > 0) return s->substep;
-    uint32_t np = spn_world_particle_count(s->w), ns = spn_world_spring_count(s->w);
-    double *ksum = calloc(np ? np : 1, sizeof *ksum), *dsum = calloc(np ? np : 1, sizeof *dsum);
-    double h = s->def.max_substep;
-    for (uint32_t i = 0; ksum && dsum && i < ns; i++) {
-        spn_spring_info sp = spn_world_spring(s->w, i);
-        ksum[sp.a] += sp.k;
-        ksum[sp.b] += sp.k;
-        dsum[sp.a] += sp.kd;
-        dsum[sp.b] += sp.kd;
-    }
-    for (uint32_t i = 0; ksum && dsum && i < np; i++) {
-        if (spn_world_is_fixed(s->w, i)) continue;
-        double m = spn_world_mass(s->w, i);
-        double a = 2 * ksum[i] / m, b = 4 * dsum[i] / m; /* a h^2 + b h < 4 */
-        /* The positive root of a h^2 + b h = 4, written 8 / (b + sqrt(b^2 + 16 a))
-         * rather than (-b + sqrt(...)) / 2a: the latter cancels to 0 when a is
-         * tiny beside b (stiffness 1e-300 gave a zero sub-step). */
-        if (a > 0 || b > 0) h = fmin(h, 0.4 * 8 / (b + sqrt(b * b + 16 * a)));
-    }
-    free(ksum);
-    free(dsum);
-    s->substep = h;
-    return h;
+    /* 0.4 of the springs' stable step (Gershgorin's bound, the world's drag
+     * in it; until 2026-12-05 a copy of that bound here left the drag out
+     * and counted broken springs), at most max_substep; that too when out
+     * of memory (0) */
+    const double stable = spn_world_stable_step(s->w, 0);
+    s->substep = stable > 0 ? fmin(s->def.max_substep, 0.4 * stable) : s->def.max_substep;
+    return s->substep;
 }
 
 spn_status spn_mesh_scene_advance(spn_mesh_scene *s, double dt)
