@@ -42,7 +42,7 @@ for h in "$build"/fuzz/${FUZZ_ONLY:-fuzz_*}; do
   dictarg=()
   [ -s "$dict" ] && dictarg=(-dict="$dict")
   log="$build/fuzz-$name.log"
-  "$h" "${dictarg[@]}" -max_total_time="$seconds" -timeout="${FUZZ_TIMEOUT:-25}" -rss_limit_mb=2048 -malloc_limit_mb=1024 \
+  "$h" "${dictarg[@]}" -max_total_time="$seconds" -timeout="${FUZZ_TIMEOUT:-25}" -report_slow_units="${FUZZ_TIMEOUT:-25}" -rss_limit_mb=2048 -malloc_limit_mb=1024 \
        -print_final_stats=1 -artifact_prefix="$crashes/$name-" "$corpus" >"$log" 2>&1
   rc=$?
   runs=$(grep -o 'Done [0-9]* runs' "$log" | tail -1 | grep -o '[0-9]*')
