@@ -106,7 +106,7 @@ static void test_solved_rest_thesis_threads(void **state)
 }
 
 /* A small generic species web, whose light particles between nearly slack
- * threads the solve does not balance in its 50 Newton steps: the web is
+ * threads the solve does not balance (its residual stalls): the web is
  * stepped from as it was built, bit for bit what stepping alone gives. (If
  * the solver learns to settle this web, pick one it does not.) */
 static void test_unfinished_solve_steps_from_built(void **state)
@@ -119,7 +119,9 @@ static void test_unfinished_solve_steps_from_built(void **state)
     assert_int_equal(spn_web_settle(alone, 3, &b), SPN_OK);
     print_message("Newton steps %d, then %.3g s stepped (%llu steps); alone %.3g s\n", a.newton_steps, a.time,
                   (unsigned long long)a.steps, b.time);
-    assert_int_equal(a.newton_steps, 50);
+    /* its residual stops halving after 30 steps: the rounds of 10 give up
+     * before the cap of 50 (c9e311e; with one run of 50 it took all 50) */
+    assert_true(a.newton_steps >= 10 && a.newton_steps < 50 && a.newton_steps % 10 == 0);
     assert_int_equal(b.newton_steps, 0);
     assert_int_equal(a.reason, SPN_SETTLE_CONVERGED);
     assert_true(a.steps > 0 && a.steps == b.steps);
