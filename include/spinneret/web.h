@@ -201,8 +201,9 @@ SPN_API spn_status spn_web_check_anchors(const spn_vec3 *anchors, int count);
 /// springs and gravity balanced, velocities 0; no time passes), when nothing
 /// else acts on the web (no force, air or collide callback, no collider, no
 /// Provot limit) and its rest state breaks no spring. Where that solve does
-/// not reach the threshold in 50 Newton steps, the web steps in time from as
-/// it was built: a time step the world's integrator can take (explicit ones: a fraction of
+/// not reach the threshold (at most 50 Newton steps, fewer when 10 of them
+/// do not halve the residual), the web steps in time from as it was built:
+/// a time step the world's integrator can take (explicit ones: a fraction of
 /// the stiffest spring's period; implicit: 5 ms), extra air drag while
 /// settling (restored afterwards; it changes how fast the web comes to rest,
 /// not where). At most `max_time` simulated seconds.

@@ -23,10 +23,10 @@
 #include <string.h>
 
 /* Newton steps the equilibrium solve may take before the web steps in time
- * instead. Where it reaches rest it does so in under 20 (Newton converges
- * quadratically there); where it does not it crawls (hundreds of steps cut to
- * a few percent), and 50 bound what that costs (docs/web-builders.md,
- * "Settling"). */
+ * instead. Where it reaches rest it does so in 3 to 33 (the physical webs,
+ * Araneus seeds 2 and 3, generic seed 4); where it does not it crawls
+ * (hundreds of steps cut to a few percent), and 50 bound what that costs
+ * (docs/web-builders.md, "Settling"). */
 #define SETTLE_NEWTON_STEPS 50
 /* The solve goes in rounds of this many Newton steps, and stops when a round
  * has not halved the residual: where it converges it does (Araneus seed 2:
