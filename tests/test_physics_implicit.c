@@ -5,7 +5,9 @@
  *    without blowing up, and settles to the same equilibrium as a tiny-step
  *    explicit run, within 1e-6 relative to the sag.
  * And: implicit steps at dt = 1 s bring a loaded taut web to rest down to
- * 1e-12 of its pretension (CG's round-off floor scales as a 2-norm). */
+ * 1e-12 of its pretension (CG's round-off floor scales as a 2-norm); with
+ * the energy limit a step that would create energy is shortened, and one
+ * that would not keeps its bits. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -131,6 +133,147 @@ static void test_explicit_blowup_reported(void **state)
     spn_world_destroy(w);
 }
 
+/* Fixed anchors at x = -1 and x = 1 (particles 0 and 1), beads of 1e-6 kg on
+ * the x axis between them, no gravity, drag 1 s^-1, implicit. */
+static spn_world *anchors_and_beads(spn_energy_limit limit, const double *xs, int n)
+{
+    spn_world_def def = spn_world_def_default();
+    def.gravity = spn_v3(0, 0, 0);
+    def.integrator = SPN_INTEGRATOR_IMPLICIT;
+    def.drag = 1;
+    def.threads = 1;
+    spn_world *w = spn_world_create(&def);
+    spn_particle_def p = spn_particle_def_default();
+    p.fixed = true;
+    p.position = spn_v3(-1, 0, 0);
+    assert_int_equal(spn_world_add_particle(w, &p, NULL), SPN_OK);
+    p.position = spn_v3(1, 0, 0);
+    assert_int_equal(spn_world_add_particle(w, &p, NULL), SPN_OK);
+    p.fixed = false;
+    p.mass = 1e-6;
+    for (int i = 0; i < n; i++) {
+        p.position = spn_v3(xs[i], 0, 0);
+        assert_int_equal(spn_world_add_particle(w, &p, NULL), SPN_OK);
+    }
+    assert_int_equal(spn_world_set_energy_limit(w, limit), SPN_OK);
+    return w;
+}
+
+/* A tension-only thread from a to b. */
+static void thread(spn_world *w, uint32_t a, uint32_t b, double rest, double k)
+{
+    spn_spring_def s = spn_spring_def_default();
+    s.tension_only = true;
+    s.a = a, s.b = b, s.rest = rest, s.k = k;
+    assert_int_equal(spn_world_add_spring(w, &s, NULL), SPN_OK);
+}
+
+/* A light bead between two threads: the one to the left taut (rest 0.5 over
+ * a length of 1, k = 1), the one to the right slack (rest 1.2 over 1) and a
+ * hundred times stiffer. The linearised step sees only the taut thread and
+ * moves the bead its whole extension, 0.5 m, which stretches the stiff
+ * thread by 0.3 m: 4.5 J out of 0.125. */
+static spn_world *bead_between_threads(spn_energy_limit limit)
+{
+    const double x = 0;
+    spn_world *w = anchors_and_beads(limit, &x, 1);
+    thread(w, 0, 2, 0.5, 1);
+    thread(w, 2, 1, 1.2, 100);
+    return w;
+}
+
+static void test_energy_limit(void **state)
+{
+    (void)state;
+    /* Off (the default): the step creates energy. */
+    spn_world *w = bead_between_threads(SPN_ENERGY_LIMIT_OFF);
+    assert_int_equal(spn_world_energy_limit(w), SPN_ENERGY_LIMIT_OFF);
+    const double e0 = spn_world_total_energy(w);
+    assert_int_equal(spn_world_step(w, 1), SPN_OK);
+    print_message("one 1 s step, no limit: %.4g J -> %.4g J\n", e0, spn_world_total_energy(w));
+    assert_true(spn_world_total_energy(w) > 10 * e0);
+    assert_int_equal(spn_world_last_step(w).cuts, 0);
+    spn_world_destroy(w);
+
+    /* On: the move is halved until it creates none, and what it takes out is booked as dissipated. */
+    w = bead_between_threads(SPN_ENERGY_LIMIT_ALWAYS);
+    assert_int_equal(spn_world_step(w, 1), SPN_OK);
+    const double e1 = spn_world_total_energy(w), lost = spn_world_energy(w).dissipated;
+    print_message("with the limit: %.4g J, %d halvings, %.4g J dissipated\n", e1, spn_world_last_step(w).cuts, lost);
+    assert_true(spn_world_last_step(w).cuts >= 2); /* half the move still gains (0.156 J) */
+    assert_true(e1 <= e0);
+    assert_true(fabs(e1 + lost - e0) <= 1e-12 * e0);
+    /* Stepped on, it comes to the balance of the two threads: 1 (L - 0.5) = 100 (2 - L - 1.2). */
+    for (int i = 0; i < 200; i++) assert_int_equal(spn_world_step(w, 1), SPN_OK);
+    const double left = 80.5 / 101;
+    print_message("bead at x = %.9f, balance at %.9f\n", spn_world_position(w, 2).x, left - 1);
+    assert_true(fabs(spn_world_position(w, 2).x - (left - 1)) < 1e-9);
+    spn_world_destroy(w);
+
+    /* A step that creates no energy keeps its bits: the taut line, limit on and off. */
+    spn_world *a = taut_line(SPN_INTEGRATOR_IMPLICIT, 50), *b = taut_line(SPN_INTEGRATOR_IMPLICIT, 50);
+    assert_int_equal(spn_world_set_energy_limit(a, SPN_ENERGY_LIMIT_ALWAYS), SPN_OK);
+    for (int i = 0; i < 60; i++) {
+        assert_int_equal(spn_world_step(a, 1.0 / 60), SPN_OK);
+        assert_int_equal(spn_world_step(b, 1.0 / 60), SPN_OK);
+        assert_int_equal(spn_world_last_step(a).cuts, 0);
+    }
+    for (uint32_t i = 0; i < spn_world_particle_count(a); i++) {
+        spn_vec3 pa = spn_world_position(a, i), pb = spn_world_position(b, i);
+        assert_memory_equal(&pa, &pb, sizeof pa);
+    }
+    spn_world_destroy(a);
+    spn_world_destroy(b);
+}
+
+/* Two beads between the threads: taut (rest 0.25 over 0.5, k = 1), a taut
+ * link between them (0.9 over 1), and the stiff slack one (0.7 over 0.5,
+ * k = 100). A 1 s step with CG held to one iteration is unfinished and
+ * creates energy; with CG finished (2 iterations) the step creates energy
+ * too, through the slack thread alone. */
+static spn_world *two_beads(spn_energy_limit limit, int cg_cap)
+{
+    const double xs[2] = {-0.5, 0.5};
+    spn_world *w = anchors_and_beads(limit, xs, 2);
+    thread(w, 0, 2, 0.25, 1);
+    thread(w, 2, 3, 0.9, 1);
+    thread(w, 3, 1, 0.7, 100);
+    assert_int_equal(spn_world_set_solver_tolerance(w, 1e-10, cg_cap), SPN_OK);
+    return w;
+}
+
+/* SPN_ENERGY_LIMIT_UNFINISHED cuts only a step whose solve stopped short. */
+static void test_energy_limit_unfinished(void **state)
+{
+    (void)state;
+    const spn_energy_limit modes[3] = {SPN_ENERGY_LIMIT_OFF, SPN_ENERGY_LIMIT_UNFINISHED, SPN_ENERGY_LIMIT_ALWAYS};
+    for (int cap = 1; cap <= 1000; cap *= 1000)
+        for (int m = 0; m < 3; m++) {
+            spn_world *w = two_beads(modes[m], cap);
+            const double e0 = spn_world_total_energy(w);
+            assert_int_equal(spn_world_step(w, 1), SPN_OK);
+            const double e1 = spn_world_total_energy(w);
+            const spn_step_report r = spn_world_last_step(w);
+            print_message("CG cap %d, limit %d: %.4g J -> %.4g J, %d CG iterations, %d halvings\n", cap, (int)modes[m],
+                          e0, e1, r.cg_iterations, r.cuts);
+            const bool unfinished = r.cg_iterations == cap && cap == 1;
+            const bool held = modes[m] == SPN_ENERGY_LIMIT_ALWAYS || (modes[m] == SPN_ENERGY_LIMIT_UNFINISHED && unfinished);
+            if (held) {
+                assert_true(r.cuts > 0);
+                assert_true(e1 <= e0);
+            } else {
+                assert_int_equal(r.cuts, 0);
+                assert_true(e1 > 10 * e0);
+            }
+            spn_world_destroy(w);
+        }
+    spn_world *w = two_beads(SPN_ENERGY_LIMIT_OFF, 1000);
+    assert_int_equal(spn_world_set_energy_limit(w, (spn_energy_limit)3), SPN_ERR_INVALID);
+    assert_non_null(strstr(spn_last_error(), "energy limit"));
+    assert_int_equal(spn_world_energy_limit(w), SPN_ENERGY_LIMIT_OFF);
+    spn_world_destroy(w);
+}
+
 static void rest_load(void *user, const spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v, spn_vec3 *f)
 {
     (void)user, (void)t, (void)x, (void)v;
@@ -178,6 +321,8 @@ int main(void)
         cmocka_unit_test(test_taut_line),
         cmocka_unit_test(test_explicit_blowup_reported),
         cmocka_unit_test(test_rest_to_round_off),
+        cmocka_unit_test(test_energy_limit),
+        cmocka_unit_test(test_energy_limit_unfinished),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -326,6 +326,9 @@ typedef struct spn_step_report {
     int breaks;           ///< springs broken in this step
     int blocked;          ///< spn_world_advance: steps taken several to a pass over memory
                           ///< (the lattice step of a big web, docs/physics-lattice.md)
+    int cuts;             ///< implicit with an energy limit (spn_world_set_energy_limit): times a
+                          ///< step's move was halved because the whole move would have created
+                          ///< energy (threads going slack within it, a solve out of CG iterations)
 } spn_step_report;
 
 /// Advance by dt seconds. On SPN_ERR_UNSTABLE the world keeps its state from
@@ -355,6 +358,26 @@ SPN_API double spn_world_stable_step(const spn_world *w, double extra_stiffness)
 /// The implicit solver's CG stop, changeable between steps (an interactive
 /// viewer wants a looser one): relative residual in (0, 1), iteration cap >= 1.
 SPN_API spn_status spn_world_set_solver_tolerance(spn_world *w, double cg_tolerance, int cg_max_iterations);
+/// Implicit steps held to creating no energy. A step whose whole move would
+/// raise the kinetic, elastic and gravitational energy above where it was
+/// (net of the force callback's and air's work, beyond round-off) is halved
+/// along its move until it does not; spn_step_report.cuts counts the
+/// halvings, and the energy a cut step takes out is booked as dissipated. The
+/// single linearised step goes wrong where threads go slack within it and,
+/// worst, where its CG solve stopped at cg_max_iterations: on a species web
+/// just built such steps ran away. spn_web_settle steps with
+/// SPN_ENERGY_LIMIT_UNFINISHED. Off (the default), a step keeps its velocity
+/// whole, which an animation wants (a halved move slows the whole web, not
+/// only what went wrong). Steps with contacts are never cut: a prey's push is
+/// work the balance does not see. docs/physics.md, "The energy limit".
+typedef enum spn_energy_limit {
+    SPN_ENERGY_LIMIT_OFF = 0,    ///< steps taken whole (default)
+    SPN_ENERGY_LIMIT_UNFINISHED, ///< only steps whose CG solve stopped short (its cap, or a breakdown)
+    SPN_ENERGY_LIMIT_ALWAYS      ///< every step
+} spn_energy_limit;
+/// SPN_ERR_INVALID for a value outside the enum.
+SPN_API spn_status spn_world_set_energy_limit(spn_world *w, spn_energy_limit limit);
+SPN_API spn_energy_limit spn_world_energy_limit(const spn_world *w);
 
 /* ---- energy and equilibrium ------------------------------------------ */
 

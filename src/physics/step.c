@@ -174,6 +174,7 @@ static void add_step(spn_step_report *total, const spn_step_report *last)
 {
     total->substeps += last->substeps;
     total->halvings += last->halvings;
+    total->cuts += last->cuts;
     total->floored += last->floored;
     total->cg_iterations += last->cg_iterations;
     total->breaks += last->breaks;

@@ -349,6 +349,14 @@ spn_status spn_world_set_solver_tolerance(spn_world *w, double cg_tolerance, int
 }
 void spn_world_set_gravity(spn_world *w, spn_vec3 g) { w->def.gravity = g; }
 void spn_world_set_drag(spn_world *w, double drag) { w->def.drag = drag; }
+spn_status spn_world_set_energy_limit(spn_world *w, spn_energy_limit limit)
+{
+    if (limit != SPN_ENERGY_LIMIT_OFF && limit != SPN_ENERGY_LIMIT_UNFINISHED && limit != SPN_ENERGY_LIMIT_ALWAYS)
+        return spn_error(SPN_ERR_INVALID, "energy limit: off (0), unfinished (1) or always (2), not %d", (int)limit);
+    w->energy_limit = (uint8_t)limit;
+    return SPN_OK;
+}
+spn_energy_limit spn_world_energy_limit(const spn_world *w) { return (spn_energy_limit)w->energy_limit; }
 double spn_world_time(const spn_world *w) { return w->t; }
 void spn_world_set_time(spn_world *w, double t) { w->t = t; }
 uint64_t spn_world_step_count(const spn_world *w) { return w->steps; }
