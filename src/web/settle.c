@@ -5,8 +5,11 @@
  * time from as it was built: a step the integrator can take, air drag added
  * while the web comes to rest (drag changes the path, not the equilibrium: at
  * rest it exerts nothing), until the largest residual force is a small
- * fraction of a mean particle's weight or thread tension and the kinetic
- * energy is negligible.
+ * fraction of a mean particle's weight or thread tension (implicit steps: and
+ * a hundredth of the lightest particle's weight) and the kinetic energy is
+ * negligible. Implicit steps whose solve stops at its cap are held to
+ * creating no energy (spn_world_set_energy_limit), and the cap starts at 100
+ * CG iterations (step_to_rest).
  *
  * Why both (measured 2026-12-05, docs/web-builders.md, "Settling"): the solve
  * takes the Araneus and the physical webs to rest in 0.03 to 0.25 s of CPU
@@ -36,6 +39,15 @@
  * the 6 s its settle took, and the CLI fuzzer's 25 s limit under the
  * sanitizers. */
 #define SETTLE_NEWTON_ROUND 10
+/* CG iterations an implicit settling step may take at first. On the
+ * species webs below 4,096 particles (block Jacobi) nearly every step hit
+ * the default cap of 1,000 (light particles between nearly slack threads),
+ * and that was the settle's cost. With unfinished steps held to creating no
+ * energy, CPU s of `build --species ... --settle` by cap (1,000 / 300 / 100 /
+ * 30; Zen 4): generic seed 3 13.6 / 3.9 / 2.5 / 2.8, Araneus seed 4 1.0 /
+ * 0.8 / 0.4 / 0.7, Zygiella seed 3 7.1 / 1.2 / 0.8 / 1.6, Argiope seed 1
+ * (multigrid) 7.9 / 6.8 / 5.8 / 6.5. */
+#define SETTLE_CG_CAP 100
 
 static double stable_step(const spn_world *w)
 {
@@ -118,6 +130,41 @@ static spn_status solve_rest(spn_world *w, double target, bool *done, int *newto
     return SPN_OK;
 }
 
+/* Implicit steps to rest, one check interval at a time: CG starts at
+ * SETTLE_CG_CAP iterations a step, and once the residual is under `endgame`
+ * (the rest floor) the cap doubles, up to the world's own, after each
+ * interval that has not halved it: near rest the soft modes of nearly slack
+ * threads need the longer solves (Zilla seed 6 crept at 5e-9 N for 25 s with
+ * the cap held at 100). Doubling it on any interval that did not halve the
+ * residual, far from rest too, took generic seed 3 from 2.1 to 6.0 s. */
+static spn_status step_to_rest(spn_world *w, const spn_settle_def *def, int cg_cap, double endgame,
+                               spn_settle_report *report)
+{
+    memset(report, 0, sizeof *report);
+    spn_settle_def sd = *def;
+    const double tolerance = spn_world_get_def(w)->cg_tolerance;
+    int cap = cg_cap < SETTLE_CG_CAP ? cg_cap : SETTLE_CG_CAP;
+    double elapsed = 0, last = INFINITY;
+    for (;;) {
+        sd.max_time = fmin(def->check_interval, def->max_time - elapsed);
+        spn_status st = spn_world_set_solver_tolerance(w, tolerance, cap);
+        spn_settle_report part;
+        if (st == SPN_OK) st = spn_world_settle(w, &sd, &part);
+        if (st != SPN_OK) return st;
+        elapsed += part.time;
+        report->time += part.time;
+        report->steps += part.steps;
+        report->reason = part.reason;
+        report->kinetic = part.kinetic;
+        report->residual = part.residual;
+        report->total_energy = part.total_energy;
+        if (part.reason == SPN_SETTLE_CONVERGED || elapsed >= def->max_time - 1e-9 * def->dt || part.steps == 0)
+            return SPN_OK;
+        if (part.residual < endgame && !(part.residual < 0.5 * last)) cap = cap < cg_cap / 2 ? 2 * cap : cg_cap;
+        last = part.residual;
+    }
+}
+
 spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *report)
 {
     double drag = spn_world_get_def(w)->drag, lightest = INFINITY;
@@ -152,15 +199,36 @@ spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *repo
             return SPN_OK;
         }
     }
+    const bool implicit = spn_world_get_def(w)->integrator == SPN_INTEGRATOR_IMPLICIT;
     spn_settle_def sd = spn_settle_def_default();
     sd.dt = stable_step(w);
     sd.max_time = max_time;
-    sd.max_residual = floor_force;
+    /* Implicit steps held to creating no energy (below) lose kinetic energy
+     * where they are cut, so a web can look at rest while it still creeps:
+     * they settle to the solve's target. At the looser floor alone (every
+     * step held, in a trial) a Zilla and a Zygiella web stopped 80 um from
+     * their rest, at a residual of 1e-8 N. */
+    sd.max_residual = implicit ? fmin(floor_force, 1e-2 * 9.81 * lightest) : floor_force;
     sd.max_kinetic = 1e-9 * lightest * 9.81 * 1e-3 * np;
     sd.check_interval = fmax(50 * sd.dt, 0.02);
     /* About critical for the web's slow modes (a few Hz). */
     spn_world_set_drag(w, fmax(drag, 20.0));
-    spn_status st = spn_world_settle(w, &sd, report);
+    /* A web as built is far from rest, and an implicit step that goes wrong
+     * there (threads going slack within it, CG out of iterations) can create
+     * energy: on Zilla seed 6 the steps stretched capture threads 3,000-fold
+     * and the settle gave up after 30 s with a residual of 666 N. A step
+     * whose solve stopped at its cap is held to creating none; one whose solve
+     * converged is taken whole, as before (holding those too cut most of the
+     * Argiope web's steps 2 to 7 times: seed 1 settled in 15.7 s of CPU, not
+     * 6). So a rough step is safe, and CG stops sooner (step_to_rest). */
+    const spn_energy_limit limit = spn_world_energy_limit(w);
+    const spn_world_def *def = spn_world_get_def(w);
+    const double cg_tolerance = def->cg_tolerance;
+    const int cg_cap = def->cg_max_iterations;
+    spn_status st = spn_world_set_energy_limit(w, SPN_ENERGY_LIMIT_UNFINISHED);
+    if (st == SPN_OK) st = implicit ? step_to_rest(w, &sd, cg_cap, floor_force, report) : spn_world_settle(w, &sd, report);
+    spn_world_set_solver_tolerance(w, cg_tolerance, cg_cap);
+    spn_world_set_energy_limit(w, limit);
     spn_world_set_drag(w, drag);
     report->newton_steps = newton_steps;
     return st;
