@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # spinneret settle: the hand-made chain settles to a statically balanced,
 # symmetric sag; bad options exit 2 naming the option and write nothing; a
-# blow-up exits 1 and clobbers nothing.
+# blow-up exits 1 and clobbers nothing; a species web as built comes to rest
+# under implicit steps held to creating no energy.
 . "$(dirname "$0")/lib/common.sh" "$@"
 WEB=$DATA/io/chain4.json
 
@@ -56,6 +57,7 @@ check_usage --tol "$WEB" -o "$O" --tol nan
 check_usage --max-time "$WEB" -o "$O" --max-time 0
 check_usage --max-kinetic "$WEB" -o "$O" --max-kinetic -5
 check_usage --solver "$WEB" -o "$O" --solver verlet
+check_usage --energy-limit "$WEB" -o "$O" --energy-limit never
 check_usage --output "$WEB"
 check_usage "-o" "$WEB" -o
 check_usage --frob "$WEB" -o "$O" --frob
@@ -73,6 +75,17 @@ echo precious >"$O"
 grep -q 'blew up' "$T/err" && grep -q 'nothing written' "$T/err" || fail "blow-up message: $(cat "$T/err")"
 [ "$(cat "$O")" = precious ] || fail "blow-up clobbered the output"
 [ "$(ls -A "$T/bad")" = out.json ] || fail "blow-up left a temporary file"
+
+# A 5 cm Zygiella web as built, stepped implicitly: its steps are held to
+# creating no energy by default and it comes to rest; with --energy-limit off
+# (the steps as they were before) it is not at rest after 2 s.
+"$SPN" build --species zygiella --size 0.05 -o "$T/zyg.json" 2>/dev/null || fail "build zygiella"
+"$SPN" settle "$T/zyg.json" -o "$T/zyg-rest.json" --solver implicit --dt 0.005 --max-time 2 2>"$T/err" ||
+    fail "zygiella settle exited $?: $(cat "$T/err")"
+grep -q 'converged' "$T/err" || fail "zygiella not at rest with the energy limit: $(cat "$T/err")"
+"$SPN" settle "$T/zyg.json" -o "$T/zyg-off.json" --solver implicit --dt 0.005 --max-time 2 --energy-limit off \
+    2>"$T/err" || fail "zygiella settle (off) exited $?"
+grep -q 'timed out' "$T/err" || fail "zygiella came to rest without the limit (pick another web): $(cat "$T/err")"
 
 # Settling in place works (the output replaces the input atomically).
 cp "$WEB" "$T/inplace.json"
