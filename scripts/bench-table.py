@@ -56,6 +56,11 @@ KNOWN = {
         ("arithmetic_ns", "arithmetic ns"), ("ns_per_spring_step", "floor ns per spring-step")]),
     "bandwidth": ("Memory bandwidth (bench/bench_bandwidth.c, STREAM-style)", [
         ("kernel", "kernel"), ("threads", "threads"), ("gb_per_s", "GB/s")]),
+    "web_settle": ("A built species web brought to rest (`spn_web_settle`, as `build --settle`; "
+                   "bench/bench_web_settle.c, 1 thread)", [
+        ("species", "species"), ("seed", "seed"), ("particles", "particles"), ("how", "how"),
+        ("converged", "at rest"), ("newton_steps", "Newton steps"), ("steps", "implicit steps"),
+        ("simulated_s", "simulated s"), ("residual_n", "residual N"), ("ms", "wall ms"), ("cpu_ms", "CPU ms")]),
 }
 
 

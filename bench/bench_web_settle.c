@@ -1,0 +1,66 @@
+/* bench_web_settle: a built web brought to rest, as `spinneret build ...
+ * --settle` does it (spn_web_settle: the static equilibrium first, implicit
+ * steps where it falls short; docs/web-builders.md, "Settling"). Issue 10's
+ * "taut silk webs at rest": the species webs, silk values, as the CLI builds
+ * them. One JSON line per web: how it came to rest (solved or stepped),
+ * Newton steps, implicit steps and simulated time, the residual, and wall and
+ * CPU time of the settle alone (the build not counted), 1 thread.
+ *
+ * The webs: Araneus seed 3 (solved), Araneus seed 1, generic seed 3,
+ * Zygiella seed 3, Argiope seed 1 and Zilla seed 3 (stepped); --quick takes
+ * the first three. Zilla seed 6 (60 s of CPU) is left out for time. */
+#include "common/bench_common.h"
+
+#include <spinneret/spinneret.h>
+
+#include <stdio.h>
+#include <string.h>
+
+typedef struct web_case {
+    spn_species species;
+    uint64_t seed;
+} web_case;
+
+static int run(web_case c)
+{
+    spn_species_def d = spn_species_def_preset(c.species);
+    d.seed = c.seed;
+    d.materials = spn_web_materials_preset(SPN_MATERIAL_SILK);
+    d.world.threads = 1;
+    spn_world *w = NULL;
+    if (spn_web_build_species(&d, &w) != SPN_OK) {
+        fprintf(stderr, "bench_web_settle: %s\n", spn_last_error());
+        return 1;
+    }
+    spn_world_set_integrator(w, SPN_INTEGRATOR_IMPLICIT); /* as the CLI settles silk */
+    spn_settle_report r;
+    const double wall0 = bench_now(), cpu0 = bench_cpu_now();
+    spn_status st = spn_web_settle(w, 30, &r);
+    const double wall = bench_now() - wall0, cpu = bench_cpu_now() - cpu0;
+    if (st != SPN_OK) {
+        fprintf(stderr, "bench_web_settle: %s\n", spn_last_error());
+        spn_world_destroy(w);
+        return 1;
+    }
+    printf("{\"bench\":\"web_settle\",\"species\":\"%s\",\"seed\":%llu,\"particles\":%u,\"springs\":%u,"
+           "\"threads\":1,\"how\":\"%s\",\"converged\":%s,\"newton_steps\":%d,\"steps\":%llu,\"simulated_s\":%.4g,"
+           "\"residual_n\":%.3g,\"ms\":%.1f,\"cpu_ms\":%.1f,\"load_average\":%.2f}\n",
+           spn_species_name(c.species), (unsigned long long)c.seed, spn_world_particle_count(w),
+           spn_world_spring_count(w), r.steps ? "stepped" : "solved",
+           r.reason == SPN_SETTLE_CONVERGED ? "true" : "false", r.newton_steps, (unsigned long long)r.steps, r.time,
+           r.residual, 1e3 * wall, 1e3 * cpu, bench_load_average());
+    fflush(stdout);
+    spn_world_destroy(w);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    const int quick = argc > 1 && strcmp(argv[1], "--quick") == 0;
+    const web_case cases[] = {{SPN_SPECIES_ARANEUS, 3}, {SPN_SPECIES_ARANEUS, 1}, {SPN_SPECIES_GENERIC, 3},
+                              {SPN_SPECIES_ZYGIELLA, 3}, {SPN_SPECIES_ARGIOPE, 1}, {SPN_SPECIES_ZILLA, 3}};
+    const int n = quick ? 3 : (int)(sizeof cases / sizeof cases[0]);
+    for (int i = 0; i < n; i++)
+        if (run(cases[i])) return 1;
+    return 0;
+}
