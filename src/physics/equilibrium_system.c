@@ -387,13 +387,8 @@ double spn__eq_slack_limit(const spn__eq *e, const double *p, double cap)
 
 double spn__eq_length_energy(const spn__eq *e, uint32_t s, double l0, double l1)
 {
-    double d0 = l0 - e->rest[s], d1 = l1 - e->rest[s];
-    if (e->tonly[s]) {
-        d0 = d0 > 0 ? d0 : 0;
-        d1 = d1 > 0 ? d1 : 0;
-    }
-    /* (d1^2 - d0^2) as a product, so a small move is not lost to cancellation */
-    return 0.5 * e->k[s] * (d1 - d0) * (d1 + d0);
+    const double d0 = l0 - e->rest[s], d1 = l1 - e->rest[s];
+    return spn__spring_energy_change(e->k[s], e->tonly[s], d0, d1, d1 - d0);
 }
 
 static double spring_energy_delta(const spn__eq *e, uint32_t s)

@@ -358,9 +358,10 @@ static void finish(spn_world *w, double h, bool ext, spn__step_result *r)
  * scale in *noise: 1e-12 of the terms summed, and the work of the forces'
  * own round-off (1e-13 of force_round_off_scale, as the CG stop takes it)
  * over the move, which bounds what a step CG left at dv = 0 (the web at
- * rest to round-off) can gain. Each spring's change is taken as a product of length
- * differences (as spn__eq_length_energy does), so a step of a web near rest
- * is not lost against the web's whole energy. The per-particle moves go to
+ * rest to round-off) can gain. Each spring's change is taken as a product
+ * (spn__spring_energy_change) of its length change, found without
+ * cancellation, so a step of a web near rest is not lost against the web's
+ * whole energy. The per-particle moves go to
  * tmp[T_R], free once the solve is done. Summed in block order: the same
  * bits on any thread count. */
 static double step_energy_gain(spn_world *w, double h, double alpha, bool ext, double force_scale, double *noise)
@@ -408,13 +409,8 @@ static double step_energy_gain(spn_world *w, double h, double alpha, bool ext, d
             const double len0 = spn_v3_len(l0), len1 = spn_v3_len(l1), sum_len = len0 + len1;
             /* |l1| - |l0| = (2 l0.d + d.d) / (|l1| + |l0|), without cancellation */
             const double dlen = sum_len > 0 ? (2 * spn_v3_dot(l0, d) + spn_v3_dot(d, d)) / sum_len : 0;
-            double e0 = len0 - sp.rest, e1 = e0 + dlen, de_len = dlen;
-            if (spn__tension_only(sp) && !(e0 > 0 && e1 > 0)) {
-                e0 = e0 > 0 ? e0 : 0;
-                e1 = e1 > 0 ? e1 : 0;
-                de_len = e1 - e0;
-            }
-            const double u = 0.5 * sp.k * de_len * (e1 + e0);
+            const double e0 = len0 - sp.rest;
+            const double u = spn__spring_energy_change(sp.k, spn__tension_only(sp), e0, e0 + dlen, dlen);
             de += u;
             dabs += fabs(u);
         }

@@ -89,6 +89,21 @@ typedef struct spn__spring {
 static inline uint32_t spn__end_b(spn__spring s) { return s.bt & SPN__END_MASK; }
 static inline bool spn__tension_only(spn__spring s) { return (s.bt >> 31) != 0; }
 
+/* A spring's energy change 1/2 k (e1^2 - e0^2) as its extension goes from e0
+ * to e1, as a product so a small move is not lost to cancellation; de is
+ * e1 - e0, taken by the caller as exactly as it can. A tension-only spring
+ * stores nothing while slack. The equilibrium's line search and the implicit
+ * step's energy limit both use it. */
+static inline double spn__spring_energy_change(double k, bool tension_only, double e0, double e1, double de)
+{
+    if (tension_only && !(e0 > 0 && e1 > 0)) {
+        e0 = e0 > 0 ? e0 : 0;
+        e1 = e1 > 0 ? e1 : 0;
+        de = e1 - e0;
+    }
+    return 0.5 * k * de * (e1 + e0);
+}
+
 /* What one force evaluation measured at its state (x, v). */
 typedef struct spn__eval {
     double elastic;     /* sum 1/2 k stretch^2 (intact, non-slack springs) */
