@@ -20,7 +20,8 @@
 
 #include <spinneret/spinneret.h>
 
-#include "physics/world_internal.h" /* spn__lattice_step_bytes */
+#include "physics/lattice_rows.h"    /* lat_gov, spn__lat_gov_pick */
+#include "physics/world_internal.h" /* spn__lattice_step_bytes, spn__lattice_gov_prefer */
 
 /* The standard web with a disturbed state: random velocities (seeded), one
  * free particle pinned mid-web, viscous drag, so damping, slack tension-only
@@ -272,10 +273,10 @@ static spn_world *disturbed_orb32(spn_integrator integ, int threads, uint32_t pa
  * displacements (every 64 steps) inside a call, and a blow-up inside a pass
  * replayed to the same step and message. Single float32 steps come from
  * spn_world_advance only (spn_world_step takes float64 ones), so the
- * reference is the same web at parallel_min 8192: above its 2,001
- * particles, so no passes, with the same bands as at 256 (SPN_BLOCK
- * particles, which both parallel_min / 8 are below), which fix the order of
- * the energy sums. */
+ * reference is the same web at parallel_min 8192 on one thread: above its
+ * 2,001 particles, so no passes, with the same bands as at 256 (SPN_BLOCK
+ * particles: an eighth of either parallel_min and a quarter of the web are
+ * below it), which fix the order of the energy sums. */
 static void test_blocked_passes_float32(void **state)
 {
     (void)state;
@@ -305,7 +306,7 @@ static void test_blocked_passes_float32(void **state)
      * and ends as the unblocked run does, at the same step, with the same
      * message, in the same state */
     spn_world *blk = disturbed_orb32(SPN_INTEGRATOR_SYMPLECTIC, 2, 256);
-    spn_world *ref = disturbed_orb32(SPN_INTEGRATOR_SYMPLECTIC, 2, 8192);
+    spn_world *ref = disturbed_orb32(SPN_INTEGRATOR_SYMPLECTIC, 1, 8192); /* (on two threads it may take passes) */
     const double big = 5e-5; /* (float32 overflows sooner than float64: at step 10) */
     assert_int_equal(spn_world_advance(ref, big, 400), SPN_ERR_UNSTABLE);
     const uint64_t good = spn_world_step_count(ref);
@@ -319,6 +320,125 @@ static void test_blocked_passes_float32(void **state)
     print_message("float32 blow-up at step %llu in both: %s\n", (unsigned long long)good + 1, want);
     spn_world_destroy(blk);
     spn_world_destroy(ref);
+}
+
+/* The thread governor's choices (lattice.c) on made-up timings (ns per
+ * particle and level, a unit 0.1 ms): threads first, then one thread, then
+ * the faster kept; the other tried 2 ms later over up to 8 units and given
+ * up once it cannot win; a unit slowed by chance not switching, a stalled
+ * one switching at once; each choice's wait doubling while its tries lose
+ * (to 4 s) and halving when one wins. */
+static void test_governor_choices(void **state)
+{
+    (void)state;
+    lat_gov g;
+    memset(&g, 0, sizeof g);
+    double t = 100;
+    assert_int_equal(spn__lat_gov_pick(&g, t), 1);
+    spn__lat_gov_record(&g, 2.0, t += 1e-4);
+    assert_int_equal(spn__lat_gov_pick(&g, t), 0);
+    spn__lat_gov_record(&g, 3.0, t += 1e-4);
+    for (int i = 0; i < 5; i++) { /* threads faster: kept, no try within 2 ms */
+        assert_int_equal(spn__lat_gov_pick(&g, t), 1);
+        spn__lat_gov_record(&g, 2.0, t += 1e-4);
+    }
+    assert_int_equal(g.kept, 1);
+    t = g.next;
+    for (int i = 0; i < 6; i++) { /* the try of one thread: 6 x 3 > 8 x 2, lost */
+        assert_int_equal(spn__lat_gov_pick(&g, t), 0);
+        spn__lat_gov_record(&g, 3.0, t += 1e-4);
+    }
+    assert_int_equal(g.try_units, 0);
+    assert_true(g.wait[0] == 4e-3 && g.next == t + 4e-3);
+    assert_int_equal(spn__lat_gov_pick(&g, t), 1);
+    /* a unit ten times slower by chance does not switch; its mean comes back */
+    spn__lat_gov_record(&g, 20.0, t += 1e-3);
+    assert_int_equal(spn__lat_gov_pick(&g, t), 1);
+    for (int i = 0; i < 30; i++) spn__lat_gov_record(&g, 2.0, t += 1e-5);
+    assert_true(g.ns[1] < 2.1);
+    /* the machine gets busy: one stalled unit on threads switches to one,
+     * and threads are tried again 2 ms later */
+    assert_int_equal(spn__lat_gov_pick(&g, t), 1);
+    spn__lat_gov_record(&g, 400.0, t += 1e-4);
+    assert_int_equal(g.kept, 0);
+    assert_true(g.next == t + 2e-3);
+    assert_int_equal(spn__lat_gov_pick(&g, t), 0);
+    spn__lat_gov_record(&g, 3.0, t += 1e-4);
+    /* tries of threads stall and stop at their first unit; their wait
+     * doubles up to 4 s */
+    double wait = g.wait[1];
+    for (int i = 0; i < 20; i++) {
+        assert_int_equal(spn__lat_gov_pick(&g, g.next - 1e-4), 0); /* not yet */
+        t = g.next;
+        assert_int_equal(spn__lat_gov_pick(&g, t), 1);
+        spn__lat_gov_record(&g, 400.0, t += 1e-2);
+        assert_true(g.wait[1] == (2 * wait < 4.0 ? 2 * wait : 4.0));
+        wait = g.wait[1];
+        assert_int_equal(g.try_units, 0);
+        assert_int_equal(spn__lat_gov_pick(&g, t), 0);
+        spn__lat_gov_record(&g, 3.0, t += 1e-4);
+    }
+    assert_true(g.wait[1] == 4.0);
+    /* a try won by chance: threads kept, their wait halved; the stall that
+     * follows sends them back for 2 s, not 2 ms */
+    t = g.next;
+    for (int i = 0; i < 8; i++) {
+        assert_int_equal(spn__lat_gov_pick(&g, t), 1);
+        spn__lat_gov_record(&g, 2.0, t += 1e-4);
+    }
+    assert_int_equal(g.kept, 1);
+    assert_true(g.wait[1] == 2.0);
+    assert_int_equal(spn__lat_gov_pick(&g, t), 1);
+    spn__lat_gov_record(&g, 400.0, t += 1e-2);
+    assert_int_equal(g.kept, 0);
+    assert_true(g.next == t + 2.0);
+    /* the machine quietens: the next try wins, and threads stay */
+    t = g.next;
+    for (int i = 0; i < 8; i++) {
+        assert_int_equal(spn__lat_gov_pick(&g, t), 1);
+        spn__lat_gov_record(&g, 2.0, t += 1e-4);
+    }
+    assert_int_equal(g.kept, 1);
+    assert_true(g.wait[1] == 1.0);
+    for (int i = 0; i < 10; i++) {
+        assert_int_equal(spn__lat_gov_pick(&g, t), 1);
+        spn__lat_gov_record(&g, 2.0, t += 1e-4);
+    }
+}
+
+/* A web between parallel_min / 8 and parallel_min particles on two threads:
+ * the governor's either choice, switched between calls, gives the bits of
+ * one thread, in the state and the energy books; on threads the steps go
+ * in blocked passes, on one thread one by one. */
+static void test_governor_same_bits(void **state)
+{
+    (void)state;
+    const spn_integrator integs[] = {SPN_INTEGRATOR_SYMPLECTIC, SPN_INTEGRATOR_RK4};
+    for (int k = 0; k < 2; k++) {
+        /* 2,001 particles, parallel_min 8,192: threads from 1,024 */
+        spn_world *two = disturbed_orb(integs[k], 40, 50, 2, 8192, true);
+        spn_world *one = disturbed_orb(integs[k], 40, 50, 1, 8192, true);
+        for (int call = 0; call < 6; call++) {
+            const bool threads = call % 2 == 0;
+            assert_true(spn__lattice_gov_prefer(two, threads));
+            assert_int_equal(spn_world_advance(two, 2e-6, 8), SPN_OK);
+#ifdef _OPENMP
+            assert_int_equal(spn_world_last_step(two).blocked, threads ? 8 : 0);
+#endif
+            assert_int_equal(spn_world_advance(one, 2e-6, 8), SPN_OK);
+            assert_int_equal(spn_world_last_step(one).blocked, 0);
+            assert_same_state(two, one);
+            spn_energy e2 = spn_world_energy(two), e1 = spn_world_energy(one);
+            assert_memory_equal(&e2.dissipated, &e1.dissipated, sizeof(double));
+        }
+        /* and as it chooses by itself */
+        assert_int_equal(spn_world_advance(two, 2e-6, 40), SPN_OK);
+        assert_int_equal(spn_world_advance(one, 2e-6, 40), SPN_OK);
+        assert_same_state(two, one);
+        assert_true(fastest(one) > 0.01);
+        spn_world_destroy(two);
+        spn_world_destroy(one);
+    }
 }
 
 /* Changing a spring keeps the lattice in step; breaking one hands over to the
@@ -496,6 +616,8 @@ int main(void)
         cmocka_unit_test(test_blocked_passes),
         cmocka_unit_test(test_rk4_pass_versions),
         cmocka_unit_test(test_blocked_passes_float32),
+        cmocka_unit_test(test_governor_choices),
+        cmocka_unit_test(test_governor_same_bits),
         cmocka_unit_test(test_changes_and_break),
         cmocka_unit_test(test_hand_built_and_breakage),
         cmocka_unit_test(test_not_a_lattice),

@@ -50,7 +50,9 @@ typedef struct spn_world_def {
     int provot_iterations;     ///< Provot passes per step, default 4
     uint64_t seed;             ///< for anything random in the world, default 1
     uint32_t parallel_min;     ///< loops over fewer items than this run on one thread
-                               ///< (waking threads costs more), default 32768
+                               ///< (waking threads costs more), default 32768; a lattice
+                               ///< web's steps inside spn_world_advance from an eighth of it,
+                               ///< on threads or one as timing shows faster (docs/physics-lattice.md)
 } spn_world_def;
 
 SPN_API spn_world_def spn_world_def_default(void);

@@ -50,6 +50,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 /* ---- building ---- */
 
@@ -111,6 +112,7 @@ void spn__lattice_build(spn_world *w)
         if (w->sflags[s] & SPN_SPRING_BROKEN) return;
     spn__lattice *L = calloc(1, sizeof *L);
     if (!L) return;
+    L->gov.t0 = -1;
     const size_t m = (size_t)rings * n;
     L->rings = rings, L->radials = n;
     L->rk = malloc(m * sizeof *L->rk), L->rkd = malloc(m * sizeof *L->rkd), L->rrest = malloc(m * sizeof *L->rrest);
@@ -151,10 +153,16 @@ void spn__lattice_spring_changed(spn_world *w, uint32_t s)
 static bool prepare(spn_world *w, int threads)
 {
     spn__lattice *L = w->lat;
-    /* Bands of an eighth of parallel_min (at least SPN_BLOCK) particles:
-     * enough of them for a static schedule to share out evenly, few enough
-     * that the radials computed twice at their edges cost nothing. */
-    const uint32_t n = L->radials, bsize = w->def.parallel_min / 8 > SPN_BLOCK ? w->def.parallel_min / 8 : SPN_BLOCK;
+    /* Bands of an eighth of parallel_min particles, or of a quarter of the
+     * web where that is less, and at least SPN_BLOCK: on a big web enough
+     * of them for a static schedule to share out evenly, few enough that
+     * the radials computed twice at their edges cost nothing; a web that
+     * takes threads below parallel_min (lattice_threads) is cut into four
+     * (the 5k web: 13, 13, 13 and 11 rows, so two threads get 26 and 24;
+     * bands of an eighth of parallel_min gave it 41 and 9, SPN_BLOCK-sized
+     * ones 11, 11, 11, 11, 6). */
+    const uint32_t n = L->radials, eighth = w->def.parallel_min / 8, quarter = w->np / 4;
+    const uint32_t want = eighth < quarter ? eighth : quarter, bsize = want > SPN_BLOCK ? want : SPN_BLOCK;
     const uint32_t rows = (bsize + n - 1) / n;
     if (L->band_rows != rows) {
         free(L->cut), free(L->partial);
@@ -460,15 +468,148 @@ double spn__lattice_step_bytes(const spn_world *w, int steps, int blocked)
     return (passes * pass + (steps - blocked) * single) / steps;
 }
 
+/* Threads for a lattice step: from an eighth of def.parallel_min particles
+ * (4,096 by default), where the rest of a step goes parallel from
+ * parallel_min. A lattice step is one sweep with no gather pass, so two
+ * threads pay on smaller webs when the machine has a core to spare (inside
+ * spn_world_advance, below): the 5k
+ * web's symplectic step 3.0 -> 1.8 wall ns a spring-step, RK4 14 -> 7.7
+ * (Zen 4, docs/physics-lattice.md, "Threads"). Below parallel_min the
+ * governor (below) decides step by step. The bits do not depend on it (the
+ * trajectory does not depend on the bands, the energy sums on the bands
+ * only). */
+static int lattice_threads(const spn_world *w)
+{
+    /* Below parallel_min only inside a replayable spn_world_advance: a lone
+     * step copies the state in and out around its sweep, and on two threads
+     * took as long as on one (5.5 against 5.3 ns a spring-step, 5k web)
+     * with twice the CPU. */
+    if (w->np < w->def.parallel_min && !w->no_backup) return 1;
+    return spn__threads(w, w->np >= w->def.parallel_min / 8 ? w->def.parallel_min : 0);
+}
+
+/* ---- threads below parallel_min: the governor ----
+ *
+ * A step of the 5k web is 30-60 us of work. Two threads nearly halve it on
+ * a quiet machine, but when other programs keep the cores busy a thread
+ * waits at each barrier for the scheduler to give its partner a core: with
+ * a build running beside it, a third of the runs took 300 ns a spring-step
+ * instead of 3-6 on one thread, and one blocked pass of four steps took
+ * 16 ms instead of 0.12 (docs/physics-lattice.md, "Threads"). A wrong
+ * choice of threads costs a hundred times what a wrong choice of one
+ * thread does, so on a web between parallel_min / 8 and parallel_min
+ * particles each unit of work (a step, or a blocked pass) is timed, and:
+ * - the choice kept has a running mean of its units' cost (an eighth of
+ *   each new unit), and gives way when that exceeds 1.5 times the other's
+ *   last figure: one stalled unit on threads at once, one unit slowed by
+ *   chance (an interrupt) on a quiet machine not;
+ * - the other is tried for LAT_GOV_TRY units, and taken if it was faster
+ *   over all of them; the try stops as lost as soon as its sum exceeds what
+ *   those units cost the kept choice, so on a busy machine a try of
+ *   threads costs one stalled unit;
+ * - each choice is tried again a wait after it was last tried or left,
+ *   from LAT_GOV_MIN_WAIT, doubled by a lost try (to LAT_GOV_MAX_WAIT) and
+ *   halved by a won one. On a busy machine threads are tried every 4 s
+ *   (one stalled pass, 0.4%), and after a try won by chance the stall that
+ *   follows sends them back to near that wait; on a quiet one a few steps
+ *   on one thread are tried as often; threads are back within 4 s of the
+ *   machine quietening, and within a few ms of stalls by chance.
+ * Results are the same bits either way (tests/test_physics_lattice.c). */
+#define LAT_GOV_MIN_WAIT 2e-3
+#define LAT_GOV_MAX_WAIT 4.0
+#define LAT_GOV_TRY 8
+
+int spn__lat_gov_pick(lat_gov *g, double now)
+{
+    if (!(g->ns[1] > 0)) return g->mode = 1; /* first threads, */
+    if (!(g->ns[0] > 0)) return g->mode = 0; /* then one thread */
+    if (!(g->wait[0] > 0)) {
+        g->kept = g->ns[1] < g->ns[0];
+        g->wait[0] = g->wait[1] = LAT_GOV_MIN_WAIT;
+        g->next = now + g->wait[!g->kept];
+    }
+    return g->mode = g->try_units > 0 || now >= g->next ? !g->kept : g->kept;
+}
+
+void spn__lat_gov_record(lat_gov *g, double ns, double now)
+{
+    const int m = g->mode;
+    if (!(g->wait[0] > 0)) { /* the first two units */
+        g->ns[m] = ns;
+        return;
+    }
+    if (m == g->kept) {
+        g->ns[m] += (ns - g->ns[m]) / 8;
+        if (g->ns[m] > 1.5 * g->ns[!m]) g->kept = !m, g->next = now + g->wait[m]; /* given way */
+        return;
+    }
+    g->try_sum += ns;
+    const bool lost = g->try_sum > LAT_GOV_TRY * g->ns[g->kept];
+    if (!lost && ++g->try_units < LAT_GOV_TRY) return;
+    g->ns[m] = g->try_sum / (lost ? g->try_units + 1 : g->try_units);
+    if (lost) {
+        g->wait[m] = g->wait[m] < LAT_GOV_MAX_WAIT / 2 ? 2 * g->wait[m] : LAT_GOV_MAX_WAIT;
+        g->next = now + g->wait[m];
+    } else {
+        g->wait[m] = g->wait[m] > 2 * LAT_GOV_MIN_WAIT ? g->wait[m] / 2 : LAT_GOV_MIN_WAIT;
+        g->kept = m, g->next = now + g->wait[!m];
+    }
+    g->try_sum = 0, g->try_units = 0;
+}
+
+bool spn__lattice_gov_prefer(spn_world *w, bool threads)
+{
+    if (!w->lat) return false;
+    lat_gov *g = &w->lat->gov;
+    g->ns[threads] = 1, g->ns[!threads] = 1e300; /* no unit measures slower than that */
+    g->kept = threads, g->try_sum = 0, g->try_units = 0;
+    g->wait[0] = g->wait[1] = LAT_GOV_MAX_WAIT, g->next = HUGE_VAL, g->t0 = -1;
+    return true;
+}
+
+static double seconds_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* The threads for a unit of work on a web that may take them (threads), as
+ * the governor picks below parallel_min, its timing started. A unit begun
+ * and not ended (a blocked pass declined on one thread, the single step
+ * taken instead) passes its pick on to the next. */
+static int gov_begin(spn_world *w, int threads)
+{
+    lat_gov *g = &w->lat->gov;
+    if (threads < 2 || w->np >= w->def.parallel_min) {
+        g->t0 = -1;
+        return threads;
+    }
+    const double now = seconds_now();
+    if (!(g->t0 >= 0)) spn__lat_gov_pick(g, now);
+    g->t0 = now;
+    return g->mode ? threads : 1;
+}
+
+/* The unit begun by gov_begin done: `levels` steps or RK4 stages. */
+static void gov_end(spn_world *w, uint32_t levels)
+{
+    lat_gov *g = &w->lat->gov;
+    if (!(g->t0 >= 0)) return;
+    const double now = seconds_now();
+    spn__lat_gov_record(g, (now - g->t0) * 1e9 / ((double)w->np * levels), now);
+    g->t0 = -1;
+}
+
 /* Threads for this world's bands, and the bands ready; 0 when the lattice
  * path does not apply. */
 static int ready(spn_world *w)
 {
     if (!applies(w)) return 0;
-    int threads = spn__threads(w, w->np);
+    int threads = lattice_threads(w);
     if (!prepare(w, threads)) return 0;
     if ((uint32_t)threads > w->lat->nbands) threads = (int)w->lat->nbands;
-    return threads < 1 ? 1 : threads;
+    return gov_begin(w, threads < 1 ? 1 : threads);
 }
 
 /* float32 inside spn_world_advance's replayable runs only (and for the step
@@ -488,7 +629,9 @@ bool spn__lattice_explicit(spn_world *w, double dt, bool symplectic, spn__step_r
     }
     if (float32(w)) {
         if (w->lat->live) write_back(w, threads);
-        return spn__lat32_explicit(w, threads, dt, symplectic, r);
+        const bool done = spn__lat32_explicit(w, threads, dt, symplectic, r);
+        if (done) gov_end(w, 1);
+        return done;
     }
     spn__lat32_sync(w);
     lat_args a;
@@ -499,6 +642,7 @@ bool spn__lattice_explicit(spn_world *w, double dt, bool symplectic, spn__step_r
     sweep64(&a, threads, sum);
     lat_explicit_result(sum, dt, w->def.drag, r);
     end(w, threads);
+    gov_end(w, 1);
     return true;
 }
 
@@ -514,7 +658,9 @@ bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r)
     }
     if (float32(w)) {
         if (w->lat->live) write_back(w, threads);
-        return spn__lat32_rk4(w, threads, dt, r);
+        const bool done = spn__lat32_rk4(w, threads, dt, r);
+        if (done) gov_end(w, 4);
+        return done;
     }
     spn__lat32_sync(w);
     lat_args a;
@@ -539,12 +685,14 @@ bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r)
     lat_mv2_carry(&L->mv2, known, sums);
     lat_rk4_result(sums, dt, w->def.drag, r);
     end(w, threads);
+    gov_end(w, 4);
     return true;
 }
 
 /* Steps as blocked passes (lattice_block_t.h), inside a replayable
  * spn_world_advance on a web too big for the caches (from def.parallel_min
- * particles, the size from which a step is spread over threads): up to k
+ * particles, the size from which a step is spread over threads) or on a
+ * smaller one stepped on threads (lattice_threads, the governor): up to k
  * Euler or symplectic steps in one pass, or one RK4 step (its four stages)
  * per pass, in float64 or (spn_world_set_precision) float32. Each step's
  * results into r[]; the count done, 0 when a blocked pass does not apply
@@ -556,13 +704,18 @@ int spn__lattice_block_steps(spn_world *w, double dt, int k, spn__step_result *r
     if (!rk4 && in != SPN_INTEGRATOR_EULER && in != SPN_INTEGRATOR_SYMPLECTIC) return 0;
     if (k > LAT_LEVELS) k = LAT_LEVELS;
     const uint32_t levels = rk4 ? 4 : (uint32_t)k;
-    if (levels < 2 || !w->no_backup || w->np < w->def.parallel_min) return 0;
+    if (levels < 2 || !w->no_backup) return 0;
     const int threads = ready(w);
-    if (!threads || !spn__lattice_block_ready(w->lat, threads, levels)) return 0;
+    /* below parallel_min only on threads: on one the 5k web's pass measured
+     * no faster than single steps (docs/physics-lattice.md) */
+    if (!threads || (threads < 2 && w->np < w->def.parallel_min) || !spn__lattice_block_ready(w->lat, threads, levels))
+        return 0;
     const int mode = rk4 ? MODE_RK4_STAGE : in == SPN_INTEGRATOR_SYMPLECTIC ? MODE_SYMPLECTIC : MODE_EULER;
     if (float32(w)) {
         if (w->lat->live) write_back(w, threads);
-        return spn__lat32_block_steps(w, threads, dt, mode, k, r);
+        const int done = spn__lat32_block_steps(w, threads, dt, mode, k, r);
+        if (done) gov_end(w, levels);
+        return done;
     }
     spn__lat32_sync(w);
     lat_args la[LAT_LEVELS];
@@ -579,6 +732,7 @@ int spn__lattice_block_steps(spn_world *w, double dt, int k, spn__step_result *r
     }
     double sums[LAT_LEVELS][L_NSUMS];
     if (!block_pass64(w->lat, la, rk4, threads, levels, sums)) return 0;
+    gov_end(w, levels);
     if (rk4) {
         lat_mv2_carry(&w->lat->mv2, known, sums);
         lat_rk4_result(sums, dt, w->def.drag, &r[0]);

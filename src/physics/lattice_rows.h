@@ -93,6 +93,29 @@ static inline void lat_mv2_carry(lat_mv2 *m, bool known, double sums[][L_NSUMS])
     m->ok = true;
 }
 
+/* The thread governor of a web that may take threads below parallel_min
+ * (lattice.c, "Threads below parallel_min"): what a unit of work (one step,
+ * or one blocked pass) costs on one thread and on threads, ns per particle
+ * and level, which is kept, and when the other is tried again. */
+typedef struct lat_gov {
+    double ns[2];     /* [0] one thread, [1] threads: the kept choice's running mean
+                       * over its units, the other's from its last try; 0 until measured */
+    double t0;        /* start of the unit being timed [s]; < 0: none */
+    double next;      /* the choice not kept is tried from this time [s] */
+    double wait[2];   /* ... each choice this long after it was last tried or left [s];
+                       * 0 before the first two units */
+    double try_sum;   /* ns of the try under way, summed over its units */
+    int try_units;    /* its units so far (0: no try under way) */
+    int mode;         /* the unit being timed: 0 one thread, 1 threads */
+    int kept;         /* the choice kept between tries */
+} lat_gov;
+
+/* The governor's choice for the unit starting at `now` [s] (0 one thread,
+ * 1 threads), and its record of the unit ending at `now` that took `ns` per
+ * particle and level. */
+int spn__lat_gov_pick(lat_gov *g, double now);
+void spn__lat_gov_record(lat_gov *g, double ns, double now);
+
 struct spn__lattice {
     uint32_t rings, radials;
     double *rk, *rkd, *rrest; /* radial slots: ring * N + i, (ring - 1, i) -> (ring, i) */
@@ -118,6 +141,7 @@ struct spn__lattice {
     double **cols;   /* per thread: COL_COUNT sum columns of col_stride doubles, zero between uses */
     int ncols;
     size_t col_stride;
+    lat_gov gov;
 };
 
 /* What a sweep does with a row once its forces are complete. */

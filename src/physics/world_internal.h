@@ -383,6 +383,10 @@ int spn__lattice_block_steps(spn_world *w, double dt, int k, spn__step_result *r
  * blocked passes (spn_step_report.blocked); a model (lattice.c). 0 when the
  * world's steps do not take the lattice. */
 double spn__lattice_step_bytes(const spn_world *w, int steps, int blocked);
+/* For tests: the lattice's thread governor (lattice.c) set to keep choosing
+ * threads (or one thread) below parallel_min, as if it had measured them
+ * faster; false when the world has no lattice. */
+bool spn__lattice_gov_prefer(spn_world *w, bool threads);
 /* The float32 lattice step (lattice_f32.c) keeps its own state during an
  * spn_world_advance call; w->x and w->v are behind it until this writes them
  * back (a no-op when it holds nothing). Called at the end of every call. */
