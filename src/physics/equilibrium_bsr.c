@@ -219,6 +219,7 @@ static void row_values(const spn__bsr *a, const spn__bsr *b, spn__bsr *c, uint32
  * float64 values or, once rounded, its float32 ones. */
 static void mirror_lower(spn__bsr *c, int threads)
 {
+    (void)threads; /* (used by OpenMP pragmas only) */
 #pragma omp parallel for schedule(static) num_threads(spn__bsr_team(c, threads))
     for (uint32_t i = 0; i < c->rows; i++)
         for (uint32_t q = c->start[i]; q < c->start[i + 1]; q++) {
@@ -863,6 +864,7 @@ __attribute__((target("avx"))) static inline void row_sum_avx(const spn__bsr *a,
 __attribute__((target("avx"))) static void rows_avx(const spn__bsr *a, const double *b, const double *x, double *y,
                                                     bool add, int threads)
 {
+    (void)threads; /* (used by OpenMP pragmas only) */
 #pragma omp parallel for schedule(static) num_threads(spn__bsr_team(a, threads))
     for (uint32_t i = 0; i < a->rows; i++) {
         double s[3], *o = y + 3 * (size_t)i;
@@ -953,6 +955,7 @@ void spn__bsr_gauss_seidel(const spn__bsr *a, const double *dinv, const double *
     /* the other parts' values as they were when the sweep began */
     memcpy(scratch, x, 3 * (size_t)n * sizeof *x);
     const int team = threads < (int)parts ? threads : (int)parts;
+    (void)team; /* (used by an OpenMP pragma only) */
 #pragma omp parallel for schedule(static) num_threads(team)
     for (uint32_t q = 0; q < parts; q++)
         gauss_seidel_part(a, dinv, b, x, scratch, (uint32_t)((uint64_t)n * q / parts),
@@ -1033,6 +1036,7 @@ SPN__KERNEL static void panel_rows(double *f, size_t n, size_t i, size_t j, size
 bool spn__dense_cholesky(double *f, size_t n, int threads)
 {
     const int nt = n < DENSE_PAR_MIN ? 1 : threads;
+    (void)nt; /* (used by OpenMP pragmas only) */
     for (size_t k0 = 0; k0 < n; k0 += 4) {
         const size_t k1 = k0 + 4 <= n ? k0 + 4 : n;
         double d[4];

@@ -240,6 +240,7 @@ static bool strong(const spn__bsr *a, const double *bn, const double *dn, uint32
  * blocks two or three times). */
 static uint32_t aggregate(const spn__bsr *a, uint32_t *agg, double theta, int threads)
 {
+    (void)threads; /* (used by OpenMP pragmas only) */
     const uint32_t n = a->rows, NONE = UINT32_MAX;
     const size_t nnz = a->start[n];
     double *dn = malloc((n ? n : 1) * sizeof *dn), *bn = malloc((nnz ? nnz : 1) * sizeof *bn);

@@ -16,7 +16,9 @@
 
 #define PAR_MIN 32768u
 
+#ifdef _OPENMP /* (used by OpenMP pragmas only) */
 static inline int team(const spn__eq *e) { return e->n < PAR_MIN ? 1 : e->threads; }
+#endif
 
 spn_status spn__precond_setup(spn__precond *pc, const spn__eq *e)
 {

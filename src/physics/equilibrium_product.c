@@ -25,7 +25,9 @@
  * spn__eq_matvec_mg); below, the product is in cache and not bound by them. */
 #define MATVEC32_MIN 32768u
 
+#ifdef _OPENMP /* (used by OpenMP pragmas only) */
 static inline int team(const spn__eq *e, uint32_t items) { return items < PAR_MIN ? 1 : e->threads; }
+#endif
 
 /* The lane layout of the product (see matvec_lanes): slot t of group g holds
  * entry t of each of its rows; a row with fewer entries is padded with a

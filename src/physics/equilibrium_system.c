@@ -36,7 +36,9 @@
 
 #define PAR_MIN 32768u /* below this many items a loop runs on one thread: smaller loops lose more to the fork than they gain */
 
+#ifdef _OPENMP /* (used by OpenMP pragmas only) */
 static inline int team(const spn__eq *e, uint32_t items) { return items < PAR_MIN ? 1 : e->threads; }
+#endif
 
 void spn__eq_free(spn__eq *e)
 {

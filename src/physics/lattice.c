@@ -310,6 +310,7 @@ static const double *inv_mass64(const lat_args *a) { return a->inv_mass; }
 /* The world's state into the lattice's arrays; false when out of memory. */
 static bool load(spn_world *w, int threads)
 {
+    (void)threads; /* (used by OpenMP pragmas only) */
     spn__lattice *L = w->lat;
     const uint32_t np = w->np;
     if (!L->state) {
@@ -334,6 +335,7 @@ static bool load(spn_world *w, int threads)
 
 static void write_back(spn_world *w, int threads)
 {
+    (void)threads; /* (used by OpenMP pragmas only) */
     spn__lattice *L = w->lat;
     const uint32_t np = w->np;
     spn_vec3 *x = w->x, *v = w->v;

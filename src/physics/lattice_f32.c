@@ -203,6 +203,7 @@ static const float *inv_mass32(const a32 *a) { return a->F->inv_mass; }
 /* The reference differences x_a - x_b of every slot, from w->x. */
 static void references(spn_world *w, int threads)
 {
+    (void)threads; /* (used by OpenMP pragmas only) */
     const spn__lattice *L = w->lat;
     spn__lat32 *F = L->f32;
     const uint32_t n = L->radials, rings = L->rings;

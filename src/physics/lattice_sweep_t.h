@@ -94,6 +94,7 @@ SPN__KERNEL static void LK(band_pass)(const LK_ARGS *a, LK_T *ws, double *cols, 
 /* One force evaluation and update over the whole lattice; sums into sum[]. */
 static void LK(sweep)(const LK_ARGS *a, int threads, double *sum)
 {
+    (void)threads; /* (used by OpenMP pragmas only) */
     const spn__lattice *L = a->L;
     const uint32_t nb = L->nbands;
 #pragma omp parallel num_threads(threads)

@@ -191,6 +191,7 @@ bool spn__step_sweep(spn_world *w, double dt, bool symplectic, spn__step_result 
     const uint32_t np = w->np, bsize = w->sweep_block, nblk = (np + bsize - 1) / bsize;
     double *partial = w->partial;
     const int threads = nblk > 1 ? spn__threads(w, np) : 1;
+    (void)threads; /* (used by an OpenMP pragma only) */
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (uint32_t blk = 0; blk < nblk; blk++) crossing_forces(w, blk, partial + (size_t)blk * SPN_NSUMS);
     const sweep_args args = {w->hs, w->a_start, w->mass, w->inv_mass, w->fs, w->x, w->v, w->x0, w->v0, w->facc,
