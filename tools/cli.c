@@ -119,6 +119,13 @@ bool cli_vec3_bounded(const char *cmd, const char *opt, const char *text, double
     return true;
 }
 
+int cli_choice(const char *text, const char *const *names, int count)
+{
+    for (int i = 0; i < count; i++)
+        if (strcmp(text, names[i]) == 0) return i;
+    return -1;
+}
+
 bool cli_size(const char *cmd, const char *opt, const char *text, int max_side, int *w, int *h)
 {
     char *end = NULL;

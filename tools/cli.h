@@ -33,6 +33,9 @@ bool cli_vec3(const char *cmd, const char *opt, const char *text, bool allow_2d,
 #define CLI_MAX_SPEED 1e3 /* velocities of bodies and air [m/s] */
 #define CLI_MAX_FORCE 1e6 /* forces on a particle [N] */
 bool cli_vec3_bounded(const char *cmd, const char *opt, const char *text, double bound, spn_vec3 *out);
+/* The index of `text` among names[0..count), or -1 (the caller says what
+ * the choices are). */
+int cli_choice(const char *text, const char *const *names, int count);
 /* "WxH" with 1 <= W, H <= max_side. */
 bool cli_size(const char *cmd, const char *opt, const char *text, int max_side, int *w, int *h);
 /* Options every subcommand takes, removed from argv before the command sees

@@ -92,11 +92,11 @@ static bool frame_range(const char *arg, spn_anim_def *d)
 static bool wind_model(const char *arg, spn_wind_kind *out)
 {
     static const char *const names[] = {"none", "thesis", "air"};
-    for (int i = 0; i < 3; i++)
-        if (strcmp(arg, names[i]) == 0) {
-            *out = (spn_wind_kind)i;
-            return true;
-        }
+    const int i = cli_choice(arg, names, 3);
+    if (i >= 0) {
+        *out = (spn_wind_kind)i;
+        return true;
+    }
     cli_usage(CMD, "--wind: unknown model '%s' (choose none, thesis or air)", arg);
     return false;
 }

@@ -96,13 +96,12 @@ static int parse_one(int c, const char *arg, void *ctx)
         if (spn_precond_parse(arg, &o->eq.preconditioner) != SPN_OK)
             return cli_usage(CMD, "--preconditioner: %s", spn_last_error()), -1;
         break;
-    case OPT_ENERGY_LIMIT:
-        for (int i = 0; i < 3; i++)
-            if (strcmp(arg, LIMITS[i]) == 0) {
-                o->limit = (spn_energy_limit)i;
-                return 1;
-            }
-        return cli_usage(CMD, "--energy-limit: '%s' is not off, unfinished or always", arg), -1;
+    case OPT_ENERGY_LIMIT: {
+        const int i = cli_choice(arg, LIMITS, 3);
+        if (i < 0) return cli_usage(CMD, "--energy-limit: '%s' is not off, unfinished or always", arg), -1;
+        o->limit = (spn_energy_limit)i;
+        return 1;
+    }
     default: return 0;
     }
     return ok ? 1 : -1;

@@ -38,11 +38,11 @@ static bool camera_kind(const char *cmd, const char *arg, spn_camera_kind *kind)
 static bool colour_by(const char *cmd, const char *arg, spn_colour_by *by)
 {
     static const char *const names[] = {"shade", "kind", "tension", "strain"};
-    for (int i = 0; i < 4; i++)
-        if (strcmp(arg, names[i]) == 0) {
-            *by = (spn_colour_by)i;
-            return true;
-        }
+    const int i = cli_choice(arg, names, 4);
+    if (i >= 0) {
+        *by = (spn_colour_by)i;
+        return true;
+    }
     cli_usage(cmd, "--colour-by: expected tension, strain, kind or shade, got '%s'", arg);
     return false;
 }
