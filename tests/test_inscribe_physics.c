@@ -69,6 +69,56 @@ static void test_inscribed_web_is_settled_and_whole(void **state)
     }
 }
 
+/* The settle after editing solves for the rest state (settle_solve): no
+ * time is stepped, every particle is balanced to a hundredth of the
+ * lightest one's weight, and it is the rest state stepping reaches. */
+static void test_settle_after_editing_is_solved(void **state)
+{
+    (void)state;
+    spn_world *solved = inscribe_orb();
+    spn_world_set_integrator(solved, SPN_INTEGRATOR_IMPLICIT);
+    spn_world *stepped = spn_world_clone(solved);
+    assert_non_null(stepped);
+    spn_target *t = NULL;
+    assert_int_equal(spn_target_create(solved, 600, &t), SPN_OK);
+    spn_text_def td = spn_text_def_default();
+    td.text = "PIG";
+    td.fit = 0.5;
+    assert_int_equal(spn_target_text(t, solved, &td), SPN_OK);
+    spn_inscribe_def d = spn_inscribe_def_default();
+    d.gaps = 5;
+    d.settle_def.max_time = 20;
+    spn_inscribe_report rep;
+    assert_int_equal(spn_inscribe(&solved, t, &d, &rep), SPN_OK);
+    assert_int_equal(rep.after.reason, SPN_SETTLE_CONVERGED);
+    assert_true(rep.after.newton_steps > 0);
+    assert_int_equal(rep.after.steps, 0);
+    double lightest = INFINITY;
+    for (uint32_t i = 0; i < spn_world_particle_count(solved); i++)
+        if (!spn_world_is_fixed(solved, i)) lightest = fmin(lightest, spn_world_mass(solved, i));
+    double target = 1e-2 * 9.81 * lightest;
+    assert_true(target < d.settle_def.max_residual);
+    assert_true(spn_world_max_residual(solved, NULL) <= target);
+    /* Stepped to the same residual: the same edits, the same rest state. */
+    d.settle_solve = false;
+    d.settle_def.max_residual = target;
+    d.settle_def.max_kinetic = 1e-30;
+    spn_inscribe_report rep2;
+    assert_int_equal(spn_inscribe(&stepped, t, &d, &rep2), SPN_OK);
+    assert_int_equal(rep2.after.reason, SPN_SETTLE_CONVERGED);
+    assert_true(rep2.after.steps > 0);
+    assert_int_equal(rep2.removed, rep.removed);
+    assert_int_equal(rep2.added, rep.added);
+    assert_int_equal(spn_world_particle_count(stepped), spn_world_particle_count(solved));
+    double apart = 0;
+    for (uint32_t i = 0; i < spn_world_particle_count(solved); i++)
+        apart = fmax(apart, spn_v3_len(spn_v3_sub(spn_world_position(solved, i), spn_world_position(stepped, i))));
+    assert_true(apart < 1e-7); /* measured 1.6e-9 m */
+    spn_target_destroy(t);
+    spn_world_destroy(stepped);
+    spn_world_destroy(solved);
+}
+
 /* Replace every capture spring by two, through a new particle at its middle. */
 static uint32_t subdivide_capture(spn_world **wp)
 {
@@ -233,6 +283,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_inscribed_web_is_settled_and_whole),
+        cmocka_unit_test(test_settle_after_editing_is_solved),
         cmocka_unit_test(test_subdivided_segments_go_whole),
         cmocka_unit_test(test_compaction_keeps_the_world_settings),
         cmocka_unit_test(test_broken_half_goes_with_its_particle),

@@ -159,9 +159,13 @@ static void print_report(const spn_inscribe_report *r, const spn_inscribe_def *d
             r->removed, d->threshold, r->gaps, spn_emphasis_name(d->emphasis), r->added, r->split);
     fprintf(stderr, "  cleaned %u dangling or unanchored threads, %u particles left without thread\n", r->pruned,
             r->particles_removed);
-    if (d->settle)
-        fprintf(stderr, "  settled: %s after %g s simulated, largest residual %.3g N (tolerance %g)\n",
-                r->after.reason == SPN_SETTLE_CONVERGED ? "converged" : "timed out", r->after.time, r->after.residual,
+    if (d->settle && r->after.reason == SPN_SETTLE_CONVERGED && r->after.steps == 0 && r->after.newton_steps > 0)
+        fprintf(stderr, "  settled: solved for the rest state (%d Newton steps), largest residual %.3g N\n",
+                r->after.newton_steps, r->after.residual);
+    else if (d->settle)
+        fprintf(stderr, "  settled: %s after %g s simulated%s, largest residual %.3g N (tolerance %g)\n",
+                r->after.reason == SPN_SETTLE_CONVERGED ? "converged" : "timed out", r->after.time,
+                r->after.newton_steps > 0 ? " (the rest state's solve fell short)" : "", r->after.residual,
                 d->settle_def.max_residual);
 }
 

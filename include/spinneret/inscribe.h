@@ -101,6 +101,11 @@ typedef struct spn_inscribe_def {
     uint64_t seed;         ///< for fill and gaps, default 1
     bool settle;           ///< settle before scoring and after editing, default true
     spn_settle_def settle_def; ///< default spn_settle_def_default()
+    /// After editing, solve for the rest state first (spn_web_solve_rest, to
+    /// settle_def.max_residual and a hundredth of the lightest particle's
+    /// weight) and step with settle_def only where that falls short; default
+    /// true. The settle before scoring always steps (docs/inscription.md).
+    bool settle_solve;
 } spn_inscribe_def;
 
 SPN_API spn_inscribe_def spn_inscribe_def_default(void);

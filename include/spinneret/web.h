@@ -209,6 +209,17 @@ SPN_API spn_status spn_web_check_anchors(const spn_vec3 *anchors, int count);
 /// not where). At most `max_time` simulated seconds.
 SPN_API spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *report);
 
+/// The static equilibrium of `w` solved for directly (spn_world_equilibrium),
+/// to a largest net force of `target` N on any free particle, in at most
+/// `max_steps` Newton steps: what spn_web_settle does first, for a web that
+/// was edited rather than built (spn_inscribe's settle after editing).
+/// *solved when it reached `target` and the rest state breaks no spring:
+/// the web is then at rest, velocities 0. Otherwise (it fell short, or
+/// something besides springs, gravity and damping acts on the web: a force,
+/// air or collide callback, a collider, a Provot limit) the web is left as
+/// it was. *newton_steps: the steps taken. Errors: out of memory.
+SPN_API spn_status spn_web_solve_rest(spn_world *w, double target, int max_steps, bool *solved, int *newton_steps);
+
 /// The web as it stood when `fraction` (0..1) of its springs, in construction
 /// order, had been laid: a new world holding those springs. The auxiliary
 /// spiral is taken away as the capture spiral passes it (the spider eats it

@@ -91,14 +91,17 @@ static bool would_break(const spn_world *w)
     return false;
 }
 
-/* The static equilibrium at residual `target` [N]: *done when it is reached
- * and breaks no spring (the web then at rest), else the web as it was. Not
- * from where an unfinished solve stopped: on the Argiope web stepping from
- * there had not come to rest after 13 minutes of CPU, against 8 s from the
- * web as built. Only running out of memory is an error. */
-static spn_status solve_rest(spn_world *w, double target, bool *done, int *newton_steps)
+/* The static equilibrium at residual `target` [N], in rounds of Newton
+ * steps, at most `max_steps`; with `give_up`, also stopped after a round
+ * that has not halved the residual. Not from where an unfinished solve
+ * stopped: on the Argiope web stepping from there had not come to rest
+ * after 13 minutes of CPU, against 8 s from the web as built; so an
+ * unfinished solve puts the web back. */
+static spn_status solve_rest(spn_world *w, double target, int max_steps, bool give_up, bool *solved, int *newton_steps)
 {
-    *done = false;
+    *solved = false;
+    *newton_steps = 0;
+    if (!equilibrium_applies(w) || max_steps < 1) return SPN_OK;
     uint32_t np = spn_world_particle_count(w);
     spn_vec3 *x = malloc((np ? np : 1) * sizeof *x), *v = malloc((np ? np : 1) * sizeof *v);
     if (!x || !v) {
@@ -109,27 +112,32 @@ static spn_status solve_rest(spn_world *w, double target, bool *done, int *newto
     spn_equilibrium_def d = spn_equilibrium_def_default();
     d.tolerance = 0;
     d.abs_tolerance = target;
-    d.max_iterations = SETTLE_NEWTON_ROUND;
+    d.max_iterations = give_up && max_steps > SETTLE_NEWTON_ROUND ? SETTLE_NEWTON_ROUND : max_steps;
     spn_equilibrium_report rep;
     spn_status st;
     double last = INFINITY;
-    *newton_steps = 0;
-    for (;;) { /* rounds of SETTLE_NEWTON_ROUND steps, each from where the last stopped */
+    for (;;) { /* rounds, each from where the last stopped */
         st = spn_world_equilibrium(w, &d, &rep);
         *newton_steps += rep.iterations;
-        if (st != SPN_OK || rep.reason != SPN_EQUILIBRIUM_MAX_ITERATIONS) break;
-        if (*newton_steps >= SETTLE_NEWTON_STEPS || !(rep.residual < 0.5 * fmin(last, rep.residual_start))) break;
+        if (st != SPN_OK || rep.reason != SPN_EQUILIBRIUM_MAX_ITERATIONS || *newton_steps >= max_steps) break;
+        if (give_up && !(rep.residual < 0.5 * fmin(last, rep.residual_start))) break;
         last = rep.residual;
+        if (d.max_iterations > max_steps - *newton_steps) d.max_iterations = max_steps - *newton_steps;
     }
     if (st == SPN_ERR_NOMEM) {
         free(x), free(v);
         return st;
     }
-    *done = st == SPN_OK && rep.reason == SPN_EQUILIBRIUM_CONVERGED && !would_break(w);
-    if (!*done)
+    *solved = st == SPN_OK && rep.reason == SPN_EQUILIBRIUM_CONVERGED && !would_break(w);
+    if (!*solved)
         for (uint32_t i = 0; i < np; i++) spn_world_set_position(w, i, x[i]), spn_world_set_velocity(w, i, v[i]);
     free(x), free(v);
     return SPN_OK;
+}
+
+spn_status spn_web_solve_rest(spn_world *w, double target, int max_steps, bool *solved, int *newton_steps)
+{
+    return solve_rest(w, target, max_steps, false, solved, newton_steps);
 }
 
 /* Implicit steps to rest, one check interval (0.25 s) at a time: CG starts
@@ -196,18 +204,17 @@ spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *repo
      * (2e-8 N on the species webs, ten times a glue droplet's weight) it
      * called the generic web at rest with three particles afloat between
      * slack threads, 1 mm above where stepping hangs them. */
-    if (equilibrium_applies(w)) {
-        bool done;
-        spn_status st = solve_rest(w, fmin(floor_force, 1e-2 * 9.81 * lightest), &done, &newton_steps);
-        if (st != SPN_OK) return st;
-        if (done) {
-            memset(report, 0, sizeof *report);
-            report->reason = SPN_SETTLE_CONVERGED;
-            report->residual = spn_world_max_residual(w, NULL);
-            report->total_energy = spn_world_total_energy(w);
-            report->newton_steps = newton_steps;
-            return SPN_OK;
-        }
+    bool solved;
+    spn_status st =
+        solve_rest(w, fmin(floor_force, 1e-2 * 9.81 * lightest), SETTLE_NEWTON_STEPS, true, &solved, &newton_steps);
+    if (st != SPN_OK) return st;
+    if (solved) {
+        memset(report, 0, sizeof *report);
+        report->reason = SPN_SETTLE_CONVERGED;
+        report->residual = spn_world_max_residual(w, NULL);
+        report->total_energy = spn_world_total_energy(w);
+        report->newton_steps = newton_steps;
+        return SPN_OK;
     }
     const bool implicit = spn_world_get_def(w)->integrator == SPN_INTEGRATOR_IMPLICIT;
     spn_settle_def sd = spn_settle_def_default();
@@ -235,7 +242,7 @@ spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *repo
     const spn_world_def *def = spn_world_get_def(w);
     const double cg_tolerance = def->cg_tolerance;
     const int cg_cap = def->cg_max_iterations;
-    spn_status st = spn_world_set_energy_limit(w, SPN_ENERGY_LIMIT_UNFINISHED);
+    st = spn_world_set_energy_limit(w, SPN_ENERGY_LIMIT_UNFINISHED);
     if (st == SPN_OK) st = implicit ? step_to_rest(w, &sd, cg_cap, report) : spn_world_settle(w, &sd, report);
     spn_world_set_solver_tolerance(w, cg_tolerance, cg_cap);
     spn_world_set_energy_limit(w, limit);
