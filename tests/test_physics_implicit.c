@@ -7,7 +7,9 @@
  * And: implicit steps at dt = 1 s bring a loaded taut web to rest down to
  * 1e-12 of its pretension (CG's round-off floor scales as a 2-norm); with
  * the energy limit a step that would create energy is shortened, and one
- * that would not keeps its bits. */
+ * that would not keeps its bits. A settle's own drag (spn_settle_def.drag)
+ * brings a mass on a spring to the same rest sooner and gives the world its
+ * drag back, also after a blow-up. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -314,6 +316,50 @@ static void test_rest_to_round_off(void **state)
     spn_world_destroy(w);
 }
 
+static void test_settle_drag(void **state)
+{
+    (void)state;
+    /* omega = 10 s^-1: drag 20 s^-1 damps it critically, the world's 1 lightly. */
+    uint64_t steps[2];
+    for (int with = 0; with < 2; with++) {
+        spn_world *w = util_mass_on_spring(SPN_INTEGRATOR_SYMPLECTIC, 1, 100, 0, 0.1);
+        spn_world_set_drag(w, 1);
+        spn_settle_def sd = spn_settle_def_default();
+        sd.max_residual = 1e-6;
+        sd.max_kinetic = 1e-12;
+        sd.drag = with ? 20 : 0;
+        spn_settle_report rep;
+        assert_int_equal(spn_world_settle(w, &sd, &rep), SPN_OK);
+        assert_int_equal(rep.reason, SPN_SETTLE_CONVERGED);
+        assert_true(fabs(spn_world_position(w, 1).x - 1) <= 1e-8); /* k x <= 1e-6 N */
+        assert_true(spn_world_get_def(w)->drag == 1);
+        steps[with] = rep.steps;
+        spn_world_destroy(w);
+    }
+    assert_true(steps[1] * 10 < steps[0]);
+    /* Bad drag: refused, nothing stepped. */
+    spn_world *w = util_mass_on_spring(SPN_INTEGRATOR_SYMPLECTIC, 1, 100, 0, 0.1);
+    spn_settle_def sd = spn_settle_def_default();
+    spn_settle_report rep;
+    const double bad[] = {-1, NAN, INFINITY};
+    for (int i = 0; i < 3; i++) {
+        sd.drag = bad[i];
+        assert_int_equal(spn_world_settle(w, &sd, &rep), SPN_ERR_INVALID);
+        assert_non_null(strstr(spn_last_error(), "drag"));
+        assert_int_equal(spn_world_step_count(w), 0);
+    }
+    spn_world_destroy(w);
+    /* A blow-up (explicit Euler, omega dt = 10) still gives the drag back. */
+    w = util_mass_on_spring(SPN_INTEGRATOR_EULER, 1, 100, 0, 0.1);
+    sd = spn_settle_def_default();
+    sd.dt = 1;
+    sd.max_time = 1e4; /* it grows tenfold a step: overflow in about 160 */
+    sd.drag = 5;
+    assert_int_equal(spn_world_settle(w, &sd, &rep), SPN_ERR_UNSTABLE);
+    assert_true(spn_world_get_def(w)->drag == 0);
+    spn_world_destroy(w);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -323,6 +369,7 @@ int main(void)
         cmocka_unit_test(test_rest_to_round_off),
         cmocka_unit_test(test_energy_limit),
         cmocka_unit_test(test_energy_limit_unfinished),
+        cmocka_unit_test(test_settle_drag),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

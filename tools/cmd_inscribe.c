@@ -37,7 +37,9 @@ static void usage(FILE *out)
             "      --dt S             time step [s]; default 1e-3\n"
             "      --tol N            residual force threshold [N]; default 1e-6\n"
             "      --max-time S       simulated time allowed per settle [s]; default 60\n"
+            "      --drag D           air drag [1/s] at least this while settling, [0, 1e6]; default 20\n"
             "      --no-settle        edit the web as it is, without settling\n"
+            "      --no-solve         after editing, step to rest without solving for it first\n"
             "output\n"
             "  -o, --output OUT       the inscribed web file (required; .spnw: binary, else JSON)\n"
             "      --render PNG       also render the result (default render settings)\n"
@@ -71,7 +73,8 @@ static bool add_text(inscribe_options *o, const char *line)
 
 enum {
     OPT_TEXT = 256, OPT_FONT, OPT_FIT, OPT_HEIGHT, OPT_SPACING, OPT_IMAGE, OPT_RASTER, OPT_THRESHOLD, OPT_EMPHASIS,
-    OPT_FILL, OPT_GAPS, OPT_SEED, OPT_SOLVER, OPT_DT, OPT_TOL, OPT_MAX_TIME, OPT_NO_SETTLE, OPT_RENDER, OPT_OVERLAY
+    OPT_FILL, OPT_GAPS, OPT_SEED, OPT_SOLVER, OPT_DT, OPT_TOL, OPT_MAX_TIME, OPT_DRAG, OPT_NO_SETTLE, OPT_NO_SOLVE,
+    OPT_RENDER, OPT_OVERLAY
 };
 
 static bool take_option(int c, const char *arg, inscribe_options *o)
@@ -98,7 +101,9 @@ static bool take_option(int c, const char *arg, inscribe_options *o)
     case OPT_DT: return cli_double(CMD, "--dt", arg, 1e-9, 1, &o->def.settle_def.dt);
     case OPT_TOL: return cli_double(CMD, "--tol", arg, 0, 1e6, &o->def.settle_def.max_residual);
     case OPT_MAX_TIME: return cli_double(CMD, "--max-time", arg, 1e-9, 1e7, &o->def.settle_def.max_time);
+    case OPT_DRAG: return cli_double(CMD, "--drag", arg, 0, 1e6, &o->def.settle_def.drag);
     case OPT_NO_SETTLE: o->def.settle = false; return true;
+    case OPT_NO_SOLVE: o->def.settle_solve = false; return true;
     case OPT_RENDER: o->render = arg; return true;
     case OPT_OVERLAY: o->overlay = arg; return true;
     default: return false;
@@ -120,6 +125,7 @@ static int parse_options(int argc, char **argv, inscribe_options *o)
         {"seed", required_argument, NULL, OPT_SEED}, {"solver", required_argument, NULL, OPT_SOLVER},
         {"dt", required_argument, NULL, OPT_DT}, {"tol", required_argument, NULL, OPT_TOL},
         {"max-time", required_argument, NULL, OPT_MAX_TIME}, {"no-settle", no_argument, NULL, OPT_NO_SETTLE},
+        {"drag", required_argument, NULL, OPT_DRAG},         {"no-solve", no_argument, NULL, OPT_NO_SOLVE},
         {"render", required_argument, NULL, OPT_RENDER}, {"overlay", required_argument, NULL, OPT_OVERLAY},
         {"help", no_argument, NULL, 'h'}, {NULL, 0, NULL, 0}};
     int r = cli_parse_options(CMD, argc, argv, ":o:h", options, usage, parse_one, o);

@@ -39,6 +39,8 @@ static void usage(FILE *out)
             "      --tol N           residual force threshold [N], in [0, 1e6]; default %g\n"
             "      --max-time S      give up after this much simulated time [s], in [1e-9, 1e7]; default %g\n"
             "      --max-kinetic J   kinetic energy threshold [J], in [0, 1e6]; default %g\n"
+            "      --drag D          air drag [1/s] at least this while settling, in [0, 1e6]\n"
+            "                        (the path to rest, not the rest state); default: FILE's\n"
             "      --energy-limit L  implicit: always (default: no step may create energy; its move\n"
             "                        is halved until it does not), unfinished (only a step whose CG\n"
             "                        solve stopped at its cap), or off (steps taken whole)\n"
@@ -64,7 +66,8 @@ enum {
     OPT_REL_TOL,
     OPT_LOAD,
     OPT_PRECOND,
-    OPT_ENERGY_LIMIT
+    OPT_ENERGY_LIMIT,
+    OPT_DRAG
 };
 
 /* --energy-limit names, in spn_energy_limit order. */
@@ -85,6 +88,7 @@ static int parse_one(int c, const char *arg, void *ctx)
         break;
     case OPT_MAX_TIME: ok = cli_double(CMD, "--max-time", arg, 1e-9, 1e7, &o->def.max_time); break;
     case OPT_MAX_KINETIC: ok = cli_double(CMD, "--max-kinetic", arg, 0, 1e6, &o->def.max_kinetic); break;
+    case OPT_DRAG: ok = cli_double(CMD, "--drag", arg, 0, 1e6, &o->def.drag); break;
     case OPT_METHOD:
         if (strcmp(arg, "equilibrium") == 0 || strcmp(arg, "static") == 0) o->equilibrium = true;
         else if (strcmp(arg, "dynamic") == 0) o->equilibrium = false;
@@ -121,6 +125,7 @@ static int parse_options(int argc, char **argv, settle_options *o)
                                             {"load", required_argument, NULL, OPT_LOAD},
                                             {"preconditioner", required_argument, NULL, OPT_PRECOND},
                                             {"energy-limit", required_argument, NULL, OPT_ENERGY_LIMIT},
+                                            {"drag", required_argument, NULL, OPT_DRAG},
                                             {"help", no_argument, NULL, 'h'},
                                             {NULL, 0, NULL, 0}};
     int r = cli_parse_options(CMD, argc, argv, ":o:h", options, usage, parse_one, o);

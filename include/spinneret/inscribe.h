@@ -100,7 +100,7 @@ typedef struct spn_inscribe_def {
     double fill_spacing;   ///< fill: distance between attachments [m]; 0 = capture radius / 80
     uint64_t seed;         ///< for fill and gaps, default 1
     bool settle;           ///< settle before scoring and after editing, default true
-    spn_settle_def settle_def; ///< default spn_settle_def_default()
+    spn_settle_def settle_def; ///< default spn_settle_def_default() with drag SPN_SETTLE_DRAG
     /// After editing, solve for the rest state first (spn_web_solve_rest, to
     /// settle_def.max_residual and a hundredth of the lightest particle's
     /// weight) and step with settle_def only where that falls short; default

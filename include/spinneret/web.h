@@ -196,6 +196,11 @@ SPN_API spn_status spn_web_build_species(const spn_species_def *def, spn_world *
 /// names the anchor by index.
 SPN_API spn_status spn_web_check_anchors(const spn_vec3 *anchors, int count);
 
+/// Air drag [1/s] spn_web_settle and spn_inscribe's settles give a web while
+/// it comes to rest (spn_settle_def.drag): about critical for a web's slow
+/// modes, a few Hz. It changes the path to rest, not the rest state.
+#define SPN_SETTLE_DRAG 20.0
+
 /// Settle a freshly built web, to thresholds relative to the web's own weight
 /// and thread tensions. First the static equilibrium (spn_world_equilibrium:
 /// springs and gravity balanced, velocities 0; no time passes), when nothing
@@ -211,8 +216,11 @@ SPN_API spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_repo
 
 /// The static equilibrium of `w` solved for directly (spn_world_equilibrium),
 /// to a largest net force of `target` N on any free particle, in at most
-/// `max_steps` Newton steps: what spn_web_settle does first, for a web that
-/// was edited rather than built (spn_inscribe's settle after editing).
+/// `max_steps` Newton steps, in rounds of 10 and given up sooner when a round
+/// does not halve the residual (where it converges it does; where it crawls,
+/// on light particles between slack threads, more steps seldom help): what
+/// spn_web_settle does first (50 steps), for a web that was edited rather
+/// than built (spn_inscribe's settle after editing).
 /// *solved when it reached `target` and the rest state breaks no spring:
 /// the web is then at rest, velocities 0. Otherwise (it fell short, or
 /// something besides springs, gravity and damping acts on the web: a force,

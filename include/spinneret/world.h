@@ -405,6 +405,10 @@ typedef struct spn_settle_def {
     double max_time;       ///< give up after this much simulated time [s], default 60
     double min_time;       ///< do not test before this time [s], default 0
     double check_interval; ///< simulated seconds between tests, default 10*dt
+    /// Air drag [1/s] the world has at least while settling, its own restored
+    /// after: it changes the path to rest and how long it takes, not the rest
+    /// state. Default 0 (the world's own drag).
+    double drag;
 } spn_settle_def;
 
 SPN_API spn_settle_def spn_settle_def_default(void);

@@ -39,6 +39,7 @@ spn_settle_def spn_settle_def_default(void)
     d.max_time = 60;
     d.min_time = 0;
     d.check_interval = 0;
+    d.drag = 0;
     return d;
 }
 
@@ -51,8 +52,12 @@ spn_status spn_world_settle(spn_world *w, const spn_settle_def *def, spn_settle_
         return spn_error(SPN_ERR_INVALID, "settle: max_time must be finite and not negative, not %g", d.max_time);
     if (!(d.max_kinetic >= 0) || !(d.max_residual >= 0))
         return spn_error(SPN_ERR_INVALID, "settle: max_kinetic and max_residual must not be negative");
+    if (!(d.drag >= 0) || !isfinite(d.drag))
+        return spn_error(SPN_ERR_INVALID, "settle: drag must be finite and not negative, not %g", d.drag);
     spn_status st = spn_world_compile(w);
     if (st != SPN_OK) return st;
+    const double drag = w->def.drag;
+    if (d.drag > drag) w->def.drag = d.drag;
     double interval = d.check_interval > 0 ? d.check_interval : 10 * d.dt;
     double t0 = w->t, next_check = t0 + d.min_time;
     uint64_t steps = 0;
@@ -67,9 +72,11 @@ spn_status spn_world_settle(spn_world *w, const spn_settle_def *def, spn_settle_
         }
         if (w->t - t0 >= d.max_time) break;
         st = spn_world_step(w, d.dt);
-        if (st != SPN_OK) return st;
+        if (st != SPN_OK) break;
         steps++;
     }
+    w->def.drag = drag;
+    if (st != SPN_OK) return st;
     report->time = w->t - t0;
     report->steps = steps;
     report->kinetic = spn__kinetic_energy(w, w->v);

@@ -91,13 +91,12 @@ static bool would_break(const spn_world *w)
     return false;
 }
 
-/* The static equilibrium at residual `target` [N], in rounds of Newton
- * steps, at most `max_steps`; with `give_up`, also stopped after a round
- * that has not halved the residual. Not from where an unfinished solve
- * stopped: on the Argiope web stepping from there had not come to rest
- * after 13 minutes of CPU, against 8 s from the web as built; so an
+/* The static equilibrium, in rounds of SETTLE_NEWTON_ROUND steps given up
+ * after one that has not halved the residual. Not from where an unfinished
+ * solve stopped: on the Argiope web stepping from there had not come to
+ * rest after 13 minutes of CPU, against 8 s from the web as built; so an
  * unfinished solve puts the web back. */
-static spn_status solve_rest(spn_world *w, double target, int max_steps, bool give_up, bool *solved, int *newton_steps)
+spn_status spn_web_solve_rest(spn_world *w, double target, int max_steps, bool *solved, int *newton_steps)
 {
     *solved = false;
     *newton_steps = 0;
@@ -112,7 +111,7 @@ static spn_status solve_rest(spn_world *w, double target, int max_steps, bool gi
     spn_equilibrium_def d = spn_equilibrium_def_default();
     d.tolerance = 0;
     d.abs_tolerance = target;
-    d.max_iterations = give_up && max_steps > SETTLE_NEWTON_ROUND ? SETTLE_NEWTON_ROUND : max_steps;
+    d.max_iterations = max_steps < SETTLE_NEWTON_ROUND ? max_steps : SETTLE_NEWTON_ROUND;
     spn_equilibrium_report rep;
     spn_status st;
     double last = INFINITY;
@@ -120,7 +119,7 @@ static spn_status solve_rest(spn_world *w, double target, int max_steps, bool gi
         st = spn_world_equilibrium(w, &d, &rep);
         *newton_steps += rep.iterations;
         if (st != SPN_OK || rep.reason != SPN_EQUILIBRIUM_MAX_ITERATIONS || *newton_steps >= max_steps) break;
-        if (give_up && !(rep.residual < 0.5 * fmin(last, rep.residual_start))) break;
+        if (!(rep.residual < 0.5 * fmin(last, rep.residual_start))) break;
         last = rep.residual;
         if (d.max_iterations > max_steps - *newton_steps) d.max_iterations = max_steps - *newton_steps;
     }
@@ -133,11 +132,6 @@ static spn_status solve_rest(spn_world *w, double target, int max_steps, bool gi
         for (uint32_t i = 0; i < np; i++) spn_world_set_position(w, i, x[i]), spn_world_set_velocity(w, i, v[i]);
     free(x), free(v);
     return SPN_OK;
-}
-
-spn_status spn_web_solve_rest(spn_world *w, double target, int max_steps, bool *solved, int *newton_steps)
-{
-    return solve_rest(w, target, max_steps, false, solved, newton_steps);
 }
 
 /* Implicit steps to rest, one check interval (0.25 s) at a time: CG starts
@@ -185,7 +179,7 @@ static spn_status step_to_rest(spn_world *w, const spn_settle_def *def, int cg_c
 
 spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *report)
 {
-    double drag = spn_world_get_def(w)->drag, lightest = INFINITY;
+    double lightest = INFINITY;
     uint32_t np = spn_world_particle_count(w);
     for (uint32_t i = 0; i < np; i++)
         if (!spn_world_is_fixed(w, i)) lightest = fmin(lightest, spn_world_mass(w, i));
@@ -206,7 +200,7 @@ spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *repo
      * slack threads, 1 mm above where stepping hangs them. */
     bool solved;
     spn_status st =
-        solve_rest(w, fmin(floor_force, 1e-2 * 9.81 * lightest), SETTLE_NEWTON_STEPS, true, &solved, &newton_steps);
+        spn_web_solve_rest(w, fmin(floor_force, 1e-2 * 9.81 * lightest), SETTLE_NEWTON_STEPS, &solved, &newton_steps);
     if (st != SPN_OK) return st;
     if (solved) {
         memset(report, 0, sizeof *report);
@@ -229,7 +223,7 @@ spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *repo
     sd.max_kinetic = 1e-9 * lightest * 9.81 * 1e-3 * np;
     sd.check_interval = fmax(50 * sd.dt, 0.02);
     /* About critical for the web's slow modes (a few Hz). */
-    spn_world_set_drag(w, fmax(drag, 20.0));
+    sd.drag = SPN_SETTLE_DRAG;
     /* A web as built is far from rest, and an implicit step that goes wrong
      * there (threads going slack within it, CG out of iterations) can create
      * energy: on Zilla seed 6 the steps stretched capture threads 3,000-fold
@@ -246,7 +240,6 @@ spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *repo
     if (st == SPN_OK) st = implicit ? step_to_rest(w, &sd, cg_cap, report) : spn_world_settle(w, &sd, report);
     spn_world_set_solver_tolerance(w, cg_tolerance, cg_cap);
     spn_world_set_energy_limit(w, limit);
-    spn_world_set_drag(w, drag);
     report->newton_steps = newton_steps;
     return st;
 }
