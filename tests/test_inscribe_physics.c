@@ -119,6 +119,41 @@ static void test_settle_after_editing_is_solved(void **state)
     spn_world_destroy(solved);
 }
 
+/* The standard web stepped symplectically at the default 1 ms blows up (its
+ * stable step is far shorter): such a web settles implicitly and keeps its
+ * integrator. At a step it can take, it steps as it is. */
+static void test_too_stiff_settles_implicitly(void **state)
+{
+    (void)state;
+    for (int stable = 0; stable < 2; stable++) {
+        spn_world *w = inscribe_orb();
+        spn_target *t = NULL;
+        assert_int_equal(spn_target_create(w, 600, &t), SPN_OK);
+        spn_text_def td = spn_text_def_default();
+        td.text = "PIG";
+        td.fit = 0.5;
+        assert_int_equal(spn_target_text(t, w, &td), SPN_OK);
+        spn_inscribe_def d = spn_inscribe_def_default();
+        d.emphasis = SPN_EMPHASIS_FILL;
+        d.settle_solve = false;
+        double reach = SPN_STABLE_REACH * spn_world_stable_step(w, 0);
+        assert_true(reach < d.settle_def.dt);
+        if (stable) d.settle_def.dt = 0.5 * reach;
+        spn_inscribe_report rep;
+        assert_int_equal(spn_inscribe(&w, t, &d, &rep), SPN_OK);
+        assert_int_equal(spn_world_get_def(w)->integrator, SPN_INTEGRATOR_SYMPLECTIC);
+        assert_int_equal(rep.implicit_before, !stable);
+        assert_true(rep.before.steps > 0);
+        /* The fill's short threads are stiffer: after editing it steps implicitly either way. */
+        assert_true(rep.implicit_after);
+        assert_int_equal(rep.after.reason, SPN_SETTLE_CONVERGED);
+        assert_true(spn_world_max_residual(w, NULL) <= d.settle_def.max_residual);
+        check_hangs_whole(w);
+        spn_target_destroy(t);
+        spn_world_destroy(w);
+    }
+}
+
 /* Replace every capture spring by two, through a new particle at its middle. */
 static uint32_t subdivide_capture(spn_world **wp)
 {
@@ -284,6 +319,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_inscribed_web_is_settled_and_whole),
         cmocka_unit_test(test_settle_after_editing_is_solved),
+        cmocka_unit_test(test_too_stiff_settles_implicitly),
         cmocka_unit_test(test_subdivided_segments_go_whole),
         cmocka_unit_test(test_compaction_keeps_the_world_settings),
         cmocka_unit_test(test_broken_half_goes_with_its_particle),

@@ -120,6 +120,10 @@ typedef struct spn_inscribe_report {
     uint32_t particles_removed; ///< particles left with no thread, taken out
     int score_histogram[11];    ///< segments per score (index 1..10)
     spn_settle_report before, after;
+    /// The settle stepped with the implicit integrator: the web's own explicit
+    /// one could not take settle_def.dt (spn_world_stable_step); the web keeps
+    /// its integrator. False when the settle took no step.
+    bool implicit_before, implicit_after;
 } spn_inscribe_report;
 
 /// Score every capture segment against the target (thesis fig 6.9, our

@@ -301,14 +301,31 @@ static spn_status solve_rest(spn_world *w, const spn_inscribe_def *d, spn_settle
     return SPN_OK;
 }
 
-static spn_status settle(spn_world *w, const spn_inscribe_def *d, bool after, spn_settle_report *rep)
+/* Whether the web's explicit integrator cannot take the settle's step: its
+ * stiffest threads would blow it up (the standard orb web at the default
+ * 1 ms, symplectic: at the second step; README's physical web once filled,
+ * at the 84th). Such a web settles with the implicit integrator. */
+static bool too_stiff(const spn_world *w, double dt)
+{
+    spn_integrator in = spn_world_get_def(w)->integrator;
+    if (in != SPN_INTEGRATOR_EULER && in != SPN_INTEGRATOR_SYMPLECTIC && in != SPN_INTEGRATOR_RK4) return false;
+    double reach = in == SPN_INTEGRATOR_RK4 ? SPN_STABLE_REACH_RK4 : SPN_STABLE_REACH;
+    return dt > reach * spn_world_stable_step(w, 0);
+}
+
+static spn_status settle(spn_world *w, const spn_inscribe_def *d, bool after, spn_settle_report *rep, bool *implicit)
 {
     if (!d->settle) return SPN_OK;
     bool solved = false;
     int newton_steps = 0;
     spn_status st = after && d->settle_solve ? solve_rest(w, d, rep, &solved, &newton_steps) : SPN_OK;
     if (st == SPN_OK && !solved) {
+        const spn_integrator own = spn_world_get_def(w)->integrator;
+        *implicit = too_stiff(w, d->settle_def.dt);
+        if (*implicit) spn_world_set_integrator(w, SPN_INTEGRATOR_IMPLICIT);
         st = spn_world_settle(w, &d->settle_def, rep);
+        spn_world_set_integrator(w, own);
+        *implicit = *implicit && rep->steps > 0; /* a web at rest already took no step */
         rep->newton_steps = newton_steps; /* those the solve took before it fell short */
     }
     if (st != SPN_OK) return st;
@@ -382,7 +399,7 @@ spn_status spn_inscribe(spn_world **wp, const spn_target *t, const spn_inscribe_
     if (!w) return spn_error(SPN_ERR_NOMEM, "out of memory");
     spn__material m = spn__capture_material(w);
     bool *remove = NULL;
-    st = settle(w, &d, false, &rep.before);
+    st = settle(w, &d, false, &rep.before, &rep.implicit_before);
     if (st == SPN_OK) st = edit_segments(w, t, &d, &m, &remove, &rep);
     if (st == SPN_OK) st = spn__clean(w, remove, &rep.pruned, &rep.particles_removed);
     free(remove);
@@ -391,7 +408,7 @@ spn_status spn_inscribe(spn_world **wp, const spn_target *t, const spn_inscribe_
         st = spn__fill(w, t, &m, spacing, d.seed, &rep.added, &rep.split);
         if (st == SPN_OK) st = spn__clean(w, NULL, &rep.pruned, &rep.particles_removed);
     }
-    if (st == SPN_OK) st = settle(w, &d, true, &rep.after);
+    if (st == SPN_OK) st = settle(w, &d, true, &rep.after, &rep.implicit_after);
     if (st != SPN_OK) {
         spn_world_destroy(w);
         return st;
