@@ -39,6 +39,18 @@ static void check_hangs_whole(const spn_world *w)
     free(label), free(deg);
 }
 
+/* "PIG" on a quarter of the web's area: fewer fill threads, a quicker test. */
+static spn_target *pig(const spn_world *w)
+{
+    spn_target *t = NULL;
+    assert_int_equal(spn_target_create(w, 600, &t), SPN_OK);
+    spn_text_def td = spn_text_def_default();
+    td.text = "PIG";
+    td.fit = 0.5;
+    assert_int_equal(spn_target_text(t, w, &td), SPN_OK);
+    return t;
+}
+
 static void test_inscribed_web_is_settled_and_whole(void **state)
 {
     (void)state;
@@ -46,12 +58,7 @@ static void test_inscribed_web_is_settled_and_whole(void **state)
     const spn_emphasis modes[] = {SPN_EMPHASIS_FILL, SPN_EMPHASIS_OUTLINE};
     for (int m = 0; m < 2; m++) {
         spn_world *w = inscribe_orb();
-        spn_target *t = NULL;
-        assert_int_equal(spn_target_create(w, 600, &t), SPN_OK);
-        spn_text_def td = spn_text_def_default();
-        td.text = "PIG";
-        td.fit = 0.5; /* a quarter of the area: fewer fill threads, a quicker test */
-        assert_int_equal(spn_target_text(t, w, &td), SPN_OK);
+        spn_target *t = pig(w);
         spn_inscribe_def d = spn_inscribe_def_default();
         d.emphasis = modes[m];
         d.gaps = 5;
@@ -79,12 +86,7 @@ static void test_settle_after_editing_is_solved(void **state)
     spn_world_set_integrator(solved, SPN_INTEGRATOR_IMPLICIT);
     spn_world *stepped = spn_world_clone(solved);
     assert_non_null(stepped);
-    spn_target *t = NULL;
-    assert_int_equal(spn_target_create(solved, 600, &t), SPN_OK);
-    spn_text_def td = spn_text_def_default();
-    td.text = "PIG";
-    td.fit = 0.5;
-    assert_int_equal(spn_target_text(t, solved, &td), SPN_OK);
+    spn_target *t = pig(solved);
     spn_inscribe_def d = spn_inscribe_def_default();
     d.gaps = 5;
     d.settle_def.max_time = 20;
@@ -127,12 +129,7 @@ static void test_too_stiff_settles_implicitly(void **state)
     (void)state;
     for (int stable = 0; stable < 2; stable++) {
         spn_world *w = inscribe_orb();
-        spn_target *t = NULL;
-        assert_int_equal(spn_target_create(w, 600, &t), SPN_OK);
-        spn_text_def td = spn_text_def_default();
-        td.text = "PIG";
-        td.fit = 0.5;
-        assert_int_equal(spn_target_text(t, w, &td), SPN_OK);
+        spn_target *t = pig(w);
         spn_inscribe_def d = spn_inscribe_def_default();
         d.emphasis = SPN_EMPHASIS_FILL;
         d.settle_solve = false;
