@@ -61,6 +61,12 @@ KNOWN = {
         ("species", "species"), ("seed", "seed"), ("particles", "particles"), ("how", "how"),
         ("converged", "at rest"), ("newton_steps", "Newton steps"), ("steps", "implicit steps"),
         ("simulated_s", "simulated s"), ("residual_n", "residual N"), ("ms", "wall ms"), ("cpu_ms", "CPU ms")]),
+    "inscribe": ("\"PIG\" written into README's physical web (`spinneret inscribe --solver implicit`: the rest "
+                 "state solved for after editing, stepped where that falls short; bench/bench_inscribe.c, 1 thread, "
+                 "the settle after editing)", [
+        ("emphasis", "emphasis"), ("settle", "settle"), ("particles", "particles"), ("how", "how"),
+        ("converged", "at rest"), ("newton_steps", "Newton steps"), ("steps", "implicit steps"),
+        ("simulated_s", "simulated s"), ("residual_n", "residual N"), ("ms", "wall ms"), ("cpu_ms", "CPU ms")]),
 }
 
 
