@@ -66,9 +66,9 @@ static int run(const spn_world *web, spn_emphasis emphasis, int before)
            "\"steps\":%llu,\"simulated_s\":%.4g,\"residual_n\":%.3g,\"ms\":%.1f,\"cpu_ms\":%.1f,"
            "\"load_average\":%.2f}\n",
            spn_emphasis_name(emphasis), before ? "stepped, own drag" : "default", spn_world_particle_count(w),
-           spn_world_spring_count(w), a->steps ? "stepped" : "solved", a->reason == SPN_SETTLE_CONVERGED ? "true" : "false",
-           a->newton_steps, (unsigned long long)a->steps, a->time, a->residual, 1e3 * wall, 1e3 * cpu,
-           bench_load_average());
+           spn_world_spring_count(w), a->steps ? "stepped" : "solved",
+           a->reason == SPN_SETTLE_CONVERGED ? "true" : "false", a->newton_steps, (unsigned long long)a->steps, a->time,
+           a->residual, 1e3 * wall, 1e3 * cpu, bench_load_average());
     fflush(stdout);
     spn_target_destroy(t);
     spn_world_destroy(w);
@@ -79,12 +79,12 @@ int main(int argc, char **argv)
 {
     const int quick = argc > 1 && strcmp(argv[1], "--quick") == 0;
     const int before = argc > 1 && strcmp(argv[1], "--before") == 0;
-    const spn_emphasis modes[] = {SPN_EMPHASIS_NONE, SPN_EMPHASIS_CROSSHATCH, SPN_EMPHASIS_OUTLINE,
-                                  SPN_EMPHASIS_FILL};
+    const spn_emphasis modes[] = {SPN_EMPHASIS_NONE, SPN_EMPHASIS_CROSSHATCH, SPN_EMPHASIS_OUTLINE, SPN_EMPHASIS_FILL};
     spn_world *web = physical_web();
     if (!web) return 1;
     int failed = 0;
-    for (int i = 0; i < (quick ? 2 : 4) && !failed; i++) failed = run(web, modes[i], before);
+    for (int i = 0; i < (quick ? 2 : 4) && !failed; i++)
+        failed = run(web, modes[i], before);
     spn_world_destroy(web);
     return failed;
 }

@@ -166,7 +166,9 @@ static void print_report(const spn_inscribe_report *r, const spn_inscribe_def *d
     fprintf(stderr, "  cleaned %u dangling or unanchored threads, %u particles left without thread\n", r->pruned,
             r->particles_removed);
     if (r->implicit_before || r->implicit_after)
-        fprintf(stderr, "  stepped implicitly (%s%s%s): the web's own solver cannot take steps of %g s on its stiffest threads\n",
+        fprintf(stderr,
+                "  stepped implicitly (%s%s%s): the web's own solver cannot take steps of %g s on its stiffest "
+                "threads\n",
                 r->implicit_before ? "before scoring" : "", r->implicit_before && r->implicit_after ? " and " : "",
                 r->implicit_after ? "after editing" : "", d->settle_def.dt);
     if (d->settle && r->after.reason == SPN_SETTLE_CONVERGED && r->after.steps == 0 && r->after.newton_steps > 0)
