@@ -110,18 +110,19 @@ static void test_solved_rest_thesis_threads(void **state)
 /* A small generic species web, whose light particles between nearly slack
  * threads the solve does not balance (its residual stalls): the web is
  * stepped from as it was built, bit for bit what stepping alone gives. (If
- * the solver learns to settle this web, pick one it does not.) */
+ * the solver learns to settle this web, pick one it does not; the 6 cm web
+ * used until the thirty-third session's mooring threads is now solved.) */
 static void test_unfinished_solve_steps_from_built(void **state)
 {
     (void)state;
-    spn_world *w = species_web(SPN_SPECIES_GENERIC, 0.06), *alone = spn_world_clone(w);
+    spn_world *w = species_web(SPN_SPECIES_GENERIC, 0.08), *alone = spn_world_clone(w);
     spn_world_set_force_callback(alone, no_force, NULL);
     spn_settle_report a, b;
     assert_int_equal(spn_web_settle(w, 3, &a), SPN_OK);
     assert_int_equal(spn_web_settle(alone, 3, &b), SPN_OK);
     print_message("Newton steps %d, then %.3g s stepped (%llu steps); alone %.3g s\n", a.newton_steps, a.time,
                   (unsigned long long)a.steps, b.time);
-    /* its residual stops halving after 30 steps: the rounds of 10 give up
+    /* its residual stops halving after 20 steps: the rounds of 10 give up
      * before the cap of 50 (c9e311e; with one run of 50 it took all 50) */
     assert_true(a.newton_steps >= 10 && a.newton_steps < 50 && a.newton_steps % 10 == 0);
     assert_int_equal(b.newton_steps, 0);
@@ -132,14 +133,19 @@ static void test_unfinished_solve_steps_from_built(void **state)
     spn_world_destroy(alone);
 }
 
-/* A 5 cm Zygiella web: the solve falls short, and until the settle held its
- * implicit steps to creating no energy (spn_world_set_energy_limit) they went
- * wrong on it (CG out of iterations, threads going slack within a step) and
- * it did not come to rest in 30 s (nor 6 cm, nor Zilla seeds 4 and 6). */
+/* A 5 cm Zygiella web as built before the thirty-third session's mooring
+ * threads (tests/data/io/zygiella-5cm-thin-moorings.json: its radii keep
+ * little of their pretension at rest): the solve falls short, and until the
+ * settle held its implicit steps to creating no energy
+ * (spn_world_set_energy_limit) they went wrong on it (CG out of iterations,
+ * threads going slack within a step) and it did not come to rest in 30 s
+ * (nor 6 cm, nor Zilla seeds 4 and 6). */
 static void test_zygiella_comes_to_rest(void **state)
 {
     (void)state;
-    spn_world *w = species_web(SPN_SPECIES_ZYGIELLA, 0.05);
+    spn_world *w = NULL;
+    assert_int_equal(spn_web_load(SPN_TEST_DATA "/io/zygiella-5cm-thin-moorings.json", &w), SPN_OK);
+    spn_world_set_integrator(w, SPN_INTEGRATOR_IMPLICIT);
     spn_settle_report r;
     assert_int_equal(spn_web_settle(w, 30, &r), SPN_OK);
     double strain = 0;

@@ -200,6 +200,17 @@ spn_status spn__layout_weave(const spn__layout *l, spn__weaver *wv, double segme
                              const double prestrain[SPN_WEB_KINDS], bool keep_aux)
 {
     if (l->failed) return wv->st = spn_error(SPN_ERR_NOMEM, "out of memory");
+    /* Mooring threads are laid of several strands (Wirth & Barth 1992: they
+     * carry the web's highest tensions). As one strand of the anchor
+     * material (silk: 5 um) they let the frame's corners in until the radii
+     * kept a tenth or less of their pretension, and the settle crawled on
+     * the near-slack hub (docs/web-builders.md, "Settling": Zilla seed 6 in
+     * 47 s of CPU, its hub threads at a strain of 6e-9; with four strands
+     * and the mooring prestrain of spn__web_prestrains, 0.65 s). */
+    spn_thread_material *mooring = &wv->mat.kind[SPN_THREAD_ANCHOR];
+    mooring->ea *= SPN__MOORING_STRANDS;
+    mooring->linear_density *= SPN__MOORING_STRANDS;
+    mooring->diameter *= sqrt(SPN__MOORING_STRANDS);
     /* Points become particles only when a line uses them. */
     if (l->nl == 0) return wv->st;
     uint32_t *pid = malloc((l->np ? l->np : 1) * sizeof *pid);
@@ -330,7 +341,10 @@ void spn__web_prestrains(double radii, double capture, double pre[SPN_WEB_KINDS]
     /* Frame and mooring threads carry several times the radii's tension
      * (Wirth & Barth 1992, forces in the orb web of Araneus diadematus); laid
      * with the radii's strain, the frame would have to stretch far before the
-     * web could balance, and a stiff-silk solver would crawl there. */
+     * web could balance, and a stiff-silk solver would crawl there. The
+     * mooring threads hold the frame's corners out against the radii: laid
+     * at 5 times the radii's strain they let the corners in until the radii
+     * kept a tenth or less of theirs (docs/web-builders.md, "Settling"). */
     pre[SPN_THREAD_FRAME] = 4 * radii;
-    pre[SPN_THREAD_ANCHOR] = 5 * radii;
+    pre[SPN_THREAD_ANCHOR] = 10 * radii;
 }

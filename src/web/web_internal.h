@@ -50,13 +50,16 @@ typedef struct spn__layout {
 uint32_t spn__lay_point(spn__layout *l, spn_vec3 p, uint32_t tag, bool fixed);
 void spn__lay_line(spn__layout *l, const uint32_t *idx, size_t n, uint32_t kind, uint32_t stage);
 void spn__layout_free(spn__layout *l);
-/* Divide every line into springs no longer than `segment`, laid
- * prestrain[kind] beyond rest, in the order the lines were added. Springs of
- * kind SPN_THREAD_AUX_SPIRAL are removed at the end unless keep_aux. */
 /* Pre-strain per thread kind for a web laid with radii at `radii` and the
- * capture spiral at `capture`: frame and mooring threads get 4x and 5x the
+ * capture spiral at `capture`: frame and mooring threads get 4x and 10x the
  * radii's strain (they carry several times the radii's tension). */
 void spn__web_prestrains(double radii, double capture, double pre[SPN_WEB_KINDS]);
+/* Strands of the anchor material a woven web's mooring threads are laid of. */
+#define SPN__MOORING_STRANDS 4.0
+/* Divide every line into springs no longer than `segment`, laid
+ * prestrain[kind] beyond rest, in the order the lines were added, the
+ * mooring threads of SPN__MOORING_STRANDS strands. Springs of kind
+ * SPN_THREAD_AUX_SPIRAL are removed at the end unless keep_aux. */
 spn_status spn__layout_weave(const spn__layout *l, spn__weaver *wv, double segment,
                              const double prestrain[SPN_WEB_KINDS], bool keep_aux);
 
