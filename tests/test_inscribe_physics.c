@@ -147,6 +147,16 @@ static void test_too_stiff_settles_implicitly(void **state)
         spn_target_destroy(t);
         spn_world_destroy(w);
     }
+    /* Told to keep its integrator, it blows up and says so; the web is untouched. */
+    spn_world *w = inscribe_orb(), *before = w;
+    spn_target *t = pig(w);
+    spn_inscribe_def d = spn_inscribe_def_default();
+    d.settle_keep_integrator = true;
+    assert_int_equal(spn_inscribe(&w, t, &d, NULL), SPN_ERR_UNSTABLE);
+    assert_non_null(strstr(spn_last_error(), "blew up"));
+    assert_ptr_equal(w, before);
+    spn_target_destroy(t);
+    spn_world_destroy(w);
 }
 
 /* Replace every capture spring by two, through a new particle at its middle. */

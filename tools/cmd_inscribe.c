@@ -33,7 +33,8 @@ static void usage(FILE *out)
             "      --gaps N           also take out N random capture segments (fig. 6.18)\n"
             "      --seed N           for fill and gaps; default 1\n"
             "settling (before scoring and after editing)\n"
-            "      --solver NAME      euler, symplectic, rk4, adaptive or implicit (default: WEB's)\n"
+            "      --solver NAME      euler, symplectic, rk4, adaptive or implicit (default: WEB's, or\n"
+            "                         implicit where WEB's explicit one cannot take --dt)\n"
             "      --dt S             time step [s]; default 1e-3\n"
             "      --tol N            residual force threshold [N]; default 1e-6\n"
             "      --max-time S       simulated time allowed per settle [s]; default 60\n"
@@ -212,6 +213,7 @@ int cmd_inscribe(int argc, char **argv)
         spn_integrator integ = SPN_INTEGRATOR_SYMPLECTIC;
         spn_integrator_parse(o.solver, &integ);
         spn_world_set_integrator(w, integ);
+        o.def.settle_keep_integrator = true; /* a solver named is the one that steps */
     }
     if (st == SPN_OK) st = make_target(&o, w, &t);
     if (st == SPN_OK && o.overlay && !(source = spn_world_clone(w))) st = spn_error(SPN_ERR_NOMEM, "out of memory");

@@ -106,6 +106,11 @@ typedef struct spn_inscribe_def {
     /// weight) and step with settle_def only where that falls short; default
     /// true. The settle before scoring always steps (docs/inscription.md).
     bool settle_solve;
+    /// Step with the web's own integrator even where it cannot take
+    /// settle_def.dt (a blow-up is then reported); default false: such a
+    /// settle steps implicitly (report.implicit_before / implicit_after).
+    /// `spinneret inscribe --solver NAME` sets it.
+    bool settle_keep_integrator;
 } spn_inscribe_def;
 
 SPN_API spn_inscribe_def spn_inscribe_def_default(void);

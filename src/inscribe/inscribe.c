@@ -48,6 +48,7 @@ spn_inscribe_def spn_inscribe_def_default(void)
      * (4 mm from it against 10). */
     d.settle_def.drag = SPN_SETTLE_DRAG;
     d.settle_solve = true;
+    d.settle_keep_integrator = false;
     return d;
 }
 
@@ -321,7 +322,7 @@ static spn_status settle(spn_world *w, const spn_inscribe_def *d, bool after, sp
     spn_status st = after && d->settle_solve ? solve_rest(w, d, rep, &solved, &newton_steps) : SPN_OK;
     if (st == SPN_OK && !solved) {
         const spn_integrator own = spn_world_get_def(w)->integrator;
-        *implicit = too_stiff(w, d->settle_def.dt);
+        *implicit = !d->settle_keep_integrator && too_stiff(w, d->settle_def.dt);
         if (*implicit) spn_world_set_integrator(w, SPN_INTEGRATOR_IMPLICIT);
         st = spn_world_settle(w, &d->settle_def, rep);
         spn_world_set_integrator(w, own);
