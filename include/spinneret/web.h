@@ -222,11 +222,15 @@ SPN_API spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_repo
 /// spn_web_settle does first (50 steps), for a web that was edited rather
 /// than built (spn_inscribe's settle after editing).
 /// *solved when it reached `target` and the rest state breaks no spring:
-/// the web is then at rest, velocities 0. Otherwise (it fell short, or
-/// something besides springs, gravity and damping acts on the web: a force,
-/// air or collide callback, a collider, a Provot limit) the web is left as
-/// it was. *newton_steps: the steps taken. Errors: out of memory.
-SPN_API spn_status spn_web_solve_rest(spn_world *w, double target, int max_steps, bool *solved, int *newton_steps);
+/// the web is then at rest, velocities 0, and `report` says so as
+/// spn_web_settle's does (reason SPN_SETTLE_CONVERGED, no time or steps,
+/// the residual and energy). Otherwise (it fell short, or something besides
+/// springs, gravity and damping acts on the web: a force, air or collide
+/// callback, a collider, a Provot limit) the web is left as it was and the
+/// reason is SPN_SETTLE_TIMEOUT. report->newton_steps: the steps taken
+/// either way. Errors: out of memory.
+SPN_API spn_status spn_web_solve_rest(spn_world *w, double target, int max_steps, bool *solved,
+                                      spn_settle_report *report);
 
 /// The web as it stood when `fraction` (0..1) of its springs, in construction
 /// order, had been laid: a new world holding those springs. The auxiliary

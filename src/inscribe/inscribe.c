@@ -284,22 +284,14 @@ static spn_status check_def(const spn_inscribe_def *d)
  * wandered between 1e-6 and 4e-9 N for 300 steps (10 s), against a target
  * of 3e-11 N. */
 #define SOLVE_STEPS 100
-static spn_status solve_rest(spn_world *w, const spn_inscribe_def *d, spn_settle_report *rep, bool *solved,
-                             int *newton_steps)
+static spn_status solve_rest(spn_world *w, const spn_inscribe_def *d, spn_settle_report *rep, bool *solved)
 {
     double lightest = INFINITY, g = spn_v3_len(spn_world_get_def(w)->gravity);
     for (uint32_t i = 0; i < spn_world_particle_count(w); i++)
         if (!spn_world_is_fixed(w, i)) lightest = fmin(lightest, spn_world_mass(w, i));
     double target = d->settle_def.max_residual;
     if (isfinite(lightest) && g > 0) target = fmin(target, 1e-2 * g * lightest);
-    spn_status st = spn_web_solve_rest(w, target, SOLVE_STEPS, solved, newton_steps);
-    if (st != SPN_OK || !*solved) return st;
-    memset(rep, 0, sizeof *rep);
-    rep->reason = SPN_SETTLE_CONVERGED;
-    rep->residual = spn_world_max_residual(w, NULL);
-    rep->total_energy = spn_world_total_energy(w);
-    rep->newton_steps = *newton_steps;
-    return SPN_OK;
+    return spn_web_solve_rest(w, target, SOLVE_STEPS, solved, rep);
 }
 
 /* Whether the web's explicit integrator cannot take the settle's step: its
@@ -318,9 +310,9 @@ static spn_status settle(spn_world *w, const spn_inscribe_def *d, bool after, sp
 {
     if (!d->settle) return SPN_OK;
     bool solved = false;
-    int newton_steps = 0;
-    spn_status st = after && d->settle_solve ? solve_rest(w, d, rep, &solved, &newton_steps) : SPN_OK;
+    spn_status st = after && d->settle_solve ? solve_rest(w, d, rep, &solved) : SPN_OK;
     if (st == SPN_OK && !solved) {
+        const int newton_steps = rep->newton_steps; /* the solve's, else 0 (spn_inscribe zeroes the reports) */
         const spn_integrator own = spn_world_get_def(w)->integrator;
         *implicit = !d->settle_keep_integrator && too_stiff(w, d->settle_def.dt);
         if (*implicit) spn_world_set_integrator(w, SPN_INTEGRATOR_IMPLICIT);

@@ -96,11 +96,13 @@ static bool would_break(const spn_world *w)
  * solve stopped: on the Argiope web stepping from there had not come to
  * rest after 13 minutes of CPU, against 8 s from the web as built; so an
  * unfinished solve puts the web back. */
-spn_status spn_web_solve_rest(spn_world *w, double target, int max_steps, bool *solved, int *newton_steps)
+spn_status spn_web_solve_rest(spn_world *w, double target, int max_steps, bool *solved, spn_settle_report *report)
 {
     *solved = false;
-    *newton_steps = 0;
+    memset(report, 0, sizeof *report);
+    report->reason = SPN_SETTLE_TIMEOUT;
     if (!equilibrium_applies(w) || max_steps < 1) return SPN_OK;
+    int *newton_steps = &report->newton_steps;
     uint32_t np = spn_world_particle_count(w);
     spn_vec3 *x = malloc((np ? np : 1) * sizeof *x), *v = malloc((np ? np : 1) * sizeof *v);
     if (!x || !v) {
@@ -128,7 +130,11 @@ spn_status spn_web_solve_rest(spn_world *w, double target, int max_steps, bool *
         return st;
     }
     *solved = st == SPN_OK && rep.reason == SPN_EQUILIBRIUM_CONVERGED && !would_break(w);
-    if (!*solved)
+    if (*solved) {
+        report->reason = SPN_SETTLE_CONVERGED;
+        report->residual = spn_world_max_residual(w, NULL);
+        report->total_energy = spn_world_total_energy(w);
+    } else
         for (uint32_t i = 0; i < np; i++) spn_world_set_position(w, i, x[i]), spn_world_set_velocity(w, i, v[i]);
     free(x), free(v);
     return SPN_OK;
@@ -191,7 +197,6 @@ spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *repo
     uint32_t ns = spn_world_spring_count(w);
     for (uint32_t s = 0; s < ns; s++) tension += spn_world_spring(w, s).tension;
     double floor_force = fmax(1e-3 * 9.81 * mass / (np ? np : 1), 1e-5 * tension / (ns ? ns : 1));
-    int newton_steps = 0;
     /* The solve's target is also a hundredth of the lightest particle's
      * weight: its velocities are 0, so no kinetic-energy test catches a
      * particle that would still fall, and with the tension threshold alone
@@ -200,16 +205,9 @@ spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *repo
      * slack threads, 1 mm above where stepping hangs them. */
     bool solved;
     spn_status st =
-        spn_web_solve_rest(w, fmin(floor_force, 1e-2 * 9.81 * lightest), SETTLE_NEWTON_STEPS, &solved, &newton_steps);
-    if (st != SPN_OK) return st;
-    if (solved) {
-        memset(report, 0, sizeof *report);
-        report->reason = SPN_SETTLE_CONVERGED;
-        report->residual = spn_world_max_residual(w, NULL);
-        report->total_energy = spn_world_total_energy(w);
-        report->newton_steps = newton_steps;
-        return SPN_OK;
-    }
+        spn_web_solve_rest(w, fmin(floor_force, 1e-2 * 9.81 * lightest), SETTLE_NEWTON_STEPS, &solved, report);
+    if (st != SPN_OK || solved) return st;
+    const int newton_steps = report->newton_steps;
     const bool implicit = spn_world_get_def(w)->integrator == SPN_INTEGRATOR_IMPLICIT;
     spn_settle_def sd = spn_settle_def_default();
     sd.dt = stable_step(w);
