@@ -40,7 +40,14 @@ spn_web_materials spn_web_materials_preset(spn_material_preset preset)
         m.kind[SPN_THREAD_ANCHOR] = m.kind[SPN_THREAD_FRAME] = m.kind[SPN_THREAD_BRIDGE] = frame;
         m.kind[SPN_THREAD_HUB] = m.kind[SPN_THREAD_AUX_SPIRAL] = silk(10e9, 2e-6, 1, 0.05);
         m.kind[SPN_THREAD_CAPTURE] = silk(3e6, 2e-6, 10, 0.05);
-        m.kind[SPN_THREAD_STABILIMENTUM] = silk(10e9, 3e-6, 4, 0.05); /* a ribbon of many fine aciniform threads */
+        /* A ribbon of many fine aciniform threads, laid loose: it pulls like
+         * capture silk, not like a 3 um fibre (1 MPa on its 3 um width; laid at
+         * the capture spiral's strain, spn__web_prestrains). As a solid 10 GPa
+         * thread at the radii's 2% it pinched the radii it joins together and
+         * rested at strains of 1e-7 at the slack point, where the settle's
+         * Newton solve crawled: Argiope webs stepped to rest in 3-5 s instead
+         * of solving in 0.1 s (docs/web-builders.md, "Settling"). */
+        m.kind[SPN_THREAD_STABILIMENTUM] = silk(1e6, 3e-6, 4, 0.05);
         m.kind[SPN_THREAD_SIGNAL] = silk(10e9, 5e-6, 1, 0.05);
         return m;
     }

@@ -337,7 +337,9 @@ void spn__site_anchors(spn_rng *rng, int n, double width, double height, spn_vec
 void spn__web_prestrains(double radii, double capture, double pre[SPN_WEB_KINDS])
 {
     for (int k = 0; k < SPN_WEB_KINDS; k++) pre[k] = radii;
-    pre[SPN_THREAD_CAPTURE] = capture;
+    /* Argiope's loose stabilimentum band pulls like capture silk and is laid
+     * like it (spn_web_materials_preset). */
+    pre[SPN_THREAD_CAPTURE] = pre[SPN_THREAD_STABILIMENTUM] = capture;
     /* Frame and mooring threads carry several times the radii's tension
      * (Wirth & Barth 1992, forces in the orb web of Araneus diadematus); laid
      * with the radii's strain, the frame would have to stretch far before the
