@@ -196,12 +196,15 @@ static void lay_spiral(sweb *w, double from, double to, gap_fn gap, double scale
         return;
     }
     bool inward = to < from;
+    /* Zygiella's open sectors are open of the spirals laid in them; the hub
+     * goes round whole (the signal thread is one of its radii). */
+    bool whole = kind == SPN_THREAD_HUB;
     double rho = from, turn_jitter = 1;
     for (long step = 0; !w->l.failed; step++) {
         int r = (int)(step % w->nr);
         if (r == 0) turn_jitter = 1 + w->d->jitter * spn_rng_range(&w->rng, -0.5, 0.5);
         if (inward ? rho < to : rho > to) break;
-        bool fits = rho < w->len[r] - w->d->margin && r != w->signal;
+        bool fits = rho < w->len[r] - w->d->margin && (r != w->signal || whole);
         if (fits) {
             if (n == cap) {
                 uint32_t *p = realloc(run, (cap *= 2) * sizeof *p);
@@ -214,7 +217,7 @@ static void lay_spiral(sweb *w, double from, double to, gap_fn gap, double scale
             run[n++] = point_on(w, r, rho + wobble, SPN_PARTICLE_SPIRAL);
             if (kind == SPN_THREAD_CAPTURE) w->capon[r]++;
         }
-        if (!fits || open_between(w, r)) {
+        if (!fits || (!whole && open_between(w, r))) {
             spn__lay_line(&w->l, run, n, kind, stage);
             n = 0;
         }
