@@ -294,6 +294,17 @@ static spn_status solve_rest(spn_world *w, const spn_inscribe_def *d, spn_settle
     return spn_web_solve_rest(w, target, SOLVE_STEPS, solved, rep);
 }
 
+/* The CG tolerance of the implicit steps to rest after editing (the world's
+ * own, default 1e-10, where it is looser; restored after). Only where the web
+ * comes to rest matters, not the path: README's physical web, "PIG" filled,
+ * 9.5 -> 4.7 s of CPU, 0.36 um from where 1e-10 stops; the standard orb web
+ * (tests/data/inscribe/orb.json) 21.3 -> 3.3 s, 26 um (1e-4: 5.5 and 5.3 s;
+ * 1e-2: 4.0 and 2.0 s, 13-39 um). The settle before scoring keeps the
+ * world's, so what is edited does not change. Settling species webs
+ * (spn_web_settle, a residual target of a hundredth of a particle's weight)
+ * is another matter: at 1e-3 Zilla seed 2 timed out. */
+#define SETTLE_CG_TOLERANCE 1e-3
+
 /* Whether the web's explicit integrator cannot take the settle's step: its
  * stiffest threads would blow it up (the standard orb web at the default
  * 1 ms, symplectic: at the second step; README's physical web once filled,
@@ -316,7 +327,13 @@ static spn_status settle(spn_world *w, const spn_inscribe_def *d, bool after, sp
         const spn_integrator own = spn_world_get_def(w)->integrator;
         *implicit = !d->settle_keep_integrator && too_stiff(w, d->settle_def.dt);
         if (*implicit) spn_world_set_integrator(w, SPN_INTEGRATOR_IMPLICIT);
-        st = spn_world_settle(w, &d->settle_def, rep);
+        const spn_world_def *wd = spn_world_get_def(w);
+        const double cg_tolerance = wd->cg_tolerance;
+        const int cg_cap = wd->cg_max_iterations;
+        if (after && SETTLE_CG_TOLERANCE > cg_tolerance)
+            st = spn_world_set_solver_tolerance(w, SETTLE_CG_TOLERANCE, cg_cap);
+        if (st == SPN_OK) st = spn_world_settle(w, &d->settle_def, rep);
+        spn_world_set_solver_tolerance(w, cg_tolerance, cg_cap);
         spn_world_set_integrator(w, own);
         *implicit = *implicit && rep->steps > 0; /* a web at rest already took no step */
         rep->newton_steps = newton_steps; /* those the solve took before it fell short */
