@@ -8,8 +8,9 @@
  * fraction of a mean particle's weight or thread tension (implicit steps: and
  * a hundredth of the lightest particle's weight) and the kinetic energy is
  * negligible. Implicit steps whose solve stops at its cap are held to
- * creating no energy (spn_world_set_energy_limit), and the cap starts at 100
- * CG iterations (step_to_rest).
+ * creating no energy (spn_world_set_energy_limit), the cap starts at 100
+ * CG iterations (step_to_rest), and CG runs with the cyclic or multigrid
+ * preconditioner to a tolerance of 1e-6 (SETTLE_CG_TOLERANCE).
  *
  * Why both (measured 2026-12-05, docs/web-builders.md, "Settling"): the solve
  * takes the Araneus and the physical webs to rest in 0.03 to 0.25 s of CPU
@@ -50,6 +51,24 @@
  * rest floor; see step_to_rest). */
 #define SETTLE_CG_CAP 100
 #define SETTLE_STALE 4 /* intervals without progress before the CG cap doubles (step_to_rest) */
+/* The implicit settling steps' preconditioner and CG tolerance (the world's
+ * own where it chose a preconditioner, or where its tolerance is looser;
+ * both restored after). Only where the web comes to rest matters, not the
+ * path, and the settle tests rest on the true forces. Below 4,096 particles
+ * the world's auto choice is block Jacobi, which needs few iterations on a
+ * moving web, but on a web creeping to rest it hit the cap of 100 at every
+ * 5 ms step. Here the cyclic preconditioner (the multigrid on webs other
+ * than hub + rings x radials) at 1e-6. CPU s of spn_web_settle, Zen 4, one
+ * run each (docs/web-builders.md, "Settling"), before -> now: Zilla seeds
+ * 2, 4, 6, 7 2.68 / 0.75 / 0.64 / 5.73 -> 1.24 / 0.69 / 0.85 / 0.56;
+ * Zygiella 5 and 7 0.41 / 0.50 -> 0.12 / 0.14; the README's geometric web
+ * 5.08 -> 1.27; 20 webs that step, 83 -> 49 s. Rest states within 0.01 um
+ * (Zilla 7) and 0.8 um (geometric) of before. A step whose CG stops at its
+ * tolerance is taken whole (SPN_ENERGY_LIMIT_UNFINISHED), and at 1e-5 two
+ * geometric webs were kicked about by such steps and never came to rest
+ * (at 1e-4 four of ten), until step_to_rest held every step once the web
+ * stops making progress. 1e-8: 57 s for the 20. */
+#define SETTLE_CG_TOLERANCE 1e-6
 
 static double stable_step(const spn_world *w)
 {
@@ -144,7 +163,13 @@ spn_status spn_web_solve_rest(spn_world *w, double target, int max_steps, bool *
  * at SETTLE_CG_CAP iterations a step, and the cap doubles, up to the world's
  * own, whenever SETTLE_STALE intervals in a row have not brought the
  * residual under half its last mark: a web that creeps needs the longer
- * solves. Zilla seed 6 crept at 1e-7 to 1e-6 N from 2 to 18 s of simulated
+ * solves. From then on every step is also held to creating no energy
+ * (SPN_ENERGY_LIMIT_ALWAYS), not only those whose CG ran out: with the
+ * multigrid the solves finish, and a thin-moored 5 cm Zygiella web
+ * (test_zygiella_comes_to_rest) cycled through the same states, a thread
+ * going slack and taut in turn, at a residual of 1e-8 N for all of its 30 s
+ * (now at rest after 1.5 s; holding every step from the start instead made
+ * Zilla seed 7 and the geometric webs two to ten times slower). Zilla seed 6 crept at 1e-7 to 1e-6 N from 2 to 18 s of simulated
  * time with the cap at 100, and came to rest at 28 s when the cap doubled
  * only under the rest floor; with this rule at 11.9 s (46 s of CPU, was
  * 60), Zilla seed 3 in 5.6 s of CPU (was 9.2). Doubling it after any one
@@ -154,7 +179,7 @@ static spn_status step_to_rest(spn_world *w, const spn_settle_def *def, int cg_c
 {
     memset(report, 0, sizeof *report);
     spn_settle_def sd = *def;
-    const double tolerance = spn_world_get_def(w)->cg_tolerance;
+    const double tolerance = fmax(spn_world_get_def(w)->cg_tolerance, SETTLE_CG_TOLERANCE);
     int cap = cg_cap < SETTLE_CG_CAP ? cg_cap : SETTLE_CG_CAP;
     double elapsed = 0, mark = INFINITY;
     int stale = 0;
@@ -178,6 +203,8 @@ static spn_status step_to_rest(spn_world *w, const spn_settle_def *def, int cg_c
             stale = 0;
         } else if (++stale >= SETTLE_STALE) {
             cap = cap < cg_cap / 2 ? 2 * cap : cg_cap;
+            st = spn_world_set_energy_limit(w, SPN_ENERGY_LIMIT_ALWAYS);
+            if (st != SPN_OK) return st;
             stale = 0;
         }
     }
@@ -231,12 +258,15 @@ spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *repo
      * Argiope web's steps 2 to 7 times: seed 1 settled in 15.7 s of CPU, not
      * 6). So a rough step is safe, and CG stops sooner (step_to_rest). */
     const spn_energy_limit limit = spn_world_energy_limit(w);
+    const spn_precond pc = spn_world_implicit_preconditioner(w);
     const spn_world_def *def = spn_world_get_def(w);
     const double cg_tolerance = def->cg_tolerance;
     const int cg_cap = def->cg_max_iterations;
     st = spn_world_set_energy_limit(w, SPN_ENERGY_LIMIT_UNFINISHED);
+    if (st == SPN_OK && implicit && pc == SPN_PRECOND_AUTO) st = spn_world_set_implicit_preconditioner(w, SPN_PRECOND_CYCLIC);
     if (st == SPN_OK) st = implicit ? step_to_rest(w, &sd, cg_cap, report) : spn_world_settle(w, &sd, report);
     spn_world_set_solver_tolerance(w, cg_tolerance, cg_cap);
+    spn_world_set_implicit_preconditioner(w, pc);
     spn_world_set_energy_limit(w, limit);
     report->newton_steps = newton_steps;
     return st;
