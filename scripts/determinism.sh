@@ -25,6 +25,7 @@ commands=(
   "settle $T/small.json -o OUT.json --solver implicit --dt 1e-3 --max-time 0.2"
   "build --species araneus --seed 3 --settle --settle-time 0.5 -o OUT.json"
   "build --species zygiella --size 0.05 --settle -o OUT.json"
+  "build --species zilla --seed 7 --settle -o OUT.json"
   "shoot --from 0,1.5,0 --to 3,3,0 -o OUT.json --max-time 1"
   "drop $DATA/hostile/tetra.obj -o OUT --max-time 0.3"
   "export $T/small.json -o OUT.obj --tubes 0.001 --dew"
