@@ -169,12 +169,14 @@ spn_status spn_web_solve_rest(spn_world *w, double target, int max_steps, bool *
  * (test_zygiella_comes_to_rest) cycled through the same states, a thread
  * going slack and taut in turn, at a residual of 1e-8 N for all of its 30 s
  * (now at rest after 1.5 s; holding every step from the start instead made
- * Zilla seed 7 and the geometric webs two to ten times slower). Zilla seed 6 crept at 1e-7 to 1e-6 N from 2 to 18 s of simulated
- * time with the cap at 100, and came to rest at 28 s when the cap doubled
- * only under the rest floor; with this rule at 11.9 s (46 s of CPU, was
- * 60), Zilla seed 3 in 5.6 s of CPU (was 9.2). Doubling it after any one
- * interval that had not halved the residual took generic seed 3 from 2.1
- * to 6.0 s (its early intervals go up and down). */
+ * Zilla seed 7 and the geometric webs two to ten times slower). The cap's
+ * rule (thirty-first session, block Jacobi): Zilla seed 6 crept at 1e-7 to
+ * 1e-6 N from 2 to 18 s of simulated time with the cap at 100, and came to
+ * rest at 28 s when the cap doubled only under the rest floor; with this
+ * rule at 11.9 s (46 s of CPU, was 60), Zilla seed 3 in 5.6 s of CPU (was
+ * 9.2). Doubling it after any one interval that had not halved the
+ * residual took generic seed 3 from 2.1 to 6.0 s (its early intervals go
+ * up and down). */
 static spn_status step_to_rest(spn_world *w, const spn_settle_def *def, int cg_cap, spn_settle_report *report)
 {
     memset(report, 0, sizeof *report);
@@ -263,7 +265,8 @@ spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *repo
     const double cg_tolerance = def->cg_tolerance;
     const int cg_cap = def->cg_max_iterations;
     st = spn_world_set_energy_limit(w, SPN_ENERGY_LIMIT_UNFINISHED);
-    if (st == SPN_OK && implicit && pc == SPN_PRECOND_AUTO) st = spn_world_set_implicit_preconditioner(w, SPN_PRECOND_CYCLIC);
+    if (st == SPN_OK && implicit && pc == SPN_PRECOND_AUTO)
+        st = spn_world_set_implicit_preconditioner(w, SPN_PRECOND_CYCLIC); /* SETTLE_CG_TOLERANCE */
     if (st == SPN_OK) st = implicit ? step_to_rest(w, &sd, cg_cap, report) : spn_world_settle(w, &sd, report);
     spn_world_set_solver_tolerance(w, cg_tolerance, cg_cap);
     spn_world_set_implicit_preconditioner(w, pc);
