@@ -62,7 +62,7 @@
  * run each (docs/web-builders.md, "Settling"), before -> now: Zilla seeds
  * 2, 4, 6, 7 2.68 / 0.75 / 0.64 / 5.73 -> 1.24 / 0.69 / 0.85 / 0.56;
  * Zygiella 5 and 7 0.41 / 0.50 -> 0.12 / 0.14; the README's geometric web
- * 5.08 -> 1.27; 20 webs that step, 83 -> 49 s. Rest states within 0.01 um
+ * 5.08 -> 1.27; 20 webs that step, 83 -> 49 s. Rest states within 4e-5 um
  * (Zilla 7) and 0.8 um (geometric) of before. A step whose CG stops at its
  * tolerance is taken whole (SPN_ENERGY_LIMIT_UNFINISHED), and at 1e-5 two
  * geometric webs were kicked about by such steps and never came to rest
