@@ -22,11 +22,13 @@ static void no_force(void *user, const spn_world *w, double t, const spn_vec3 *x
     (void)user, (void)w, (void)t, (void)x, (void)v, (void)f;
 }
 
-/* A small species web as `spinneret build --settle` settles it (silk: implicit). */
-static spn_world *species_web(spn_species kind, double size)
+/* A species web as `spinneret build --species ... --settle` settles it (silk:
+ * implicit): seed `seed`, `size` metres across (0: the preset's). */
+static spn_world *species_web(spn_species kind, uint64_t seed, double size)
 {
     spn_species_def d = spn_species_def_preset(kind);
-    d.size = size;
+    d.seed = seed;
+    if (size > 0) d.size = size;
     d.world.integrator = SPN_INTEGRATOR_IMPLICIT;
     spn_world *w = NULL;
     assert_int_equal(spn_web_build_species(&d, &w), SPN_OK);
@@ -137,11 +139,7 @@ static void test_argiope_and_zygiella_are_solved(void **state)
         double least;
     } cases[] = {{SPN_SPECIES_ARGIOPE, 1, SPN_THREAD_STABILIMENTUM, 0.1}, {SPN_SPECIES_ZYGIELLA, 2, SPN_THREAD_HUB, 0}};
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
-        spn_species_def d = spn_species_def_preset(cases[c].kind);
-        d.seed = cases[c].seed;
-        d.world.integrator = SPN_INTEGRATOR_IMPLICIT;
-        spn_world *w = NULL;
-        assert_int_equal(spn_web_build_species(&d, &w), SPN_OK);
+        spn_world *w = species_web(cases[c].kind, cases[c].seed, 0);
         spn_settle_report r;
         assert_int_equal(spn_web_settle(w, 30, &r), SPN_OK);
         const double least = least_strain(w, cases[c].tag);
@@ -161,7 +159,7 @@ static void test_argiope_and_zygiella_are_solved(void **state)
 static void test_unfinished_solve_steps_from_built(void **state)
 {
     (void)state;
-    spn_world *w = species_web(SPN_SPECIES_GENERIC, 0.08), *alone = spn_world_clone(w);
+    spn_world *w = species_web(SPN_SPECIES_GENERIC, 1, 0.08), *alone = spn_world_clone(w);
     spn_world_set_force_callback(alone, no_force, NULL);
     spn_settle_report a, b;
     assert_int_equal(spn_web_settle(w, 3, &a), SPN_OK);
@@ -214,11 +212,7 @@ static void test_zygiella_comes_to_rest(void **state)
  * checked at rest, having stepped. */
 static spn_world *stepped_to_rest(spn_species kind, uint64_t seed, double cg_tolerance, spn_settle_report *r)
 {
-    spn_species_def d = spn_species_def_preset(kind);
-    d.seed = seed;
-    d.world.integrator = SPN_INTEGRATOR_IMPLICIT;
-    spn_world *w = NULL;
-    assert_int_equal(spn_web_build_species(&d, &w), SPN_OK);
+    spn_world *w = species_web(kind, seed, 0);
     if (cg_tolerance > 0) assert_int_equal(spn_world_set_solver_tolerance(w, cg_tolerance, 1000), SPN_OK);
     assert_int_equal(spn_web_settle(w, 30, r), SPN_OK);
     print_message("%s seed %llu: Newton steps %d, then %.3g s stepped (%llu steps), residual %.3g N\n",
