@@ -40,7 +40,8 @@ SPN_API const char *spn_precond_name(spn_precond p);
 /// SPN_PRECOND_AUTO (the default: from 4,096 particles the cyclic preconditioner on such a web at
 /// any step, the multigrid on others at steps of 5 ms and up; block Jacobi otherwise). Results agree to the
 /// solver tolerance; a clone of a world mid-run continues within it, not bit for bit
-/// (the clone builds its hierarchy afresh).
+/// (the clone builds its hierarchy afresh). Changing the choice drops a kept hierarchy (the next step
+/// that wants one builds it for the new choice).
 SPN_API spn_status spn_world_set_implicit_preconditioner(spn_world *w, spn_precond p);
 /// The implicit step's preconditioner as set (SPN_PRECOND_AUTO until then).
 SPN_API spn_precond spn_world_implicit_preconditioner(const spn_world *w);

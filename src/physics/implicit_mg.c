@@ -46,17 +46,30 @@ struct spn__imp_mg {
     bool failed;       /* the build failed for this signature: block Jacobi until it changes */
 };
 
+/* A change of choice drops the hierarchy: create() decided from the choice
+ * whether it holds the cyclic preconditioner or the V-cycle, so kept it would
+ * go on serving the old choice (multigrid then cyclic on a lattice web: still
+ * the V-cycle), and a choice that no longer wants it (spn_web_settle's cyclic
+ * put back to auto on a small web) would leave it allocated for nothing. The
+ * next step that wants one builds it afresh. */
 spn_status spn_world_set_implicit_preconditioner(spn_world *w, spn_precond p)
 {
+    uint8_t code;
     switch (p) {
-    case SPN_PRECOND_AUTO: w->implicit_pc = 0; return SPN_OK;
-    case SPN_PRECOND_BLOCK_JACOBI: w->implicit_pc = 1; return SPN_OK;
-    case SPN_PRECOND_MULTIGRID: w->implicit_pc = 2; return SPN_OK;
-    case SPN_PRECOND_CYCLIC: w->implicit_pc = 3; return SPN_OK;
+    case SPN_PRECOND_AUTO: code = 0; break;
+    case SPN_PRECOND_BLOCK_JACOBI: code = 1; break;
+    case SPN_PRECOND_MULTIGRID: code = 2; break;
+    case SPN_PRECOND_CYCLIC: code = 3; break;
     default:
         return spn_error(SPN_ERR_INVALID, "implicit preconditioner: block-jacobi, multigrid, cyclic or auto, not %s",
                          spn_precond_name(p));
     }
+    if (code != w->implicit_pc) {
+        spn__imp_mg_free(w->imp_mg);
+        w->imp_mg = NULL;
+        w->implicit_pc = code;
+    }
+    return SPN_OK;
 }
 
 spn_precond spn_world_implicit_preconditioner(const spn_world *w)

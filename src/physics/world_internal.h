@@ -176,7 +176,7 @@ struct spn_world {
     spn__jac *jac;        /* implicit: per-spring Jacobian (on demand) */
     double *pinv;         /* implicit: per-particle inverse 3x3 block, 6 each (on demand) */
     struct spn__imp_mg *imp_mg; /* implicit: the multigrid preconditioner (implicit_mg.c, on demand) */
-    uint8_t implicit_pc;  /* implicit preconditioner: 0 auto, 1 block Jacobi, 2 multigrid */
+    uint8_t implicit_pc;  /* implicit preconditioner: 0 auto, 1 block Jacobi, 2 multigrid, 3 cyclic */
     uint8_t energy_limit; /* implicit: which steps may not create energy (spn_energy_limit) */
     double *partial;      /* SPN_NSUMS per block */
     uint32_t npartial;    /* blocks the partial array holds */
