@@ -215,7 +215,10 @@ SPN_API spn_status spn_web_check_anchors(const spn_vec3 *anchors, int count);
 SPN_API spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *report);
 
 /// The static equilibrium of `w` solved for directly (spn_world_equilibrium),
-/// to a largest net force of `target` N on any free particle, in at most
+/// to a largest net force of `target` N on any free particle (and at most a
+/// hundredth of the lightest free particle's weight: the solve sets every
+/// velocity to 0, so only the residual tells a particle that would still
+/// fall), in at most
 /// `max_steps` Newton steps, in rounds of 10 and given up sooner when a round
 /// does not halve the residual (where it converges it does; where it crawls,
 /// on light particles between slack threads, more steps seldom help): what

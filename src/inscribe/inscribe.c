@@ -276,23 +276,14 @@ static spn_status check_def(const spn_inscribe_def *d)
  * web is near it, and stepping there took most of an inscription's time
  * (README's physical web, implicit: cross-hatch 23 s, outline 11 s, fill 74 s
  * of CPU) or blew up (symplectic at the default 1 ms). The solve's target is
- * also a hundredth of the lightest particle's weight, as spn_web_settle's:
- * it sets every velocity to 0, so only the residual can tell a particle
- * that would still fall. Where the solve crawls it gives up early (a round
- * of 10 Newton steps that does not halve the residual), and the web steps:
- * a dark fill on README's web, its light threads slack between attachments,
- * wandered between 1e-6 and 4e-9 N for 300 steps (10 s), against a target
- * of 3e-11 N. */
+ * also a hundredth of the lightest particle's weight (spn_web_solve_rest's
+ * own): it sets every velocity to 0, so only the residual can tell a
+ * particle that would still fall. Where the solve crawls it gives up early
+ * (a round of 10 Newton steps that does not halve the residual), and the web
+ * steps: a dark fill on README's web, its light threads slack between
+ * attachments, wandered between 1e-6 and 4e-9 N for 300 steps (10 s),
+ * against a target of 3e-11 N. */
 #define SOLVE_STEPS 100
-static spn_status solve_rest(spn_world *w, const spn_inscribe_def *d, spn_settle_report *rep, bool *solved)
-{
-    double lightest = INFINITY, g = spn_v3_len(spn_world_get_def(w)->gravity);
-    for (uint32_t i = 0; i < spn_world_particle_count(w); i++)
-        if (!spn_world_is_fixed(w, i)) lightest = fmin(lightest, spn_world_mass(w, i));
-    double target = d->settle_def.max_residual;
-    if (isfinite(lightest) && g > 0) target = fmin(target, 1e-2 * g * lightest);
-    return spn_web_solve_rest(w, target, SOLVE_STEPS, solved, rep);
-}
 
 /* The CG tolerance of the implicit steps to rest after editing (the world's
  * own, default 1e-10, where it is looser; restored after). Only where the web
@@ -321,7 +312,7 @@ static spn_status settle(spn_world *w, const spn_inscribe_def *d, bool after, sp
 {
     if (!d->settle) return SPN_OK;
     bool solved = false;
-    spn_status st = after && d->settle_solve ? solve_rest(w, d, rep, &solved) : SPN_OK;
+    spn_status st = after && d->settle_solve ? spn_web_solve_rest(w, d->settle_def.max_residual, SOLVE_STEPS, &solved, rep) : SPN_OK;
     if (st == SPN_OK && !solved) {
         const int newton_steps = rep->newton_steps; /* the solve's, else 0 (spn_inscribe zeroes the reports) */
         const spn_integrator own = spn_world_get_def(w)->integrator;

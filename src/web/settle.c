@@ -110,13 +110,29 @@ static bool would_break(const spn_world *w)
     return false;
 }
 
+/* The mass of the lightest free particle (INFINITY when none is free). */
+static double lightest_mass(const spn_world *w)
+{
+    double lightest = INFINITY;
+    for (uint32_t i = 0; i < spn_world_particle_count(w); i++)
+        if (!spn_world_is_fixed(w, i)) lightest = fmin(lightest, spn_world_mass(w, i));
+    return lightest;
+}
+
 /* The static equilibrium, in rounds of SETTLE_NEWTON_ROUND steps given up
  * after one that has not halved the residual. Not from where an unfinished
  * solve stopped: on the Argiope web stepping from there had not come to
  * rest after 13 minutes of CPU, against 8 s from the web as built; so an
- * unfinished solve puts the web back. */
+ * unfinished solve puts the web back. The target is also a hundredth of the
+ * lightest particle's weight: the solve sets every velocity to 0, so no
+ * kinetic-energy test can catch a particle that would still fall, and with
+ * a tension threshold alone (2e-8 N on the species webs, ten times a glue
+ * droplet's weight) it called the generic web at rest with three particles
+ * afloat between slack threads, 1 mm above where stepping hangs them. */
 spn_status spn_web_solve_rest(spn_world *w, double target, int max_steps, bool *solved, spn_settle_report *report)
 {
+    const double g = spn_v3_len(spn_world_get_def(w)->gravity), lightest = lightest_mass(w);
+    if (isfinite(lightest) && g > 0) target = fmin(target, 1e-2 * g * lightest);
     *solved = false;
     memset(report, 0, sizeof *report);
     report->reason = SPN_SETTLE_TIMEOUT;
@@ -214,11 +230,9 @@ static spn_status step_to_rest(spn_world *w, const spn_settle_def *def, int cg_c
 
 spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *report)
 {
-    double lightest = INFINITY;
-    uint32_t np = spn_world_particle_count(w);
-    for (uint32_t i = 0; i < np; i++)
-        if (!spn_world_is_fixed(w, i)) lightest = fmin(lightest, spn_world_mass(w, i));
+    double lightest = lightest_mass(w);
     if (!isfinite(lightest)) lightest = 1e-9;
+    uint32_t np = spn_world_particle_count(w);
     /* At rest: no particle feels more than a thousandth of a mean particle's
      * weight or a hundred-thousandth of a mean thread tension. */
     double mass = 0, tension = 0;
@@ -226,15 +240,8 @@ spn_status spn_web_settle(spn_world *w, double max_time, spn_settle_report *repo
     uint32_t ns = spn_world_spring_count(w);
     for (uint32_t s = 0; s < ns; s++) tension += spn_world_spring(w, s).tension;
     double floor_force = fmax(1e-3 * 9.81 * mass / (np ? np : 1), 1e-5 * tension / (ns ? ns : 1));
-    /* The solve's target is also a hundredth of the lightest particle's
-     * weight: its velocities are 0, so no kinetic-energy test catches a
-     * particle that would still fall, and with the tension threshold alone
-     * (2e-8 N on the species webs, ten times a glue droplet's weight) it
-     * called the generic web at rest with three particles afloat between
-     * slack threads, 1 mm above where stepping hangs them. */
-    bool solved;
-    spn_status st =
-        spn_web_solve_rest(w, fmin(floor_force, 1e-2 * 9.81 * lightest), SETTLE_NEWTON_STEPS, &solved, report);
+    bool solved; /* to floor_force and a hundredth of the lightest particle's weight */
+    spn_status st = spn_web_solve_rest(w, floor_force, SETTLE_NEWTON_STEPS, &solved, report);
     if (st != SPN_OK || solved) return st;
     const int newton_steps = report->newton_steps;
     const bool implicit = spn_world_get_def(w)->integrator == SPN_INTEGRATOR_IMPLICIT;
