@@ -86,6 +86,27 @@ static void test_ranges(void **state)
         assert_non_null(strstr(spn_last_error(), doubles[i].name));
         *doubles[i].field = keep;
     }
+    /* The strains a thread is laid at, each named (geometric and species). */
+    double *strains[] = {&d.strains.radii, &d.strains.capture, &d.strains.frame, &d.strains.anchor};
+    const char *strain_names[] = {"strains.radii", "strains.capture", "strains.frame", "strains.anchor"};
+    spn_species_def sd = spn_species_def_preset(SPN_SPECIES_ZILLA);
+    double *species_strains[] = {&sd.strains.radii, &sd.strains.capture, &sd.strains.frame, &sd.strains.anchor};
+    const double bad_strains[] = {-0.01, 4.5, NAN};
+    for (size_t i = 0; i < 4; i++)
+        for (size_t b = 0; b < 3; b++) {
+            double keep = *strains[i];
+            *strains[i] = bad_strains[b];
+            assert_int_equal(spn_web_build_geometric(&d, &w), SPN_ERR_INVALID);
+            assert_null(w);
+            assert_non_null(strstr(spn_last_error(), strain_names[i]));
+            *strains[i] = keep;
+            keep = *species_strains[i];
+            *species_strains[i] = bad_strains[b];
+            assert_int_equal(spn_web_build_species(&sd, &w), SPN_ERR_INVALID);
+            assert_null(w);
+            assert_non_null(strstr(spn_last_error(), strain_names[i]));
+            *species_strains[i] = keep;
+        }
     int *ints[] = {&d.u, &d.v, &d.k};
     int bad[] = {4, 3, 50};
     for (size_t i = 0; i < 3; i++) {

@@ -38,10 +38,14 @@ static void usage(FILE *out)
             "geometric (thesis symbols and ranges):\n"
             "  --t [0.1,0.2] (0.15)  --s [0.25,0.30] (0.28)  --u [1,3] (3)  --v [4,8] (8)\n"
             "  --r-min, --r-max [0.3,0.7]  --m [0,0.6] (0.1)  --m-prime [0,0.5] (0.2)  --k [5,45] (15)\n"
-            "  --segment M (0.01)  --prestrain F (0.02)  --capture-prestrain F (0.3)\n\n"
+            "  --segment M (0.01)\n"
+            "  --prestrain F  --capture-prestrain F  --frame-prestrain F  --anchor-prestrain F\n"
+            "                         strain radii, capture spiral, frame and moorings are laid at\n"
+            "                         (silk: 0.02, 0.3, 0.08, 0.2; thesis: 1.33, 0.75, 0.33, 1.5)\n\n"
             "species (the preset's values unless given):\n"
             "  --size M  --radii N  --mesh-inner M  --mesh-outer M  --hub-offset F  --contraction F\n"
             "  --hub-radius M  --free-zone M  --jitter F (natural variation)  --margin M\n"
+            "  --prestrain F  --capture-prestrain F  --frame-prestrain F  --anchor-prestrain F  as geometric\n"
             "  --keep-aux             keep the auxiliary spiral (normally removed)\n");
 }
 
@@ -116,17 +120,23 @@ static const num_opt nums[] = {
     {"r-min", G(r_min), false, 0.3, 0.7},                   {"r-max", G(r_max), false, 0.3, 0.7},
     {"m", G(m), false, 0, 0.6},                             {"m-prime", G(m_prime), false, 0, 0.5},
     {"k", G(k), true, 5, 45},                               {"segment", G(segment), false, 1e-4, 1},
-    {"prestrain", G(prestrain), false, 0, 1},               {"capture-prestrain", G(capture_prestrain), false, 0, 4},
+    {"prestrain", G(strains.radii), false, 0, 4},           {"capture-prestrain", G(strains.capture), false, 0, 4},
+    {"frame-prestrain", G(strains.frame), false, 0, 4},     {"anchor-prestrain", G(strains.anchor), false, 0, 4},
     {"size", S(size), false, 0.02, 5},                      {"radii", S(radii), true, 6, 200},
     {"mesh-inner", S(mesh_inner), false, 1e-4, 0.1},        {"mesh-outer", S(mesh_outer), false, 1e-4, 0.1},
     {"hub-offset", S(hub_offset), false, -0.3, 0.3},        {"contraction", S(contraction), false, 0, 0.6},
     {"jitter", S(jitter), false, 0, 0.3},                   {"margin", S(margin), false, 0, 0.1},
 };
-/* Options both the physical builder and the species presets take. */
+/* Options the species presets take too (from the physical builder or the geometric one). */
 static const struct {
     const char *name;
     size_t species_offset;
-} shared[] = {{"hub-radius", offsetof(spn_species_def, hub_radius)}, {"free-zone", offsetof(spn_species_def, free_zone)}};
+} shared[] = {{"hub-radius", offsetof(spn_species_def, hub_radius)},
+              {"free-zone", offsetof(spn_species_def, free_zone)},
+              {"prestrain", offsetof(spn_species_def, strains.radii)},
+              {"capture-prestrain", offsetof(spn_species_def, strains.capture)},
+              {"frame-prestrain", offsetof(spn_species_def, strains.frame)},
+              {"anchor-prestrain", offsetof(spn_species_def, strains.anchor)}};
 #define NNUM (sizeof nums / sizeof nums[0])
 
 static bool set_num(opts *o, const num_opt *n, const char *text)
@@ -196,12 +206,14 @@ static int parse(int argc, char **argv, opts *o)
     return 0;
 }
 
-/* The species must be known before its preset's values are overridden. */
-static const char *find_species(int argc, char **argv)
+/* The species and the material preset must be known before their values are
+ * overridden: `option` is "--species" or "--preset". */
+static const char *find_option(int argc, char **argv, const char *option)
 {
+    const size_t n = strlen(option);
     for (int i = 1; i < argc; i++) {
-        if (strcmp(argv[i], "--species") == 0 && i + 1 < argc) return argv[i + 1];
-        if (strncmp(argv[i], "--species=", 10) == 0) return argv[i] + 10;
+        if (strcmp(argv[i], option) == 0 && i + 1 < argc) return argv[i + 1];
+        if (strncmp(argv[i], option, n) == 0 && argv[i][n] == '=') return argv[i] + n + 1;
     }
     return NULL;
 }
@@ -303,10 +315,13 @@ int cmd_build(int argc, char **argv)
     o.frame_count = 60;
     o.phys = spn_physical_def_default();
     o.geo = spn_geometric_def_default();
-    const char *species = find_species(argc, argv);
+    const char *species = find_option(argc, argv, "--species"), *preset = find_option(argc, argv, "--preset");
     spn_species sp = SPN_SPECIES_GENERIC;
     if (species && spn_species_parse(species, &sp) != SPN_OK) return cli_usage(CMD, "--species: %s", spn_last_error());
     o.sp = spn_species_def_preset(sp);
+    spn_material_preset mp;
+    if (preset && spn_material_preset_parse(preset, &mp) == SPN_OK) /* else build() says what is wrong */
+        o.geo.strains = o.sp.strains = spn_web_strains_preset(mp);
     int rc = parse(argc, argv, &o);
     if (rc) return rc < 0 ? 0 : rc;
     if (o.method && strcmp(o.method, "physical") != 0 && strcmp(o.method, "geometric") != 0)

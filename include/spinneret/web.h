@@ -86,6 +86,23 @@ typedef enum spn_material_preset {
 } spn_material_preset;
 
 SPN_API spn_web_materials spn_web_materials_preset(spn_material_preset preset);
+
+/// The strains the woven builders (geometric, species) lay each kind of thread
+/// at: length over rest length, minus 1, each in [0, 4].
+typedef struct spn_web_strains {
+    double radii;   ///< radii, hub, signal and bridge threads (and any kind not named below)
+    double capture; ///< capture spiral, and Argiope's stabilimentum, which pulls like it
+    double frame;   ///< frame threads: sides and arches
+    double anchor;  ///< mooring threads from the frame to the anchors
+} spn_web_strains;
+
+/// The strains that go with a material preset. Silk: radii 2%, capture 30%,
+/// frame 8%, moorings 20% (frame and moorings carry several times the radii's
+/// tension). Thesis: Mehla's own over-extensions (placement over rest length:
+/// spokes 7 on 3 mm, 133%; spiral 75%; inner frame 20 on 15 mm, 33%; outer
+/// frame 5 on 2 mm, 150%), which its soft, heavy springs need to hang taut
+/// (laid at silk's strains they sag below their own frame).
+SPN_API spn_web_strains spn_web_strains_preset(spn_material_preset preset);
 /// "thesis" or "silk"; SPN_ERR_INVALID naming the choices otherwise.
 SPN_API spn_status spn_material_preset_parse(const char *name, spn_material_preset *out);
 SPN_API const char *spn_material_preset_name(spn_material_preset preset);
@@ -126,7 +143,7 @@ SPN_API spn_status spn_web_build_physical(const spn_physical_def *def, spn_world
 typedef struct spn_geometric_def {
     const spn_vec3 *anchors;   ///< P_i: 3 .. SPN_WEB_MAX_ANCHORS, in order around the web
     int anchor_count;
-    spn_web_materials materials; ///< default: the silk preset
+    spn_web_materials materials; ///< default: the silk preset (another preset: set `strains` to its own)
     double t;                  ///< attachment points P' = (1-t)P + tG, t in [0.1, 0.2], default 0.15
     double s;                  ///< arch ends Q, R at s along the frame, s in [0.25, 0.30], default 0.28
     int u;                     ///< radii on the longest arch, U in [1, 3], default 3
@@ -136,8 +153,7 @@ typedef struct spn_geometric_def {
     double m_prime;            ///< m' (thesis: 0.2), in [0, 0.5]: inner edge of the capture spiral
     int k;                     ///< capture-spiral turns K in [5, 45], default 15
     double segment;            ///< longest spring when lines are divided [m], default 0.01
-    double prestrain;          ///< frame and radii laid this fraction beyond rest, default 0.02
-    double capture_prestrain;  ///< capture spiral, default 0.3
+    spn_web_strains strains;   ///< how far beyond rest each thread is laid; default: silk's
     uint64_t seed;             ///< default 1
     spn_world_def world;
 } spn_geometric_def;
@@ -167,7 +183,7 @@ typedef struct spn_species_def {
     const spn_vec3 *anchors;   ///< NULL: the species' typical site (anchors around a web of `size`)
     int anchor_count;
     double size;               ///< web diameter when anchors are NULL [m]
-    spn_web_materials materials; ///< default: the silk preset
+    spn_web_materials materials; ///< default: the silk preset (another preset: set `strains` to its own)
     int radii;                 ///< number of radii
     double hub_radius;         ///< [m]
     double free_zone;          ///< width of the free zone between hub and capture spiral [m]
@@ -182,7 +198,8 @@ typedef struct spn_species_def {
     double open_sector_angle;  ///< its direction from the hub [rad, from +x], default upper left
     bool stabilimentum;        ///< Argiope's zig-zag band above and below the hub
     double jitter;             ///< relative natural variation of angles and gaps, default 0.08
-    double segment, prestrain, capture_prestrain; ///< division into springs, as geometric
+    double segment;            ///< division into springs, as geometric
+    spn_web_strains strains;   ///< as geometric; default: silk's
     uint64_t seed;
     spn_world_def world;
 } spn_species_def;

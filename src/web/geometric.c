@@ -32,8 +32,7 @@ spn_geometric_def spn_geometric_def_default(void)
     d.m_prime = 0.2;
     d.k = 15;
     d.segment = 0.01;
-    d.prestrain = 0.02;
-    d.capture_prestrain = 0.3;
+    d.strains = spn_web_strains_preset(SPN_MATERIAL_SILK);
     d.seed = 1;
     d.world = spn_world_def_default();
     return d;
@@ -58,8 +57,7 @@ static spn_status check_def(const spn_geometric_def *d)
     if (st == SPN_OK) st = range("m_prime", d->m_prime, 0, 0.5);
     if (st == SPN_OK) st = range("K", d->k, 5, 45);
     if (st == SPN_OK && !(d->segment > 0)) st = spn_error(SPN_ERR_INVALID, "segment must be positive");
-    if (st == SPN_OK) st = range("prestrain", d->prestrain, 0, 1);
-    if (st == SPN_OK) st = range("capture_prestrain", d->capture_prestrain, 0, 4);
+    if (st == SPN_OK) st = spn__web_check_strains(&d->strains);
     if (st == SPN_OK && d->m + d->m_prime > 0.9)
         st = spn_error(SPN_ERR_INVALID, "m + m_prime = %g leaves no room for the capture spiral", d->m + d->m_prime);
     return st;
@@ -145,7 +143,7 @@ spn_status spn_web_build_geometric(const spn_geometric_def *def, spn_world **out
     int nf = lay_frame(&l, &f, ends);
     lay_radii_and_spiral(&l, def, f.g, ends, nf);
     double pre[SPN_WEB_KINDS];
-    spn__web_prestrains(def->prestrain, def->capture_prestrain, pre);
+    spn__web_prestrains(&def->strains, pre);
     spn__weaver wv;
     spn_world_def wd = def->world;
     wd.seed = def->seed;
@@ -166,8 +164,7 @@ spn_status spn_web_build_geometric(const spn_geometric_def *def, spn_world **out
     spn__meta_num(&m, "G_x", f.g.x);
     spn__meta_num(&m, "G_y", f.g.y);
     spn__meta_num(&m, "segment", def->segment);
-    spn__meta_num(&m, "prestrain", def->prestrain);
-    spn__meta_num(&m, "capture_prestrain", def->capture_prestrain);
+    spn__meta_strains(&m, &def->strains);
     st = spn__weaver_finish(&wv, spn__meta_end(&m), out);
     spn__meta_free(&m);
     return st;

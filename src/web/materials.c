@@ -69,7 +69,37 @@ spn_web_materials spn_web_materials_preset(spn_material_preset preset)
     /* The thesis gives every particle 10 ug, and the spiral adds no particles
      * (it joins spoke masses), so its threads carry almost no mass of their own. */
     m.kind[SPN_THREAD_CAPTURE] = m.kind[SPN_THREAD_AUX_SPIRAL] = mat(0.0003 * 0.003, 0.05 * particle / 0.003, 1.5e-6, zeta);
+    /* Argiope's band pulls like the capture spiral, as in silk (above): with
+     * the spokes' stiffness at the capture spiral's strain it pinched the
+     * radii together and curled. */
+    m.kind[SPN_THREAD_STABILIMENTUM] = m.kind[SPN_THREAD_CAPTURE];
     return m;
+}
+
+spn_web_strains spn_web_strains_preset(spn_material_preset preset)
+{
+    spn_web_strains s;
+    if (preset == SPN_MATERIAL_SILK) {
+        /* Frame and mooring threads carry several times the radii's tension
+         * (Wirth & Barth 1992, forces in the orb web of Araneus diadematus);
+         * laid with the radii's strain, the frame would have to stretch far
+         * before the web could balance, and a stiff-silk solver would crawl
+         * there. The mooring threads hold the frame's corners out against the
+         * radii: laid at 5 times the radii's strain they let the corners in
+         * until the radii kept a tenth or less of theirs (docs/web-builders.md,
+         * "Settling"); at 10 times, of four strands (SPN__MOORING_STRANDS),
+         * they keep them taut. */
+        s.radii = 0.02, s.capture = 0.3, s.frame = 4 * s.radii, s.anchor = 10 * s.radii;
+        return s;
+    }
+    /* The thesis' placements over its rest lengths (spn_physical_def_default):
+     * spokes 7 on 3 mm, inner frame 20 on 15 mm, outer frame 5 on 2 mm, and the
+     * spiral's extension. Its springs are soft for their mass (a 3 mm spoke
+     * of 10 ug at 0.01 N/m): laid at silk's 2% a woven web hung below its own
+     * frame, and a geometric web collapsed onto its lower side
+     * (docs/web-builders.md, "The thesis preset"). */
+    s.radii = 7.0 / 3 - 1, s.capture = 0.75, s.frame = 20.0 / 15 - 1, s.anchor = 5.0 / 2 - 1;
+    return s;
 }
 
 static const char *preset_names[] = {"thesis", "silk"};

@@ -41,8 +41,7 @@ spn_species_def spn_species_def_preset(spn_species species)
     d.open_sector_angle = 0.75 * SPN_PI; /* upper left */
     d.jitter = 0.08;
     d.segment = 0.01;
-    d.prestrain = 0.02;
-    d.capture_prestrain = 0.3;
+    d.strains = spn_web_strains_preset(SPN_MATERIAL_SILK);
     d.seed = 1;
     d.world = spn_world_def_default();
     switch (species) {

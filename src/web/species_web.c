@@ -335,7 +335,7 @@ static spn_status check_def(const spn_species_def *d)
     if (!(d->hub_offset >= -0.3 && d->hub_offset <= 0.3)) return spn_error(SPN_ERR_INVALID, "hub_offset must be in [-0.3, 0.3]");
     if (!(d->contraction >= 0 && d->contraction <= 0.6)) return spn_error(SPN_ERR_INVALID, "contraction must be in [0, 0.6]");
     if (!(d->segment > 0)) return spn_error(SPN_ERR_INVALID, "segment must be positive");
-    return SPN_OK;
+    return spn__web_check_strains(&d->strains);
 }
 
 static void weave(sweb *w)
@@ -395,7 +395,7 @@ spn_status spn_web_build_species(const spn_species_def *def, spn_world **out)
     smooth_frame(w);
     weave(w);
     double pre[SPN_WEB_KINDS];
-    spn__web_prestrains(def->prestrain, def->capture_prestrain, pre);
+    spn__web_prestrains(&def->strains, pre);
     spn__weaver wv;
     spn_world_def wd = def->world;
     wd.seed = def->seed;
@@ -418,6 +418,7 @@ spn_status spn_web_build_species(const spn_species_def *def, spn_world **out)
     spn__meta_num(&m, "open_sector", def->open_sector);
     spn__meta_num(&m, "stabilimentum", def->stabilimentum);
     spn__meta_num(&m, "jitter", def->jitter);
+    spn__meta_strains(&m, &def->strains);
     st = spn__weaver_finish(&wv, spn__meta_end(&m), out);
     spn__meta_free(&m);
     for (int r = 0; r < MAX_RADII; r++) free(w->on[r]);

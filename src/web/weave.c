@@ -298,6 +298,14 @@ void spn__meta_materials(spn__meta *m, const spn_web_materials *mat)
     spn_sink_printf(&m->sink, "}");
 }
 
+void spn__meta_strains(spn__meta *m, const spn_web_strains *s)
+{
+    spn__meta_num(m, "prestrain", s->radii);
+    spn__meta_num(m, "capture_prestrain", s->capture);
+    spn__meta_num(m, "frame_prestrain", s->frame);
+    spn__meta_num(m, "anchor_prestrain", s->anchor);
+}
+
 const char *spn__meta_end(spn__meta *m)
 {
     spn_sink_printf(&m->sink, "}}");
@@ -334,19 +342,23 @@ void spn__site_anchors(spn_rng *rng, int n, double width, double height, spn_vec
     }
 }
 
-void spn__web_prestrains(double radii, double capture, double pre[SPN_WEB_KINDS])
+void spn__web_prestrains(const spn_web_strains *s, double pre[SPN_WEB_KINDS])
 {
-    for (int k = 0; k < SPN_WEB_KINDS; k++) pre[k] = radii;
+    for (int k = 0; k < SPN_WEB_KINDS; k++) pre[k] = s->radii;
     /* Argiope's loose stabilimentum band pulls like capture silk and is laid
      * like it (spn_web_materials_preset). */
-    pre[SPN_THREAD_CAPTURE] = pre[SPN_THREAD_STABILIMENTUM] = capture;
-    /* Frame and mooring threads carry several times the radii's tension
-     * (Wirth & Barth 1992, forces in the orb web of Araneus diadematus); laid
-     * with the radii's strain, the frame would have to stretch far before the
-     * web could balance, and a stiff-silk solver would crawl there. The
-     * mooring threads hold the frame's corners out against the radii: laid
-     * at 5 times the radii's strain they let the corners in until the radii
-     * kept a tenth or less of theirs (docs/web-builders.md, "Settling"). */
-    pre[SPN_THREAD_FRAME] = 4 * radii;
-    pre[SPN_THREAD_ANCHOR] = 10 * radii;
+    pre[SPN_THREAD_CAPTURE] = pre[SPN_THREAD_STABILIMENTUM] = s->capture;
+    pre[SPN_THREAD_FRAME] = s->frame;
+    pre[SPN_THREAD_ANCHOR] = s->anchor;
+}
+
+spn_status spn__web_check_strains(const spn_web_strains *s)
+{
+    const char *names[4] = {"radii", "capture", "frame", "anchor"};
+    const double v[4] = {s->radii, s->capture, s->frame, s->anchor};
+    for (int i = 0; i < 4; i++)
+        if (!(v[i] >= 0 && v[i] <= 4))
+            return spn_error(SPN_ERR_INVALID, "strains.%s = %g is outside [0, 4] (length over rest, minus 1)", names[i],
+                             v[i]);
+    return SPN_OK;
 }

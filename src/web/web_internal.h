@@ -50,10 +50,10 @@ typedef struct spn__layout {
 uint32_t spn__lay_point(spn__layout *l, spn_vec3 p, uint32_t tag, bool fixed);
 void spn__lay_line(spn__layout *l, const uint32_t *idx, size_t n, uint32_t kind, uint32_t stage);
 void spn__layout_free(spn__layout *l);
-/* Pre-strain per thread kind for a web laid with radii at `radii` and the
- * capture spiral at `capture`: frame and mooring threads get 4x and 10x the
- * radii's strain (they carry several times the radii's tension). */
-void spn__web_prestrains(double radii, double capture, double pre[SPN_WEB_KINDS]);
+/* Pre-strain per thread kind from a woven builder's strains. */
+void spn__web_prestrains(const spn_web_strains *s, double pre[SPN_WEB_KINDS]);
+/* Each of the strains in [0, 4]; the message names the field. */
+spn_status spn__web_check_strains(const spn_web_strains *s);
 /* Strands of the anchor material a woven web's mooring threads are laid of. */
 #define SPN__MOORING_STRANDS 4.0
 /* Divide every line into springs no longer than `segment`, laid
@@ -78,6 +78,8 @@ void spn__meta_num(spn__meta *m, const char *key, double v);
 void spn__meta_str(spn__meta *m, const char *key, const char *v);
 /* Every thread kind's material, as "materials": {kind: {ea, ...}}. */
 void spn__meta_materials(spn__meta *m, const spn_web_materials *mat);
+/* The strains, as "prestrain", "capture_prestrain", "frame_prestrain", "anchor_prestrain". */
+void spn__meta_strains(spn__meta *m, const spn_web_strains *s);
 const char *spn__meta_end(spn__meta *m);
 void spn__meta_free(spn__meta *m);
 

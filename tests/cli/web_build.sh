@@ -27,6 +27,18 @@ first=$(stat -c %s "$T/frames/$(ls "$T/frames" | head -1)")
 last=$(stat -c %s "$T/frames/$(ls "$T/frames" | tail -1)")
 [ "$last" -gt "$first" ] || fail "the last frame ($last bytes) should hold more web than the first ($first)"
 
+# The material preset brings its strains: the thesis' soft threads laid at
+# its own over-extensions (spokes 133%), which an option still overrides, and
+# the web hangs taut: solved, not stepped for seconds.
+"$SPN" build --species araneus --preset thesis --settle -o "$T/t.json" 2>"$T/err" || fail "thesis build"
+grep -q "static equilibrium" "$T/err" || fail "the thesis-preset web should be solved: $(cat "$T/err")"
+grep -Eq '"prestrain": *1\.333' "$T/t.json" || fail "thesis strains expected in the metadata"
+"$SPN" build --species araneus --preset=thesis --frame-prestrain 0.25 -o "$T/t2.json" || fail "thesis build with a strain"
+grep -Eq '"frame_prestrain": *0\.25[,}]' "$T/t2.json" || fail "--frame-prestrain should override the preset's"
+grep -Eq '"prestrain": *1\.333' "$T/t2.json" || fail "the preset's other strains should stay"
+"$SPN" build --species araneus -o "$T/s.json" || fail "silk build"
+grep -Eq '"anchor_prestrain": *0\.2[,}]' "$T/s.json" || fail "silk strains expected in the metadata"
+
 check_bad() { # expected-text args...
     local want=$1; shift
     "$SPN" build "$@" -o "$T/bad.json" 2>"$T/err" && fail "should fail: $*"
@@ -43,4 +55,5 @@ check_bad "\-\-m" --method geometric --anchors "0,0;1,0;0,1" --m 0.7
 check_bad "\-\-k" --method geometric --anchors "0,0;1,0;0,1" --k 46
 check_bad "\-\-t" --method geometric --anchors "0,0;1,0;0,1" --t 0.3
 check_bad "species" --species spidey
+check_bad "\-\-anchor-prestrain" --species zilla --anchor-prestrain 5
 echo "web build ok"
