@@ -58,9 +58,10 @@ KNOWN = {
         ("kernel", "kernel"), ("threads", "threads"), ("gb_per_s", "GB/s")]),
     "web_settle": ("A built species web brought to rest (`spn_web_settle`, as `build --settle`; "
                    "bench/bench_web_settle.c, 1 thread)", [
-        ("species", "species"), ("seed", "seed"), ("particles", "particles"), ("how", "how"),
-        ("converged", "at rest"), ("newton_steps", "Newton steps"), ("steps", "implicit steps"),
-        ("simulated_s", "simulated s"), ("residual_n", "residual N"), ("ms", "wall ms"), ("cpu_ms", "CPU ms")]),
+        ("species", "species"), ("seed", "seed"), ("build", "web"), ("particles", "particles"),
+        ("build_cpu_ms", "build CPU ms"), ("how", "how"), ("converged", "at rest"), ("newton_steps", "Newton steps"),
+        ("steps", "implicit steps"), ("simulated_s", "simulated s"), ("residual_n", "residual N"), ("ms", "wall ms"),
+        ("cpu_ms", "CPU ms")]),
     "inscribe": ("\"PIG\" written into README's physical web (`spinneret inscribe --solver implicit`: the rest "
                  "state solved for after editing, stepped where that falls short; bench/bench_inscribe.c, 1 thread, "
                  "the settle after editing)", [

@@ -16,6 +16,8 @@
 #include <string.h>
 #include <spinneret/spinneret.h>
 
+#include "web_checks.h"
+
 #include "physics/equilibrium_internal.h"
 
 /* Largest net static force on a free particle: springs, gravity (if asked)
@@ -449,6 +451,7 @@ static void test_species_web_multigrid(void **state)
 {
     (void)state;
     spn_species_def sd = spn_species_def_preset(SPN_SPECIES_ARANEUS);
+    web_as_designed(&sd.strains, &sd.form_find); /* far from rest */
     spn_world *mg = NULL;
     assert_int_equal(spn_web_build_species(&sd, &mg), SPN_OK);
     spn_world *bj = spn_world_clone(mg), *two = spn_world_clone(mg);

@@ -209,4 +209,15 @@ static inline spn_physical_def web_physical_30cm(bool silk)
     return d;
 }
 
+/* A woven web as designed, laid at the strains silk webs were laid at until
+ * the thirty-sixth session (radii 2%, capture 30%, frame 8%, moorings 20%),
+ * without the form finding: the web every species build gave before, far
+ * from rest, for the tests of the solve and of the stepped settle (form
+ * finding leaves a web at rest as built). */
+static inline void web_as_designed(spn_web_strains *strains, bool *form_find)
+{
+    strains->radii = 0.02, strains->capture = 0.3, strains->frame = 0.08, strains->anchor = 0.2;
+    *form_find = false;
+}
+
 #endif

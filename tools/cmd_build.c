@@ -41,7 +41,7 @@ static void usage(FILE *out)
             "  --segment M (0.01)\n"
             "  --prestrain F  --capture-prestrain F  --frame-prestrain F  --anchor-prestrain F\n"
             "                         strain radii, capture spiral, frame and moorings are laid at\n"
-            "                         (silk: 0.02, 0.3, 0.08, 0.2; thesis: 1.33, 0.75, 0.33, 1.5)\n\n"
+            "                         (silk: 0.005, 0.3, 0.08, 0.2; thesis: 1.33, 0.75, 0.33, 1.5)\n\n"
             "species (the preset's values unless given):\n"
             "  --size M  --radii N  --mesh-inner M  --mesh-outer M  --hub-offset F  --contraction F\n"
             "  --hub-radius M  --free-zone M  --jitter F (natural variation)  --margin M\n"

@@ -96,9 +96,10 @@ typedef struct spn_web_strains {
     double anchor;  ///< mooring threads from the frame to the anchors
 } spn_web_strains;
 
-/// The strains that go with a material preset. Silk: radii 2%, capture 30%,
+/// The strains that go with a material preset. Silk: radii 0.5%, capture 30%,
 /// frame 8%, moorings 20% (frame and moorings carry several times the radii's
-/// tension). Thesis: Mehla's own over-extensions (placement over rest length:
+/// tension; the radii rest at 0.5% on the shape the form finding gives, what
+/// they kept at rest when laid at 2% on the designed one). Thesis: Mehla's own over-extensions (placement over rest length:
 /// spokes 7 on 3 mm, 133%; spiral 75%; inner frame 20 on 15 mm, 33%; outer
 /// frame 5 on 2 mm, 150%), which its soft, heavy springs need to hang taut
 /// (laid at silk's strains they sag below their own frame).
@@ -154,6 +155,9 @@ typedef struct spn_geometric_def {
     int k;                     ///< capture-spiral turns K in [5, 45], default 15
     double segment;            ///< longest spring when lines are divided [m], default 0.01
     spn_web_strains strains;   ///< how far beyond rest each thread is laid; default: silk's
+    bool form_find;            ///< default true: find the web's shape with every thread but frame and
+                               ///< moorings pulling at its laid tension, then lay them on it
+                               ///< (docs/web-builders.md, "The woven web's shape"); false: as designed
     uint64_t seed;             ///< default 1
     spn_world_def world;
 } spn_geometric_def;
@@ -200,6 +204,7 @@ typedef struct spn_species_def {
     double jitter;             ///< relative natural variation of angles and gaps, default 0.08
     double segment;            ///< division into springs, as geometric
     spn_web_strains strains;   ///< as geometric; default: silk's
+    bool form_find;            ///< as geometric; default true
     uint64_t seed;
     spn_world_def world;
 } spn_species_def;

@@ -33,6 +33,7 @@ spn_geometric_def spn_geometric_def_default(void)
     d.k = 15;
     d.segment = 0.01;
     d.strains = spn_web_strains_preset(SPN_MATERIAL_SILK);
+    d.form_find = true;
     d.seed = 1;
     d.world = spn_world_def_default();
     return d;
@@ -165,7 +166,13 @@ spn_status spn_web_build_geometric(const spn_geometric_def *def, spn_world **out
     spn__meta_num(&m, "G_y", f.g.y);
     spn__meta_num(&m, "segment", def->segment);
     spn__meta_strains(&m, &def->strains);
+    spn__meta_num(&m, "form_find", def->form_find);
     st = spn__weaver_finish(&wv, spn__meta_end(&m), out);
     spn__meta_free(&m);
+    bool found;
+    if (st == SPN_OK && def->form_find && (st = spn__web_form_find(*out, pre, &found)) != SPN_OK) {
+        spn_world_destroy(*out);
+        *out = NULL;
+    }
     return st;
 }

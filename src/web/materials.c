@@ -85,11 +85,17 @@ spn_web_strains spn_web_strains_preset(spn_material_preset preset)
          * laid with the radii's strain, the frame would have to stretch far
          * before the web could balance, and a stiff-silk solver would crawl
          * there. The mooring threads hold the frame's corners out against the
-         * radii: laid at 5 times the radii's strain they let the corners in
+         * radii: laid at 5 times the radii's old 2% they let the corners in
          * until the radii kept a tenth or less of theirs (docs/web-builders.md,
          * "Settling"); at 10 times, of four strands (SPN__MOORING_STRANDS),
-         * they keep them taut. */
-        s.radii = 0.02, s.capture = 0.3, s.frame = 4 * s.radii, s.anchor = 10 * s.radii;
+         * they keep them taut. The radii are laid at 0.5% on the shape the
+         * form finding gives (form_find.c): what they kept at rest when laid
+         * at 2% on the designed one (0.1-0.5% on the species webs, 0.2% on
+         * the geometric web). At 2% they would pull the frame in by a tenth of
+         * the web's width; at 0.3-1% the species webs rest within 0.3-1.4%
+         * (median particle) of where they rested before ("The woven web's
+         * shape"). */
+        s.radii = 0.005, s.capture = 0.3, s.frame = 0.08, s.anchor = 0.2;
         return s;
     }
     /* The thesis' placements over its rest lengths (spn_physical_def_default):

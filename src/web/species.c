@@ -42,6 +42,7 @@ spn_species_def spn_species_def_preset(spn_species species)
     d.jitter = 0.08;
     d.segment = 0.01;
     d.strains = spn_web_strains_preset(SPN_MATERIAL_SILK);
+    d.form_find = true;
     d.seed = 1;
     d.world = spn_world_def_default();
     switch (species) {

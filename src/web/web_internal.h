@@ -54,6 +54,11 @@ void spn__layout_free(spn__layout *l);
 void spn__web_prestrains(const spn_web_strains *s, double pre[SPN_WEB_KINDS]);
 /* Each of the strains in [0, 4]; the message names the field. */
 spn_status spn__web_check_strains(const spn_web_strains *s);
+/* The woven web's shape with every thread but frame, moorings and bridge
+ * pulling at its laid tension, those threads then laid at prestrain[kind]
+ * on it (form_find.c); *found false (the web left as laid) where the solve
+ * fell short. Errors: out of memory. */
+spn_status spn__web_form_find(spn_world *w, const double prestrain[SPN_WEB_KINDS], bool *found);
 /* Strands of the anchor material a woven web's mooring threads are laid of. */
 #define SPN__MOORING_STRANDS 4.0
 /* Divide every line into springs no longer than `segment`, laid

@@ -1,0 +1,79 @@
+/* The woven web's shape found before its threads are laid (form finding).
+ *
+ * A spider does not leave its radii as it first draws them: it walks them
+ * and tightens them, and the frame gives under their pull. Laid straight onto
+ * the designed geometry at their strains, a woven web is far from rest: the
+ * frame and the moorings stretch and bow under the radii, the radii lose most
+ * of their strain (the geometric web's from 2% to 0.2%, a few to 1e-9), and
+ * a web resting on nearly slack threads is where the settle's Newton solve
+ * stalls and it falls back to seconds of stepping (docs/web-builders.md,
+ * "Settling").
+ *
+ * Here every thread but the frame and the moorings (radii, hub, signal,
+ * capture spiral, stabilimentum) first pulls at its laid tension whatever
+ * its length: a spring of (almost) zero rest length whose stiffness is that
+ * tension over its length, a force density. Such a thread cannot go slack,
+ * and the static equilibrium of those pulls against the elastic frame and
+ * moorings (and gravity) is a well-posed problem Newton solves in a few
+ * steps. Each thread is then laid on the shape found at the tension it
+ * pulls with there (its laid tension, changed by as much as its length
+ * changed), so the web as built is at rest, every radius taut. Frame and
+ * mooring threads keep the rest lengths they were laid with. Where the solve
+ * falls short the web is left as laid. */
+#include "web_internal.h"
+
+#include "spinneret/equilibrium.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+/* Newton steps the form finding may take: on the species and geometric webs
+ * measured it took 6-29, to 1e-9 N (docs/web-builders.md, "The woven web's
+ * shape"). */
+#define FORM_FIND_STEPS 60
+
+static bool elastic(uint32_t tag) { return tag == SPN_THREAD_FRAME || tag == SPN_THREAD_ANCHOR || tag == SPN_THREAD_BRIDGE; }
+
+spn_status spn__web_form_find(spn_world *w, const double prestrain[SPN_WEB_KINDS], bool *found)
+{
+    *found = false;
+    const uint32_t ns = spn_world_spring_count(w), np = spn_world_particle_count(w);
+    double *ea = malloc((ns ? ns : 1) * sizeof *ea), *rest = malloc((ns ? ns : 1) * sizeof *rest);
+    spn_vec3 *x = malloc((np ? np : 1) * sizeof *x);
+    if (!ea || !rest || !x) {
+        free(ea), free(rest), free(x);
+        return spn_error(SPN_ERR_NOMEM, "out of memory finding the web's shape");
+    }
+    for (uint32_t i = 0; i < np; i++) x[i] = spn_world_position(w, i);
+    for (uint32_t s = 0; s < ns; s++) {
+        const spn_spring_info si = spn_world_spring(w, s);
+        rest[s] = si.rest;
+        ea[s] = 0;
+        if (si.broken || elastic(si.tag) || !(si.rest > 0 && si.length > 0)) continue;
+        ea[s] = si.k * si.rest;
+        const double pre = prestrain[si.tag < SPN_WEB_KINDS ? si.tag : 0];
+        /* tension k (L - r) = ea pre at the laid length L, r a billionth of L */
+        spn_world_set_spring_rest(w, s, 1e-9 * si.length);
+        spn_world_set_spring_stiffness(w, s, ea[s] * pre / (si.length * (1 - 1e-9)), spn_world_spring_damping(w, s));
+    }
+    spn_equilibrium_def d = spn_equilibrium_def_default();
+    d.max_iterations = FORM_FIND_STEPS;
+    spn_equilibrium_report rep;
+    spn_status st = spn_world_equilibrium(w, &d, &rep);
+    *found = st == SPN_OK && rep.reason == SPN_EQUILIBRIUM_CONVERGED;
+    for (uint32_t s = 0; s < ns; s++) {
+        if (ea[s] == 0) continue;
+        /* laid at the tension it pulls with in the shape found, so that the
+         * web as built is that shape's equilibrium */
+        const spn_spring_info si = spn_world_spring(w, s);
+        const double r = *found ? si.length / (1 + si.k * (si.length - si.rest) / ea[s]) : rest[s];
+        spn_world_set_spring_rest(w, s, r);
+        spn_world_set_spring_stiffness(w, s, ea[s] / r, spn_world_spring_damping(w, s));
+    }
+    for (uint32_t i = 0; i < np; i++) {
+        if (!*found) spn_world_set_position(w, i, x[i]);
+        spn_world_set_velocity(w, i, spn_v3(0, 0, 0));
+    }
+    free(ea), free(rest), free(x);
+    return st == SPN_ERR_NOMEM ? st : SPN_OK;
+}
