@@ -99,10 +99,11 @@ typedef struct spn_web_strains {
 /// The strains that go with a material preset. Silk: radii 0.5%, capture 30%,
 /// frame 8%, moorings 20% (frame and moorings carry several times the radii's
 /// tension; the radii rest at 0.5% on the shape the form finding gives, what
-/// they kept at rest when laid at 2% on the designed one). Thesis: Mehla's own over-extensions (placement over rest length:
-/// spokes 7 on 3 mm, 133%; spiral 75%; inner frame 20 on 15 mm, 33%; outer
-/// frame 5 on 2 mm, 150%), which its soft, heavy springs need to hang taut
-/// (laid at silk's strains they sag below their own frame).
+/// they kept at rest when laid at 2% on the designed one). Thesis: Mehla's
+/// own over-extensions (placement over rest length: spokes 7 on 3 mm, 133%;
+/// spiral 75%; inner frame 20 on 15 mm, 33%; outer frame 5 on 2 mm, 150%),
+/// which its soft, heavy springs need to hang taut (laid at silk's strains
+/// they sag below their own frame).
 SPN_API spn_web_strains spn_web_strains_preset(spn_material_preset preset);
 /// "thesis" or "silk"; SPN_ERR_INVALID naming the choices otherwise.
 SPN_API spn_status spn_material_preset_parse(const char *name, spn_material_preset *out);

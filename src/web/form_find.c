@@ -9,8 +9,8 @@
  * stalls and it falls back to seconds of stepping (docs/web-builders.md,
  * "Settling").
  *
- * Here every thread but the frame and the moorings (radii, hub, signal,
- * capture spiral, stabilimentum) first pulls at its laid tension whatever
+ * Here every thread but the frame, the moorings and bridge lines (radii,
+ * hub, signal, capture spiral, stabilimentum) first pulls at its laid tension whatever
  * its length: a spring of (almost) zero rest length whose stiffness is that
  * tension over its length, a force density. Such a thread cannot go slack,
  * and the static equilibrium of those pulls against the elastic frame and
