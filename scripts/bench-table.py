@@ -56,7 +56,7 @@ KNOWN = {
         ("arithmetic_ns", "arithmetic ns"), ("ns_per_spring_step", "floor ns per spring-step")]),
     "bandwidth": ("Memory bandwidth (bench/bench_bandwidth.c, STREAM-style)", [
         ("kernel", "kernel"), ("threads", "threads"), ("gb_per_s", "GB/s")]),
-    "web_settle": ("A built species web brought to rest (`spn_web_settle`, as `build --settle`; "
+    "web_settle": ("A built species or geometric web brought to rest (`spn_web_settle`, as `build --settle`; "
                    "bench/bench_web_settle.c, 1 thread)", [
         ("species", "species"), ("seed", "seed"), ("build", "web"), ("particles", "particles"),
         ("build_cpu_ms", "build CPU ms"), ("how", "how"), ("converged", "at rest"), ("newton_steps", "Newton steps"),
