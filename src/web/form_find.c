@@ -35,10 +35,9 @@
 /* Webs of more particles are left as designed. The solve's cost grows
  * faster than the web (Zilla webs, CPU s of the build: the default size,
  * 3,000-3,500 particles, 0.03-0.08; 1 m, 48k, 2.1; 2 m, 185k, 6.6 (0.23 as
- * designed); 5 m, over a
- * million, not done after 18 minutes and 3.7 GB), and a build should take
- * seconds; such a web settles as it did before, at the cost of its own
- * settle. */
+ * designed); 5 m, over a million, not done after 18 minutes and 3.7 GB),
+ * and a build should take seconds; such a web settles as it did before, at
+ * the cost of its own settle. */
 #define FORM_FIND_MAX_PARTICLES 200000
 
 static bool elastic(uint32_t tag) { return tag == SPN_THREAD_FRAME || tag == SPN_THREAD_ANCHOR || tag == SPN_THREAD_BRIDGE; }
