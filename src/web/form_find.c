@@ -10,8 +10,8 @@
  * "Settling").
  *
  * Here every thread but the frame, the moorings and bridge lines (radii,
- * hub, signal, capture spiral, stabilimentum) first pulls at its laid tension whatever
- * its length: a spring of (almost) zero rest length whose stiffness is that
+ * hub, signal, capture spiral, stabilimentum) first pulls at its laid
+ * tension whatever its length: a spring of (almost) zero rest length whose stiffness is that
  * tension over its length, a force density. Such a thread cannot go slack,
  * and the static equilibrium of those pulls against the elastic frame and
  * moorings (and gravity) is a well-posed problem Newton solves in a few
@@ -42,9 +42,8 @@
 
 static bool elastic(uint32_t tag) { return tag == SPN_THREAD_FRAME || tag == SPN_THREAD_ANCHOR || tag == SPN_THREAD_BRIDGE; }
 
-spn_status spn__web_form_find(spn_world *w, const double prestrain[SPN_WEB_KINDS], bool *found)
+spn_status spn__web_form_find(spn_world *w, const double prestrain[SPN_WEB_KINDS])
 {
-    *found = false;
     const uint32_t ns = spn_world_spring_count(w), np = spn_world_particle_count(w);
     if (np > FORM_FIND_MAX_PARTICLES) return SPN_OK;
     double *ea = malloc((ns ? ns : 1) * sizeof *ea), *rest = malloc((ns ? ns : 1) * sizeof *rest);
@@ -69,18 +68,18 @@ spn_status spn__web_form_find(spn_world *w, const double prestrain[SPN_WEB_KINDS
     d.max_iterations = FORM_FIND_STEPS;
     spn_equilibrium_report rep;
     spn_status st = spn_world_equilibrium(w, &d, &rep);
-    *found = st == SPN_OK && rep.reason == SPN_EQUILIBRIUM_CONVERGED;
+    const bool found = st == SPN_OK && rep.reason == SPN_EQUILIBRIUM_CONVERGED;
     for (uint32_t s = 0; s < ns; s++) {
         if (ea[s] == 0) continue;
         /* laid at the tension it pulls with in the shape found, so that the
          * web as built is that shape's equilibrium */
         const spn_spring_info si = spn_world_spring(w, s);
-        const double r = *found ? si.length / (1 + si.k * (si.length - si.rest) / ea[s]) : rest[s];
+        const double r = found ? si.length / (1 + si.k * (si.length - si.rest) / ea[s]) : rest[s];
         spn_world_set_spring_rest(w, s, r);
         spn_world_set_spring_stiffness(w, s, ea[s] / r, spn_world_spring_damping(w, s));
     }
     for (uint32_t i = 0; i < np; i++) {
-        if (!*found) spn_world_set_position(w, i, x[i]);
+        if (!found) spn_world_set_position(w, i, x[i]);
         spn_world_set_velocity(w, i, spn_v3(0, 0, 0));
     }
     free(ea), free(rest), free(x);

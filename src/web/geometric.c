@@ -165,14 +165,7 @@ spn_status spn_web_build_geometric(const spn_geometric_def *def, spn_world **out
     spn__meta_num(&m, "G_x", f.g.x);
     spn__meta_num(&m, "G_y", f.g.y);
     spn__meta_num(&m, "segment", def->segment);
-    spn__meta_strains(&m, &def->strains);
-    spn__meta_num(&m, "form_find", def->form_find);
-    st = spn__weaver_finish(&wv, spn__meta_end(&m), out);
+    st = spn__woven_finish(&wv, &m, &def->strains, def->form_find, out);
     spn__meta_free(&m);
-    bool found;
-    if (st == SPN_OK && def->form_find && (st = spn__web_form_find(*out, pre, &found)) != SPN_OK) {
-        spn_world_destroy(*out);
-        *out = NULL;
-    }
     return st;
 }

@@ -418,15 +418,8 @@ spn_status spn_web_build_species(const spn_species_def *def, spn_world **out)
     spn__meta_num(&m, "open_sector", def->open_sector);
     spn__meta_num(&m, "stabilimentum", def->stabilimentum);
     spn__meta_num(&m, "jitter", def->jitter);
-    spn__meta_strains(&m, &def->strains);
-    spn__meta_num(&m, "form_find", def->form_find);
-    st = spn__weaver_finish(&wv, spn__meta_end(&m), out);
+    st = spn__woven_finish(&wv, &m, &def->strains, def->form_find, out);
     spn__meta_free(&m);
-    bool found;
-    if (st == SPN_OK && def->form_find && (st = spn__web_form_find(*out, pre, &found)) != SPN_OK) {
-        spn_world_destroy(*out);
-        *out = NULL;
-    }
     for (int r = 0; r < MAX_RADII; r++) free(w->on[r]);
     spn__layout_free(&w->l);
     free(w);

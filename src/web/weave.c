@@ -298,12 +298,22 @@ void spn__meta_materials(spn__meta *m, const spn_web_materials *mat)
     spn_sink_printf(&m->sink, "}");
 }
 
-void spn__meta_strains(spn__meta *m, const spn_web_strains *s)
+spn_status spn__woven_finish(spn__weaver *wv, spn__meta *m, const spn_web_strains *s, bool form_find, spn_world **out)
 {
     spn__meta_num(m, "prestrain", s->radii);
     spn__meta_num(m, "capture_prestrain", s->capture);
     spn__meta_num(m, "frame_prestrain", s->frame);
     spn__meta_num(m, "anchor_prestrain", s->anchor);
+    spn__meta_num(m, "form_find", form_find);
+    spn_status st = spn__weaver_finish(wv, spn__meta_end(m), out);
+    if (st != SPN_OK || !form_find) return st;
+    double pre[SPN_WEB_KINDS];
+    spn__web_prestrains(s, pre);
+    if ((st = spn__web_form_find(*out, pre)) != SPN_OK) {
+        spn_world_destroy(*out);
+        *out = NULL;
+    }
+    return st;
 }
 
 const char *spn__meta_end(spn__meta *m)

@@ -55,10 +55,11 @@ void spn__web_prestrains(const spn_web_strains *s, double pre[SPN_WEB_KINDS]);
 /* Each of the strains in [0, 4]; the message names the field. */
 spn_status spn__web_check_strains(const spn_web_strains *s);
 /* The woven web's shape with every thread but frame, moorings and bridge
- * pulling at its laid tension, those threads then laid at prestrain[kind]
- * on it (form_find.c); *found false (the web left as laid) where the solve
- * fell short. Errors: out of memory. */
-spn_status spn__web_form_find(spn_world *w, const double prestrain[SPN_WEB_KINDS], bool *found);
+ * pulling at its laid tension (prestrain[kind]), those threads then laid on
+ * it at the tension each pulls with there (form_find.c); the web is left as
+ * laid where the solve falls short or the web is too big. Errors: out of
+ * memory. */
+spn_status spn__web_form_find(spn_world *w, const double prestrain[SPN_WEB_KINDS]);
 /* Strands of the anchor material a woven web's mooring threads are laid of. */
 #define SPN__MOORING_STRANDS 4.0
 /* Divide every line into springs no longer than `segment`, laid
@@ -83,8 +84,12 @@ void spn__meta_num(spn__meta *m, const char *key, double v);
 void spn__meta_str(spn__meta *m, const char *key, const char *v);
 /* Every thread kind's material, as "materials": {kind: {ea, ...}}. */
 void spn__meta_materials(spn__meta *m, const spn_web_materials *mat);
-/* The strains, as "prestrain", "capture_prestrain", "frame_prestrain", "anchor_prestrain". */
-void spn__meta_strains(spn__meta *m, const spn_web_strains *s);
+/* The woven builders' (geometric, species) end: the strains and form_find
+ * into the metadata ("prestrain", "capture_prestrain", "frame_prestrain",
+ * "anchor_prestrain", "form_find"), the world out of the weaver
+ * (spn__weaver_finish), then, if form_find, its shape found
+ * (spn__web_form_find). *out NULL on an error. m stays the caller's. */
+spn_status spn__woven_finish(spn__weaver *wv, spn__meta *m, const spn_web_strains *s, bool form_find, spn_world **out);
 const char *spn__meta_end(spn__meta *m);
 void spn__meta_free(spn__meta *m);
 
