@@ -83,7 +83,8 @@ static int run(web_case c, bool designed)
         return 1;
     }
     printf("{\"bench\":\"web_settle\",\"species\":\"%s\",\"seed\":%llu,\"build\":\"%s\",\"particles\":%u,"
-           "\"springs\":%u,\"threads\":1,\"build_ms\":%.1f,\"build_cpu_ms\":%.1f,\"how\":\"%s\",\"converged\":%s,\"newton_steps\":%d,\"steps\":%llu,\"simulated_s\":%.4g,"
+           "\"springs\":%u,\"threads\":1,\"build_ms\":%.1f,\"build_cpu_ms\":%.1f,\"how\":\"%s\",\"converged\":%s,"
+           "\"newton_steps\":%d,\"steps\":%llu,\"simulated_s\":%.4g,"
            "\"residual_n\":%.3g,\"ms\":%.1f,\"cpu_ms\":%.1f,\"load_average\":%.2f}\n",
            c.anchors ? (c.anchors == 3 ? "geometric, 3 anchors" : "geometric, 4 anchors") : spn_species_name(c.species),
            (unsigned long long)c.seed, designed ? "designed" : "form-found",
