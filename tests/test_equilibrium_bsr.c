@@ -332,7 +332,7 @@ static void test_galerkin_refresh(void **state)
 {
     (void)state;
     check_refresh(400, false); /* chunks with their own windows */
-    check_refresh(400, true);  /* windows across the whole matrix */
+    check_refresh(400, true);  /* each chunk's rows of A P scattered across the whole matrix */
     check_refresh(40, false);
 }
 

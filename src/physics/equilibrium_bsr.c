@@ -459,10 +459,13 @@ done:
 }
 
 /* Scratch of one thread of spn__bsr_galerkin_refresh: the window of A P's
- * rows a chunk of C reads (wstart, wcol, wval; grown as needed), the
- * positions of a row's columns (pos, stamped by seen), and a row of C's sums. */
+ * rows a chunk of C reads (wstart, wcol, wval; grown as needed), gathered:
+ * rows lists them in the order R's rows first read them and slot[k] is row
+ * k's place in it (UINT32_MAX when not in the window). Also the positions of
+ * a row's columns (pos, stamped by seen), and a row of C's sums. */
 typedef struct refresh_scratch {
     uint32_t *seen, *pos, stamp;
+    uint32_t *rows, *slot, nrows;
     uint32_t *wstart, *wcol;
     double *wval, *acc; /* blocks of `stride` numbers, 32-byte aligned */
     size_t wcap, vcap, acap, stride;
@@ -530,13 +533,33 @@ static uint32_t window_cols(const spn__bsr *a, const spn__bsr *p, uint32_t k, si
     return (uint32_t)(w - wn);
 }
 
-/* Rows [lo, hi] of A P into s's window, each block summed over A's then
- * P's entries in their order (spn__blk_mul_add). */
-static bool refresh_window(const spn__bsr *a, const spn__bsr *p, uint32_t lo, uint32_t hi, refresh_scratch *s)
+/* The rows of A P that rows [i0, i1) of R read, into s->rows and s->slot
+ * (the previous chunk's slots cleared first).
+ * Why gathered, not the range between the least and greatest: where
+ * aggregates mix particles numbered far apart (a species web's radii and
+ * capture spiral), that range is most of A P for every chunk, and each
+ * refresh formed A P about once per chunk: 205 s for a 406k-particle web's
+ * form finding, memory growing with it. */
+static void gather_rows(const spn__bsr *r, uint32_t i0, uint32_t i1, refresh_scratch *s)
+{
+    for (uint32_t j = 0; j < s->nrows; j++) s->slot[s->rows[j]] = UINT32_MAX;
+    s->nrows = 0;
+    for (uint32_t q = r->start[i0]; q < r->start[i1]; q++)
+        if (s->slot[r->col[q]] == UINT32_MAX) {
+            s->slot[r->col[q]] = s->nrows;
+            s->rows[s->nrows++] = r->col[q];
+        }
+}
+
+/* The gathered rows of A P into s's window, each block summed over A's then
+ * P's entries in their order (spn__blk_mul_add): a row's sums are the same
+ * whichever chunk forms it. */
+static bool refresh_window(const spn__bsr *a, const spn__bsr *p, refresh_scratch *s)
 {
     size_t wn = 0;
-    for (uint32_t k = lo; k <= hi; k++) {
-        s->wstart[k - lo] = (uint32_t)wn;
+    for (uint32_t j = 0; j < s->nrows; j++) {
+        const uint32_t k = s->rows[j];
+        s->wstart[j] = (uint32_t)wn;
         const uint32_t cnt = window_cols(a, p, k, wn, s);
         if (cnt == UINT32_MAX) return false;
         double ta[9], tp[9];
@@ -547,13 +570,13 @@ static bool refresh_window(const spn__bsr *a, const spn__bsr *p, uint32_t lo, ui
         }
         wn += cnt;
     }
-    s->wstart[hi + 1 - lo] = (uint32_t)wn;
+    s->wstart[s->nrows] = (uint32_t)wn;
     return true;
 }
 
 /* Row I of C's sums (the blocks on and above the diagonal) from the window,
  * then rounded into C. */
-static bool refresh_row(const spn__bsr *r, spn__bsr *c, uint32_t I, uint32_t lo, refresh_scratch *s)
+static bool refresh_row(const spn__bsr *r, spn__bsr *c, uint32_t I, refresh_scratch *s)
 {
     const uint32_t q0 = c->start[I], q1 = c->start[I + 1];
     double *acc = grown_blocks(s->acc, &s->acap, (size_t)(q1 - q0), s->stride);
@@ -564,7 +587,7 @@ static bool refresh_row(const spn__bsr *r, spn__bsr *c, uint32_t I, uint32_t lo,
     double tr[9];
     for (uint32_t q = r->start[I]; q < r->start[I + 1]; q++) {
         const double *rb = spn__bsr_block(r, q, tr);
-        const uint32_t i = r->col[q] - lo;
+        const uint32_t i = s->slot[r->col[q]];
         for (uint32_t t = s->wstart[i]; t < s->wstart[i + 1]; t++)
             if (s->wcol[t] >= I) spn__blk_mul_add(rb, s->wval + 9 * (size_t)t, acc + 9 * (size_t)s->pos[s->wcol[t]]);
     }
@@ -596,12 +619,12 @@ __attribute__((target("avx"))) static inline void blk_mul_add_avx_acc(const __m2
 
 /* refresh_window on 256-bit vectors, the window's blocks in ACC layout (P
  * in float32, as the built hierarchy keeps it; the same order of sums). */
-__attribute__((target("avx"))) static bool refresh_window_avx(const spn__bsr *a, const spn__bsr *p, uint32_t lo,
-                                                              uint32_t hi, refresh_scratch *s)
+__attribute__((target("avx"))) static bool refresh_window_avx(const spn__bsr *a, const spn__bsr *p, refresh_scratch *s)
 {
     size_t wn = 0;
-    for (uint32_t k = lo; k <= hi; k++) {
-        s->wstart[k - lo] = (uint32_t)wn;
+    for (uint32_t j = 0; j < s->nrows; j++) {
+        const uint32_t k = s->rows[j];
+        s->wstart[j] = (uint32_t)wn;
         const uint32_t cnt = window_cols(a, p, k, wn, s);
         if (cnt == UINT32_MAX) return false;
         double ta[9];
@@ -614,12 +637,11 @@ __attribute__((target("avx"))) static bool refresh_window_avx(const spn__bsr *a,
         }
         wn += cnt;
     }
-    s->wstart[hi + 1 - lo] = (uint32_t)wn;
+    s->wstart[s->nrows] = (uint32_t)wn;
     return true;
 }
 
-__attribute__((target("avx"))) static bool refresh_row_avx(const spn__bsr *r, spn__bsr *c, uint32_t I, uint32_t lo,
-                                                           refresh_scratch *s)
+__attribute__((target("avx"))) static bool refresh_row_avx(const spn__bsr *r, spn__bsr *c, uint32_t I, refresh_scratch *s)
 {
     const uint32_t q0 = c->start[I], q1 = c->start[I + 1];
     double *acc = grown_blocks(s->acc, &s->acap, (size_t)(q1 - q0), ACC);
@@ -632,7 +654,7 @@ __attribute__((target("avx"))) static bool refresh_row_avx(const spn__bsr *r, sp
         const double *rb = spn__bsr_block(r, q, tr);
         __m256d av[9];
         for (int m = 0; m < 9; m++) av[m] = _mm256_broadcast_sd(rb + m);
-        const uint32_t i = r->col[q] - lo;
+        const uint32_t i = s->slot[r->col[q]];
         for (uint32_t t = s->wstart[i]; t < s->wstart[i + 1]; t++)
             if (s->wcol[t] >= I) blk_mul_add_avx_acc(av, s->wval + ACC * (size_t)t, acc + ACC * (size_t)s->pos[s->wcol[t]]);
     }
@@ -645,18 +667,16 @@ __attribute__((target("avx"))) static bool refresh_row_avx(const spn__bsr *r, sp
 
 bool spn__bsr_galerkin_refresh(const spn__bsr *a, const spn__bsr *p, const spn__bsr *r, spn__bsr *c, int threads)
 {
-    const uint32_t nc = p->cols, rows = r->rows;
+    const uint32_t n = a->rows, nc = p->cols, rows = r->rows;
     const double products = (double)a->start[a->rows] * p->start[p->rows] / (p->rows ? p->rows : 1);
     const int nt = products < PAR_MIN_PRODUCTS ? 1 : threads;
     const uint32_t chunk = galerkin_chunk(rows, nt), chunks = (rows + chunk - 1) / chunk;
     /* the vector path reads P's float32 blocks straight (the hierarchy's P once built) */
     const bool avx = SPN__AVX && spn__have_avx() && p->fval != NULL;
-    uint32_t widest = 0; /* the most rows a chunk's window has */
+    uint32_t widest = 0; /* the most entries of R a chunk's rows have: a bound on its window's rows */
     for (uint32_t ch = 0; ch < chunks; ch++) {
         const uint32_t i0 = ch * chunk, i1 = i0 + chunk < rows ? i0 + chunk : rows;
-        uint32_t lo, hi;
-        window_of(r, i0, i1, &lo, &hi);
-        if (lo <= hi && hi - lo + 1 > widest) widest = hi - lo + 1;
+        if (r->start[i1] - r->start[i0] > widest) widest = r->start[i1] - r->start[i0];
     }
     int bad = 0;
 #pragma omp parallel num_threads(nt) reduction(+ : bad)
@@ -665,29 +685,29 @@ bool spn__bsr_galerkin_refresh(const spn__bsr *a, const spn__bsr *p, const spn__
         s.stride = avx ? ACC : 9;
         s.seen = malloc((nc ? nc : 1) * sizeof *s.seen);
         s.pos = malloc((nc ? nc : 1) * sizeof *s.pos);
+        s.slot = malloc((n ? n : 1) * sizeof *s.slot);
+        s.rows = malloc(((size_t)widest + 1) * sizeof *s.rows);
         s.wstart = malloc(((size_t)widest + 2) * sizeof *s.wstart);
-        bool ok = s.seen && s.pos && s.wstart;
+        bool ok = s.seen && s.pos && s.slot && s.rows && s.wstart;
         for (uint32_t k = 0; ok && k < nc; k++) s.seen[k] = 0;
+        for (uint32_t k = 0; ok && k < n; k++) s.slot[k] = UINT32_MAX;
 #pragma omp for schedule(dynamic, 1)
         for (uint32_t ch = 0; ch < chunks; ch++) {
             const uint32_t i0 = ch * chunk, i1 = i0 + chunk < rows ? i0 + chunk : rows;
-            uint32_t lo, hi;
-            window_of(r, i0, i1, &lo, &hi);
             if (!ok) continue;
+            gather_rows(r, i0, i1, &s);
 #if SPN__AVX
             if (avx) {
-                if (lo <= hi) ok = refresh_window_avx(a, p, lo, hi, &s);
-                else lo = 0; /* no entries: rows of zeros */
-                for (uint32_t I = i0; ok && I < i1; I++) ok = refresh_row_avx(r, c, I, lo, &s);
+                ok = refresh_window_avx(a, p, &s);
+                for (uint32_t I = i0; ok && I < i1; I++) ok = refresh_row_avx(r, c, I, &s);
                 continue;
             }
 #endif
-            if (lo <= hi) ok = refresh_window(a, p, lo, hi, &s);
-            else lo = 0; /* no entries: rows of zeros */
-            for (uint32_t I = i0; ok && I < i1; I++) ok = refresh_row(r, c, I, lo, &s);
+            ok = refresh_window(a, p, &s);
+            for (uint32_t I = i0; ok && I < i1; I++) ok = refresh_row(r, c, I, &s);
         }
         bad += !ok;
-        free(s.seen), free(s.pos), free(s.wstart), free(s.wcol), free(s.wval), free(s.acc);
+        free(s.seen), free(s.pos), free(s.slot), free(s.rows), free(s.wstart), free(s.wcol), free(s.wval), free(s.acc);
     }
     if (bad) return false;
     mirror_lower(c, threads);

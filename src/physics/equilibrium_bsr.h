@@ -90,7 +90,8 @@ bool spn__bsr_galerkin(const spn__bsr *r, const spn__bsr *ap, spn__bsr *c, int t
  * windows would overlap too much). */
 bool spn__bsr_galerkin_ap(const spn__bsr *a, const spn__bsr *p, const spn__bsr *r, spn__bsr *c, int threads);
 /* C's values again from A's current ones, C = R (A P) with the patterns of
- * C, P and R kept (the hierarchy of a later Newton step): C's blocks are
+ * C, P and R kept (the hierarchy of a later Newton step), C's rows in
+ * chunks, each forming just the rows of A P its rows of R read: C's blocks are
  * written as float32 (fval; C must have been rounded), the blocks of A, P
  * and R read in whatever form they have (spn__bsr_block). Each row of C is
  * summed in a fixed order: the same bits on any team. false on out of
