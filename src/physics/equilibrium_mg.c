@@ -6,7 +6,9 @@
  * Hierarchy: particles are grouped into aggregates over the strong couplings
  * (a block A_ij is strong when |A_ij|_F >= THETA sqrt(|A_ii|_F |A_jj|_F):
  * a root whose strong neighbours are all free takes them, the rest join the
- * aggregate they are most strongly tied to). The tentative prolongator P0
+ * aggregate they are most strongly tied to; a level whose aggregates
+ * come out thin is aggregated again at a lower THETA_THIN, see
+ * THIN_AGGREGATES). The tentative prolongator P0
  * copies an aggregate's three translations to its members: rigid
  * translations are the near-kernel of a taut web (out of plane its operator
  * is a weighted Laplacian, in plane two of them, 50:1 anisotropic). P0 is
@@ -59,6 +61,22 @@
 #include <string.h>
 
 #define THETA 0.08      /* strong coupling (block norms, scaled by the diagonals) */
+/* A level whose aggregates average fewer than THIN_AGGREGATES rows is
+ * aggregated again with the coupling threshold THETA_THIN. Why: threads of
+ * many particles whose ties to the threads they cross fall under THETA
+ * (a species web's form finding, where the capture spiral pulls with a
+ * fraction of the radii's tension) aggregate along each thread alone, three
+ * particles at a time; the next level is then a looser net of the same
+ * kind, and the smoothed stencils densify level after level instead of
+ * shrinking. Zilla webs' form finding, levels' rows (blocks a row) and
+ * setup: 185k particles, 67k (8.6), 26k (54), 5.4k (175) with THETA alone,
+ * 50k (6.0), 6.4k (19), 0.9k (57) with this, CG 39 both ways, 5.2 -> 3.4 s
+ * and 626 -> 423 MB; 406k particles 77 -> 19 s, 2.0 -> 1.0 GB. THETA / 4
+ * was not enough (5.3 s); THETA / 16 and 0 were alike (0: 43 CG). The
+ * standard web coarsens by 5-6 a level and never meets the rule: THETA
+ * itself at 0.005 took its 20k web from 25 to 33 CG. */
+#define THIN_AGGREGATES 3.2
+#define THETA_THIN (THETA / 16)
 #define COARSEST 40u    /* particles on the level solved by dense Cholesky */
 #define DENSE_MAX 300u  /* a coarsest level larger than this (coarsening stalled) gets Gauss-Seidel sweeps instead */
 #define COARSE_SWEEPS 4
@@ -433,6 +451,7 @@ static bool add_level(spn__mg *mg, int l)
     L->agg = spn__big_alloc((n ? n : 1) * sizeof *L->agg);
     if (!L->agg) return false;
     uint32_t nc = aggregate(&L->A, L->agg, THETA, mg->threads);
+    if (nc > 0 && (double)n < THIN_AGGREGATES * nc) nc = aggregate(&L->A, L->agg, THETA_THIN, mg->threads);
     bool ok = nc > 0;
     /* smoothing widens the stencil a level at a time (5, 10, 22, 45 blocks a
      * row on the 100k web, 5, 10, 27, 63 on the 1M web): dense levels keep P0 */
