@@ -32,30 +32,53 @@
  * measured it took 6-29, to 1e-9 N (docs/web-builders.md, "The woven web's
  * shape"). */
 #define FORM_FIND_STEPS 60
-/* Webs of more particles are left as designed. The solve's cost grows
- * faster than the web (Zilla webs, CPU s of the build: the default size,
- * 3,000-3,500 particles, 0.03-0.08; 1 m, 48k, 2.1; 2 m, 185k, 6.6 (0.23 as
- * designed); 5 m, over a million, not done after 18 minutes and 3.7 GB),
- * and a build should take seconds; such a web settles as it did before, at
- * the cost of its own settle. */
-#define FORM_FIND_MAX_PARTICLES 200000
+/* Webs of more particles are left as designed (they settle at the cost of
+ * their own settle). The cap takes in every species web up to the largest
+ * --size: Zilla at 5 m has 1.1M particles. Measured 2026-12-05, build
+ * with form finding, wall s and peak memory: Zilla 1 m (50k particles) 1.0
+ * s, 143 MB; 2 m (185k) 3.7 s, 423 MB; 3 m (406k) 16 s, 1.0 GB; 5 m (1.1M)
+ * 49 s, 2.6 GB; the other species at 5 m (323k-653k) 6-9 s, 0.8-1.1 GB.
+ * Until the multigrid's thin-aggregate rule (equilibrium_mg.c) the 5 m
+ * Zilla web had not finished after 18 minutes and 3.7 GB, and the cap was
+ * 200,000. */
+#define FORM_FIND_MAX_PARTICLES 1500000
+static uint32_t max_particles = FORM_FIND_MAX_PARTICLES;
+static int max_steps = FORM_FIND_STEPS;
+
+uint32_t spn__form_find_set_max_particles(uint32_t particles)
+{
+    const uint32_t old = max_particles;
+    max_particles = particles;
+    return old;
+}
+
+int spn__form_find_set_steps(int steps)
+{
+    const int old = max_steps;
+    max_steps = steps;
+    return old;
+}
 
 static bool elastic(uint32_t tag) { return tag == SPN_THREAD_FRAME || tag == SPN_THREAD_ANCHOR || tag == SPN_THREAD_BRIDGE; }
 
 spn_status spn__web_form_find(spn_world *w, const double prestrain[SPN_WEB_KINDS])
 {
     const uint32_t ns = spn_world_spring_count(w), np = spn_world_particle_count(w);
-    if (np > FORM_FIND_MAX_PARTICLES) return SPN_OK;
+    if (np > max_particles) return SPN_OK;
+    /* each thread's EA (0: not made a force density), rest length and
+     * stiffness as laid, kept to be put back where the solve falls short */
     double *ea = malloc((ns ? ns : 1) * sizeof *ea), *rest = malloc((ns ? ns : 1) * sizeof *rest);
+    double *k = malloc((ns ? ns : 1) * sizeof *k);
     spn_vec3 *x = malloc((np ? np : 1) * sizeof *x);
-    if (!ea || !rest || !x) {
-        free(ea), free(rest), free(x);
+    if (!ea || !rest || !k || !x) {
+        free(ea), free(rest), free(k), free(x);
         return spn_error(SPN_ERR_NOMEM, "out of memory finding the web's shape");
     }
     for (uint32_t i = 0; i < np; i++) x[i] = spn_world_position(w, i);
     for (uint32_t s = 0; s < ns; s++) {
         const spn_spring_info si = spn_world_spring(w, s);
         rest[s] = si.rest;
+        k[s] = si.k;
         ea[s] = 0;
         if (si.broken || elastic(si.tag) || !(si.rest > 0 && si.length > 0)) continue;
         ea[s] = si.k * si.rest;
@@ -65,7 +88,7 @@ spn_status spn__web_form_find(spn_world *w, const double prestrain[SPN_WEB_KINDS
         spn_world_set_spring_stiffness(w, s, ea[s] * pre / (si.length * (1 - 1e-9)), spn_world_spring_damping(w, s));
     }
     spn_equilibrium_def d = spn_equilibrium_def_default();
-    d.max_iterations = FORM_FIND_STEPS;
+    d.max_iterations = max_steps;
     spn_equilibrium_report rep;
     spn_status st = spn_world_equilibrium(w, &d, &rep);
     const bool found = st == SPN_OK && rep.reason == SPN_EQUILIBRIUM_CONVERGED;
@@ -76,12 +99,12 @@ spn_status spn__web_form_find(spn_world *w, const double prestrain[SPN_WEB_KINDS
         const spn_spring_info si = spn_world_spring(w, s);
         const double r = found ? si.length / (1 + si.k * (si.length - si.rest) / ea[s]) : rest[s];
         spn_world_set_spring_rest(w, s, r);
-        spn_world_set_spring_stiffness(w, s, ea[s] / r, spn_world_spring_damping(w, s));
+        spn_world_set_spring_stiffness(w, s, found ? ea[s] / r : k[s], spn_world_spring_damping(w, s));
     }
     for (uint32_t i = 0; i < np; i++) {
         if (!found) spn_world_set_position(w, i, x[i]);
         spn_world_set_velocity(w, i, spn_v3(0, 0, 0));
     }
-    free(ea), free(rest), free(x);
+    free(ea), free(rest), free(k), free(x);
     return st == SPN_ERR_NOMEM ? st : SPN_OK;
 }

@@ -60,6 +60,11 @@ spn_status spn__web_check_strains(const spn_web_strains *s);
  * laid where the solve falls short or the web is too big. Errors: out of
  * memory. */
 spn_status spn__web_form_find(spn_world *w, const double prestrain[SPN_WEB_KINDS]);
+/* For tests: the most particles a web may have to be form-found and the
+ * Newton steps its solve may take (FORM_FIND_MAX_PARTICLES and
+ * FORM_FIND_STEPS until set); each returns the old value. */
+uint32_t spn__form_find_set_max_particles(uint32_t particles);
+int spn__form_find_set_steps(int steps);
 /* Strands of the anchor material a woven web's mooring threads are laid of. */
 #define SPN__MOORING_STRANDS 4.0
 /* Divide every line into springs no longer than `segment`, laid
