@@ -27,6 +27,8 @@ static void usage(FILE *out)
             "  --settle-time S                 at most S simulated seconds (default 30)\n"
             "  --frames DIR                    write PNG frames of the construction into DIR\n"
             "  --frame-count N                 frames of the construction (default 60)\n"
+            "  --as-designed                   geometric and species webs: skip the form finding that\n"
+            "                                  builds them at rest (faster on big webs; settle them after)\n"
             "  --png FILE                      also render the finished web (PNG, SVG or PDF)\n"
             "  -o, --output FILE               the web file to write (.spnw: binary, else JSON)\n\n"
             "physical (thesis values; 1 thesis unit = 1 mm):\n"
@@ -94,7 +96,7 @@ static bool parse_anchors(const char *text, opts *o)
 }
 
 enum { O_ANCHORS = 256, O_METHOD, O_SPECIES, O_PRESET, O_SEED, O_SETTLE, O_SETTLE_TIME, O_FRAMES, O_FRAME_COUNT,
-       O_PROVOT, O_KEEP_AUX, O_PNG, O_NUM };
+       O_PROVOT, O_KEEP_AUX, O_AS_DESIGNED, O_PNG, O_NUM };
 
 /* Numeric options: name, where it goes, range. */
 typedef struct num_opt {
@@ -168,7 +170,8 @@ static int parse(int argc, char **argv, opts *o)
         {"seed", required_argument, NULL, O_SEED},       {"settle", no_argument, NULL, O_SETTLE},
         {"settle-time", required_argument, NULL, O_SETTLE_TIME}, {"frames", required_argument, NULL, O_FRAMES},
         {"frame-count", required_argument, NULL, O_FRAME_COUNT}, {"provot", required_argument, NULL, O_PROVOT},
-        {"keep-aux", no_argument, NULL, O_KEEP_AUX},     {"png", required_argument, NULL, O_PNG},     {"output", required_argument, NULL, 'o'},
+        {"keep-aux", no_argument, NULL, O_KEEP_AUX},     {"as-designed", no_argument, NULL, O_AS_DESIGNED},
+        {"png", required_argument, NULL, O_PNG},         {"output", required_argument, NULL, 'o'},
         {"help", no_argument, NULL, 'h'}};
     for (size_t i = 0; i < sizeof fixed / sizeof fixed[0]; i++) lo[k++] = fixed[i];
     for (size_t i = 0; i < NNUM; i++) lo[k++] = (struct option){nums[i].name, required_argument, NULL, O_NUM + (int)i};
@@ -192,6 +195,7 @@ static int parse(int argc, char **argv, opts *o)
             o->phys.provot = true;
             break;
         case O_KEEP_AUX: o->keep_aux = true; break;
+        case O_AS_DESIGNED: o->geo.form_find = o->sp.form_find = false; break;
         case O_PNG: o->png = optarg; break;
         case ':': return cli_usage(CMD, "option '%s' needs a value", argv[optind - 1]);
         case '?': return cli_usage(CMD, "unknown option '%s'", argv[optind - 1]);
@@ -327,6 +331,9 @@ int cmd_build(int argc, char **argv)
     if (o.method && strcmp(o.method, "physical") != 0 && strcmp(o.method, "geometric") != 0)
         return cli_usage(CMD, "--method: expected physical or geometric, got '%s'", o.method);
     if (o.species && o.method) return cli_usage(CMD, "--species builds its own web; leave out --method");
+    if (!o.sp.form_find && !o.species && (!o.method || strcmp(o.method, "physical") == 0))
+        return cli_usage(CMD, "--as-designed: only geometric and species webs are form-found (the physical builder "
+                              "lays its threads as it goes)");
     spn_world *w = NULL;
     spn_status st = build(&o, &w);
     if (st != SPN_OK && strncmp(spn_last_error(), "anchors:", 8) == 0) /* the builder's word for --anchors */

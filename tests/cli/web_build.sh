@@ -39,6 +39,17 @@ grep -Eq '"prestrain": *1\.333' "$T/t2.json" || fail "the preset's other strains
 "$SPN" build --species araneus -o "$T/s.json" || fail "silk build"
 grep -Eq '"anchor_prestrain": *0\.2[,}]' "$T/s.json" || fail "silk strains expected in the metadata"
 
+# Woven webs are form-found (built at rest) unless --as-designed: then the
+# metadata says so and the web differs; the physical builder has no such step.
+"$SPN" build --species zilla --seed 2 --as-designed -o "$T/d.json" || fail "build --as-designed"
+grep -Eq '"form_find": *(0|false)' "$T/d.json" || fail "--as-designed should be in the metadata"
+grep -Eq '"form_find": *(1|true)' "$T/s.json" || fail "form finding should be on by default"
+"$SPN" build --species zilla --seed 2 -o "$T/z.json" || fail "zilla build"
+cmp -s "$T/d.json" "$T/z.json" && fail "--as-designed should give another web"
+"$SPN" build --method geometric --anchors "0,0.5;-0.45,-0.3;0.45,-0.3" --as-designed -o "$T/gd.json" ||
+    fail "geometric --as-designed"
+grep -Eq '"form_find": *(0|false)' "$T/gd.json" || fail "geometric --as-designed should be in the metadata"
+
 check_bad() { # expected-text args...
     local want=$1; shift
     "$SPN" build "$@" -o "$T/bad.json" 2>"$T/err" && fail "should fail: $*"
@@ -55,5 +66,7 @@ check_bad "\-\-m" --method geometric --anchors "0,0;1,0;0,1" --m 0.7
 check_bad "\-\-k" --method geometric --anchors "0,0;1,0;0,1" --k 46
 check_bad "\-\-t" --method geometric --anchors "0,0;1,0;0,1" --t 0.3
 check_bad "species" --species spidey
+check_bad "\-\-as-designed" --method physical --anchors "0,0;1,0;0,1" --as-designed
+check_bad "\-\-as-designed" --anchors "0,0;1,0;0,1" --as-designed
 check_bad "\-\-anchor-prestrain" --species zilla --anchor-prestrain 5
 echo "web build ok"
