@@ -35,12 +35,12 @@
 /* Webs of more particles are left as designed (they settle at the cost of
  * their own settle). The cap takes in every species web up to the largest
  * --size: Zilla at 5 m has 1.1M particles. Measured 2026-12-05, build
- * with form finding, wall s and peak memory: Zilla 1 m (50k particles) 1.0
- * s, 143 MB; 2 m (185k) 3.7 s, 423 MB; 3 m (406k) 16 s, 1.0 GB; 5 m (1.1M)
- * 49 s, 2.6 GB; the other species at 5 m (323k-653k) 6-9 s, 0.8-1.1 GB.
- * Until the multigrid's thin-aggregate rule (equilibrium_mg.c) the 5 m
- * Zilla web had not finished after 18 minutes and 3.7 GB, and the cap was
- * 200,000. */
+ * with form finding, wall s and peak memory: Zilla 1 m (50k particles) 0.9
+ * s, 143 MB; 2 m (185k) 3.2 s, 424 MB; 3 m (406k) 10 s, 1.0 GB; 5 m (1.1M)
+ * 30 s, 2.6 GB; the other species at 5 m (323k-653k) 6-8 s, 0.8-1.1 GB.
+ * Until the multigrid's thin-aggregate rule (equilibrium_mg.c) and the
+ * halved Newton steps (equilibrium.c) the 5 m Zilla web had not finished
+ * after 18 minutes and 3.7 GB, and the cap was 200,000. */
 #define FORM_FIND_MAX_PARTICLES 1500000
 static uint32_t max_particles = FORM_FIND_MAX_PARTICLES;
 static int max_steps = FORM_FIND_STEPS;
