@@ -530,6 +530,20 @@ static void first_system(spn_world *w, spn_precond kind, spn__eq *e, spn__precon
     assert_int_equal(spn__precond_setup(pc, e), SPN_OK);
 }
 
+/* Rows, blocks and longest row of the first two levels of the multigrid
+ * built for w's first Newton system; free_particles: that system's size. */
+static void first_levels(spn_world *w, uint32_t rows[2], uint32_t blocks[2], uint32_t longest[2],
+                         uint32_t *free_particles)
+{
+    spn__eq e;
+    spn__precond pc;
+    first_system(w, SPN_PRECOND_MULTIGRID, &e, &pc);
+    for (int l = 0; l < 2; l++) assert_true(spn__mg_level(pc.mg, l, &rows[l], &blocks[l], &longest[l]));
+    *free_particles = e.n;
+    spn__precond_free(&pc);
+    spn__eq_free(&e);
+}
+
 /* A hub joins every radial. Smoothed like any other row, its prolongator
  * row reaches all the aggregates around it, and the Galerkin product R A P
  * makes every one of them a neighbour of every other on the next level (on
@@ -542,18 +556,12 @@ static void test_hub_row_makes_no_dense_level(void **state)
 {
     (void)state;
     spn_world *w = small_orb(12, 400, 0.02, 1);
-    spn__eq e;
-    spn__precond pc;
-    first_system(w, SPN_PRECOND_MULTIGRID, &e, &pc);
-    uint32_t rows0, blocks0, longest0, rows1, blocks1, longest1;
-    assert_true(spn__mg_level(pc.mg, 0, &rows0, &blocks0, &longest0));
-    assert_true(spn__mg_level(pc.mg, 1, &rows1, &blocks1, &longest1));
-    assert_int_equal(rows0, e.n);
-    assert_true(longest0 >= 400); /* the hub's row */
-    assert_true(rows1 > 100 && rows1 < rows0 / 2);
-    assert_true((double)blocks1 / rows1 < 25);
-    spn__precond_free(&pc);
-    spn__eq_free(&e);
+    uint32_t rows[2], blocks[2], longest[2], free_particles;
+    first_levels(w, rows, blocks, longest, &free_particles);
+    assert_int_equal(rows[0], free_particles);
+    assert_true(longest[0] >= 400); /* the hub's row */
+    assert_true(rows[1] > 100 && rows[1] < rows[0] / 2);
+    assert_true((double)blocks[1] / rows[1] < 25);
     spn_world_destroy(w);
 }
 
@@ -601,17 +609,12 @@ static void test_thin_aggregates_are_formed_again(void **state)
 {
     (void)state;
     spn_world *w = anisotropic_net(60, 0.03);
-    spn__eq e;
-    spn__precond pc;
-    first_system(w, SPN_PRECOND_MULTIGRID, &e, &pc);
-    uint32_t rows0, blocks0, longest0, rows1, blocks1, longest1;
-    assert_true(spn__mg_level(pc.mg, 0, &rows0, &blocks0, &longest0));
-    assert_true(spn__mg_level(pc.mg, 1, &rows1, &blocks1, &longest1));
-    print_message("level 0: %u rows; level 1: %u rows, %.1f blocks a row\n", rows0, rows1, (double)blocks1 / rows1);
-    assert_int_equal(rows0, 58u * 58u);
-    assert_true(rows1 * 5 < rows0);
-    spn__precond_free(&pc);
-    spn__eq_free(&e);
+    uint32_t rows[2], blocks[2], longest[2], free_particles;
+    first_levels(w, rows, blocks, longest, &free_particles);
+    print_message("level 0: %u rows; level 1: %u rows, %.1f blocks a row\n", rows[0], rows[1],
+                  (double)blocks[1] / rows[1]);
+    assert_int_equal(rows[0], 58u * 58u);
+    assert_true(rows[1] * 5 < rows[0]);
     spn_equilibrium_def d = spn_equilibrium_def_default();
     d.preconditioner = SPN_PRECOND_MULTIGRID;
     d.load = spn_v3(0, 0, -1e-3);
