@@ -7,8 +7,9 @@
  * (a block A_ij is strong when |A_ij|_F >= THETA sqrt(|A_ii|_F |A_jj|_F):
  * a root whose strong neighbours are all free takes them, the rest join the
  * aggregate they are most strongly tied to; a level whose aggregates
- * come out thin is aggregated again at a lower THETA_THIN, see
- * THIN_AGGREGATES). The tentative prolongator P0
+ * come out thin is aggregated again at a lower THETA_THIN, and if still
+ * thin its aggregates are aggregated: THIN_AGGREGATES). The tentative
+ * prolongator P0
  * copies an aggregate's three translations to its members: rigid
  * translations are the near-kernel of a taut web (out of plane its operator
  * is a weighted Laplacian, in plane two of them, 50:1 anisotropic). P0 is
@@ -74,7 +75,16 @@
  * and 626 -> 423 MB; 406k particles 77 -> 19 s, 2.0 -> 1.0 GB. THETA / 4
  * was not enough (5.3 s); THETA / 16 and 0 were alike (0: 43 CG). The
  * standard web coarsens by 5-6 a level and never meets the rule: THETA
- * itself at 0.005 took its 20k web from 25 to 33 CG. */
+ * itself at 0.005 took its 20k web from 25 to 33 CG.
+ * Where the aggregates are still thin, every tie was strong already: a web
+ * whose threads are chains of many particles (a species web at rest, where
+ * the settle solves it) aggregates three to a chain at any threshold. Then
+ * the aggregates themselves are aggregated (aggregate_again). Zilla 2 m at
+ * rest (185k particles), the settle's solve: levels 67k, 26k (54 blocks a
+ * row), 5.3k (176) -> 11.7k (10.5), 1.1k, 272; CG 22 -> 34, but
+ * `spinneret settle --method equilibrium` 4.5 -> 2.0-2.5 s and 615 -> 380
+ * MB; `build --settle` 2 m 9.1 -> 6.0 s, 3 m 24.5 -> 15.7 s, 5 m (1.1M)
+ * 106 s and 5.9 GB -> 57 s and 2.6 GB. */
 #define THIN_AGGREGATES 3.2
 #define THETA_THIN (THETA / 16)
 #define COARSEST 40u    /* particles on the level solved by dense Cholesky */
@@ -305,6 +315,65 @@ static uint32_t aggregate(const spn__bsr *a, uint32_t *agg, double theta, int th
     return na;
 }
 
+/* Aggregates of the aggregates in agg (nc of them): two aggregates are
+ * neighbours when a block of A joins their members, tied as strongly as the
+ * sum of those blocks' norms; they are grouped by aggregate()'s rule with
+ * every tie strong (a root whose neighbours are all free takes them, the
+ * rest join their most strongly tied neighbour's group, an isolated one
+ * stays alone), in the order of the aggregates. agg is rewritten to the
+ * groups; returns their number (0: out of memory). */
+static uint32_t aggregate_again(const spn__bsr *a, uint32_t *agg, uint32_t nc)
+{
+    const uint32_t n = a->rows, NONE = UINT32_MAX;
+    uint32_t *first = calloc((size_t)nc + 1, sizeof *first), *member = malloc((n ? n : 1) * sizeof *member);
+    uint32_t *group = malloc((nc ? nc : 1) * sizeof *group), *seen = malloc((nc ? nc : 1) * sizeof *seen);
+    double *tie = malloc((nc ? nc : 1) * sizeof *tie);
+    uint32_t ng = 0, stamp = 0;
+    if (!first || !member || !group || !seen || !tie) goto done;
+    for (uint32_t i = 0; i < n; i++) first[agg[i] + 1]++;
+    for (uint32_t k = 0; k < nc; k++) first[k + 1] += first[k];
+    for (uint32_t i = 0; i < n; i++) member[first[agg[i]]++] = i;
+    for (uint32_t k = nc; k > 0; k--) first[k] = first[k - 1];
+    first[0] = 0;
+    for (uint32_t k = 0; k < nc; k++) group[k] = NONE, seen[k] = 0;
+    for (int pass = 0; pass < 2; pass++)
+        for (uint32_t K = 0; K < nc; K++) {
+            if (group[K] != NONE) continue;
+            /* K's neighbours, each once (seen), with the sum of their ties */
+            bool free_all = true, any = false;
+            uint32_t best = NONE;
+            stamp++;
+            for (uint32_t m = first[K]; m < first[K + 1]; m++)
+                for (uint32_t q = a->start[member[m]]; q < a->start[member[m] + 1]; q++) {
+                    const uint32_t J = agg[a->col[q]];
+                    if (J == K) continue;
+                    double tmp[9];
+                    const double t = fro(spn__bsr_block(a, q, tmp));
+                    if (seen[J] != stamp) seen[J] = stamp, tie[J] = 0;
+                    tie[J] += t;
+                    any = true;
+                    free_all = free_all && group[J] == NONE;
+                }
+            if (pass == 0 && any && free_all) { /* a root: takes its neighbours */
+                for (uint32_t m = first[K]; m < first[K + 1]; m++)
+                    for (uint32_t q = a->start[member[m]]; q < a->start[member[m] + 1]; q++)
+                        if (agg[a->col[q]] != K) group[agg[a->col[q]]] = ng;
+                group[K] = ng++;
+            } else if (pass == 1) { /* joins its most strongly tied neighbour's group, or stays alone */
+                for (uint32_t m = first[K]; m < first[K + 1]; m++)
+                    for (uint32_t q = a->start[member[m]]; q < a->start[member[m] + 1]; q++) {
+                        const uint32_t J = agg[a->col[q]];
+                        if (J != K && group[J] != NONE && (best == NONE || tie[J] > tie[best])) best = J;
+                    }
+                group[K] = best != NONE ? group[best] : ng++;
+            }
+        }
+    for (uint32_t i = 0; i < n; i++) agg[i] = group[agg[i]];
+done:
+    free(first), free(member), free(group), free(seen), free(tie);
+    return ng;
+}
+
 /* ---- prolongator and coarse operator ------------------------------------- */
 
 static bool level_inverse(const mg_level *L)
@@ -452,6 +521,7 @@ static bool add_level(spn__mg *mg, int l)
     if (!L->agg) return false;
     uint32_t nc = aggregate(&L->A, L->agg, THETA, mg->threads);
     if (nc > 0 && (double)n < THIN_AGGREGATES * nc) nc = aggregate(&L->A, L->agg, THETA_THIN, mg->threads);
+    if (nc > 0 && (double)n < THIN_AGGREGATES * nc) nc = aggregate_again(&L->A, L->agg, nc);
     bool ok = nc > 0;
     /* smoothing widens the stencil a level at a time (5, 10, 22, 45 blocks a
      * row on the 100k web, 5, 10, 27, 63 on the 1M web): dense levels keep P0 */
