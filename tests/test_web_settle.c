@@ -408,7 +408,8 @@ static double web_difference(const spn_world *a, const spn_world *b)
  * step, where Zilla seed 2 takes about 15) or the web has more particles
  * than the form finding takes (here the cap set one under the web's), the
  * web is left as designed: positions, rest lengths and stiffnesses the same
- * bits as the web built with form_find off. The web form-found differs. */
+ * bits as the web built with form_find off, and its metadata says so
+ * ("form_found": 0). The web form-found differs. */
 static void test_form_find_falls_back_to_the_design(void **state)
 {
     (void)state;
@@ -420,6 +421,8 @@ static void test_form_find_falls_back_to_the_design(void **state)
     d.form_find = true;
     assert_int_equal(spn_web_build_species(&d, &found), SPN_OK);
     assert_true(web_difference(designed, found) > 1e-3);
+    assert_non_null(strstr(spn_world_metadata(found), "\"form_found\": 1"));
+    assert_non_null(strstr(spn_world_metadata(designed), "\"form_found\": 0"));
     for (int c = 0; c < 2; c++) {
         const int old_steps = c == 0 ? spn__form_find_set_steps(1) : 0;
         const uint32_t old_max = c == 1 ? spn__form_find_set_max_particles(spn_world_particle_count(designed) - 1) : 0;
@@ -429,6 +432,8 @@ static void test_form_find_falls_back_to_the_design(void **state)
         else spn__form_find_set_max_particles(old_max);
         assert_int_equal(st, SPN_OK);
         assert_true(web_difference(designed, w) == 0);
+        assert_non_null(strstr(spn_world_metadata(w), "\"form_find\": 1")); /* asked for */
+        assert_non_null(strstr(spn_world_metadata(w), "\"form_found\": 0")); /* and not done */
         spn_world_destroy(w);
     }
     spn_world_destroy(designed), spn_world_destroy(found);

@@ -159,7 +159,8 @@ typedef struct spn_geometric_def {
     bool form_find;            ///< default true: find the web's shape with every thread but frame and
                                ///< moorings pulling at its laid tension, then lay them on it
                                ///< (docs/web-builders.md, "The woven web's shape"); false: as designed.
-                               ///< Webs of more than 200,000 particles are left as designed.
+                               ///< Webs of more than 1,500,000 particles, and webs whose solve falls
+                               ///< short, are left as designed: metadata "form_found" says which.
     uint64_t seed;             ///< default 1
     spn_world_def world;
 } spn_geometric_def;

@@ -61,9 +61,10 @@ int spn__form_find_set_steps(int steps)
 
 static bool elastic(uint32_t tag) { return tag == SPN_THREAD_FRAME || tag == SPN_THREAD_ANCHOR || tag == SPN_THREAD_BRIDGE; }
 
-spn_status spn__web_form_find(spn_world *w, const double prestrain[SPN_WEB_KINDS])
+spn_status spn__web_form_find(spn_world *w, const double prestrain[SPN_WEB_KINDS], bool *found_out)
 {
     const uint32_t ns = spn_world_spring_count(w), np = spn_world_particle_count(w);
+    *found_out = false;
     if (np > max_particles) return SPN_OK;
     /* each thread's EA (0: not made a force density), rest length and
      * stiffness as laid, kept to be put back where the solve falls short */
@@ -106,5 +107,6 @@ spn_status spn__web_form_find(spn_world *w, const double prestrain[SPN_WEB_KINDS
         spn_world_set_velocity(w, i, spn_v3(0, 0, 0));
     }
     free(ea), free(rest), free(k), free(x);
+    *found_out = found;
     return st == SPN_ERR_NOMEM ? st : SPN_OK;
 }

@@ -305,11 +305,18 @@ spn_status spn__woven_finish(spn__weaver *wv, spn__meta *m, const spn_web_strain
     spn__meta_num(m, "frame_prestrain", s->frame);
     spn__meta_num(m, "anchor_prestrain", s->anchor);
     spn__meta_num(m, "form_find", form_find);
-    spn_status st = spn__weaver_finish(wv, spn__meta_end(m), out);
-    if (st != SPN_OK || !form_find) return st;
-    double pre[SPN_WEB_KINDS];
-    spn__web_prestrains(s, pre);
-    if ((st = spn__web_form_find(*out, pre)) != SPN_OK) {
+    spn_status st = spn__weaver_finish(wv, NULL, out);
+    bool found = false;
+    if (st == SPN_OK && form_find) {
+        double pre[SPN_WEB_KINDS];
+        spn__web_prestrains(s, pre);
+        st = spn__web_form_find(*out, pre, &found);
+    }
+    /* form_found: whether the web was laid on the shape found (0 where it was
+     * left as designed: not asked for, the solve fell short, or too big) */
+    spn__meta_num(m, "form_found", found);
+    if (st == SPN_OK) st = spn_world_set_metadata(*out, spn__meta_end(m));
+    if (st != SPN_OK && *out) {
         spn_world_destroy(*out);
         *out = NULL;
     }

@@ -57,9 +57,9 @@ spn_status spn__web_check_strains(const spn_web_strains *s);
 /* The woven web's shape with every thread but frame, moorings and bridge
  * pulling at its laid tension (prestrain[kind]), those threads then laid on
  * it at the tension each pulls with there (form_find.c); the web is left as
- * laid where the solve falls short or the web is too big. Errors: out of
- * memory. */
-spn_status spn__web_form_find(spn_world *w, const double prestrain[SPN_WEB_KINDS]);
+ * laid where the solve falls short or the web is too big (*found false).
+ * Errors: out of memory. */
+spn_status spn__web_form_find(spn_world *w, const double prestrain[SPN_WEB_KINDS], bool *found);
 /* For tests: the most particles a web may have to be form-found and the
  * Newton steps its solve may take (FORM_FIND_MAX_PARTICLES and
  * FORM_FIND_STEPS until set); each returns the old value. */

@@ -45,6 +45,8 @@ grep -Eq '"anchor_prestrain": *0\.2[,}]' "$T/s.json" || fail "silk strains expec
 grep -Eq '"form_find": *(0|false)' "$T/d.json" || fail "--as-designed should be in the metadata"
 grep -Eq '"form_find": *(1|true)' "$T/s.json" || fail "form finding should be on by default"
 "$SPN" build --species zilla --seed 2 -o "$T/z.json" || fail "zilla build"
+grep -Eq '"form_found": *1' "$T/z.json" || fail "the web found should say so in its metadata"
+grep -Eq '"form_found": *0' "$T/d.json" || fail "the web as designed should say it was not form-found"
 cmp -s "$T/d.json" "$T/z.json" && fail "--as-designed should give another web"
 "$SPN" build --method geometric --anchors "0,0.5;-0.45,-0.3;0.45,-0.3" --as-designed -o "$T/gd.json" ||
     fail "geometric --as-designed"
