@@ -11,16 +11,16 @@
  *
  * Here every thread but the frame, the moorings and bridge lines (radii,
  * hub, signal, capture spiral, stabilimentum) first pulls at its laid
- * tension whatever its length: a spring of (almost) zero rest length whose stiffness is that
- * tension over its length, a force density. Such a thread cannot go slack,
- * and the static equilibrium of those pulls against the elastic frame and
- * moorings (and gravity) is a well-posed problem Newton solves in a few
- * steps. Each thread is then laid on the shape found at the tension it
- * pulls with there (its laid tension, changed by as much as its length
- * changed), so the web as built is at rest, every radius taut. Frame and
- * mooring threads keep the rest lengths they were laid with. Where the solve
- * falls short, and on webs of more than FORM_FIND_MAX_PARTICLES particles,
- * the web is left as laid. */
+ * tension whatever its length: a spring of (almost) zero rest length whose
+ * stiffness is that tension over its length, a force density. Such a thread
+ * cannot go slack, and the static equilibrium of those pulls against the
+ * elastic frame and moorings (and gravity) is a well-posed problem Newton
+ * solves in a few steps. Each thread is then laid on the shape found at the
+ * tension it pulls with there (its laid tension, changed by as much as its
+ * length changed), so the web as built is at rest, every radius taut. Frame
+ * and mooring threads keep the rest lengths they were laid with. Where the
+ * solve falls short, and on webs of more than FORM_FIND_MAX_PARTICLES
+ * particles, the web is left as laid. */
 #include "web_internal.h"
 
 #include "spinneret/equilibrium.h"

@@ -89,11 +89,12 @@ void spn__meta_num(spn__meta *m, const char *key, double v);
 void spn__meta_str(spn__meta *m, const char *key, const char *v);
 /* Every thread kind's material, as "materials": {kind: {ea, ...}}. */
 void spn__meta_materials(spn__meta *m, const spn_web_materials *mat);
-/* The woven builders' (geometric, species) end: the strains and form_find
- * into the metadata ("prestrain", "capture_prestrain", "frame_prestrain",
- * "anchor_prestrain", "form_find"), the world out of the weaver
- * (spn__weaver_finish), then, if form_find, its shape found
- * (spn__web_form_find). *out NULL on an error. m stays the caller's. */
+/* The woven builders' (geometric, species) end: the world out of the
+ * weaver (spn__weaver_finish), then, if form_find, its shape found
+ * (spn__web_form_find), then the metadata set, with the strains and the
+ * outcome added ("prestrain", "capture_prestrain", "frame_prestrain",
+ * "anchor_prestrain", "form_find": asked for, "form_found": done). *out
+ * NULL on an error. m stays the caller's. */
 spn_status spn__woven_finish(spn__weaver *wv, spn__meta *m, const spn_web_strains *s, bool form_find, spn_world **out);
 const char *spn__meta_end(spn__meta *m);
 void spn__meta_free(spn__meta *m);
