@@ -18,7 +18,8 @@
  * (spn__bsr_galerkin_refresh), with P and R in float32 as the built
  * hierarchy holds them: the same floats as rounding the product above of
  * the same P, on one and two threads, both numberings, and after A's values
- * change (what it is for). */
+ * change (what it is for), with its scratch made afresh and kept from the
+ * call before (as the hierarchy keeps it between Newton steps). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -296,6 +297,7 @@ static void check_refresh(uint32_t side, bool scrambled)
     for (size_t k = 0; k < np; k++) p.val[k] = (float)p.val[k]; /* P as its float32 copy will read */
     uint32_t *perm;
     assert_true(spn__bsr_transpose(&p, &r, &perm));
+    spn__bsr_refresh *kept[2] = {NULL, NULL}; /* each team's scratch, kept as a Newton step keeps it for the next */
     for (int change = 0; change < 2; change++) {
         if (change) /* new values in A's pattern: every third diagonal block stiffer (still symmetric) */
             for (uint32_t i = 0; i < g.a.rows; i += 3)
@@ -314,15 +316,17 @@ static void check_refresh(uint32_t side, bool scrambled)
         assert_non_null(pf.fval);
         for (size_t k = 0; k < np; k++) pf.fval[k] = (float)p.val[k];
         pf.fval[np] = 0;
-        for (int t = 1; t <= 2; t++) {
-            memset(c.fval, 0xff, (nc + 1) * sizeof *c.fval); /* NaN: every block must be written */
-            assert_true(spn__bsr_galerkin_refresh(&g.a, &pf, &r, &c, t));
-            for (size_t k = 0; k < nc; k++) assert_true(c.fval[k] == (float)ref.val[k]);
-        }
+        for (int t = 1; t <= 2; t++)
+            for (int use = 0; use < 2; use++) { /* without scratch kept, and with it (from the first values on) */
+                memset(c.fval, 0xff, (nc + 1) * sizeof *c.fval); /* NaN: every block must be written */
+                assert_true(spn__bsr_galerkin_refresh(&g.a, &pf, &r, &c, t, use ? &kept[t - 1] : NULL));
+                for (size_t k = 0; k < nc; k++) assert_true(c.fval[k] == (float)ref.val[k]);
+            }
         free(pf.fval);
         free(c.fval);
         spn__bsr_free(&ref);
     }
+    spn__bsr_refresh_free(kept[0]), spn__bsr_refresh_free(kept[1]);
     spn__bsr_free(&r), spn__bsr_free(&p);
     free(perm);
     free_grid(&g);

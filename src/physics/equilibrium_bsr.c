@@ -665,7 +665,56 @@ __attribute__((target("avx"))) static bool refresh_row_avx(const spn__bsr *r, sp
 }
 #endif
 
-bool spn__bsr_galerkin_refresh(const spn__bsr *a, const spn__bsr *p, const spn__bsr *r, spn__bsr *c, int threads)
+/* The scratch of every thread of spn__bsr_galerkin_refresh, kept between
+ * calls on one level (spn__bsr_refresh_keep). */
+struct spn__bsr_refresh {
+    int threads;
+    uint32_t n, nc, widest;
+    refresh_scratch s[];
+};
+
+static void scratch_free(refresh_scratch *s)
+{
+    free(s->seen), free(s->pos), free(s->slot), free(s->rows), free(s->wstart), free(s->wcol), free(s->wval), free(s->acc);
+    memset(s, 0, sizeof *s);
+}
+
+void spn__bsr_refresh_free(spn__bsr_refresh *k)
+{
+    if (!k) return;
+    for (int t = 0; t < k->threads; t++) scratch_free(&k->s[t]);
+    free(k);
+}
+
+/* s ready for a refresh of a level of n rows and nc coarse ones whose
+ * chunks read at most widest rows of R (stride: numbers a window block). A
+ * scratch kept from an earlier call keeps its window and sums: they were
+ * grown to that call's needs, which are this one's (the patterns are the
+ * same), and growing them again each Newton step cost a copy and fresh
+ * pages each time. */
+static bool scratch_ready(refresh_scratch *s, uint32_t n, uint32_t nc, uint32_t widest, size_t stride)
+{
+    if (s->seen && s->stride == stride) {
+        if (s->stamp < UINT32_MAX - n) return true; /* the stamps of one call: at most n */
+        for (uint32_t k = 0; k < nc; k++) s->seen[k] = 0;
+        s->stamp = 0;
+        return true;
+    }
+    scratch_free(s);
+    s->stride = stride;
+    s->seen = malloc((nc ? nc : 1) * sizeof *s->seen);
+    s->pos = malloc((nc ? nc : 1) * sizeof *s->pos);
+    s->slot = malloc((n ? n : 1) * sizeof *s->slot);
+    s->rows = malloc(((size_t)widest + 1) * sizeof *s->rows);
+    s->wstart = malloc(((size_t)widest + 2) * sizeof *s->wstart);
+    if (!(s->seen && s->pos && s->slot && s->rows && s->wstart)) return false;
+    for (uint32_t k = 0; k < nc; k++) s->seen[k] = 0;
+    for (uint32_t k = 0; k < n; k++) s->slot[k] = UINT32_MAX;
+    return true;
+}
+
+bool spn__bsr_galerkin_refresh(const spn__bsr *a, const spn__bsr *p, const spn__bsr *r, spn__bsr *c, int threads,
+                               spn__bsr_refresh **keep)
 {
     const uint32_t n = a->rows, nc = p->cols, rows = r->rows;
     const double products = (double)a->start[a->rows] * p->start[p->rows] / (p->rows ? p->rows : 1);
@@ -678,36 +727,42 @@ bool spn__bsr_galerkin_refresh(const spn__bsr *a, const spn__bsr *p, const spn__
         const uint32_t i0 = ch * chunk, i1 = i0 + chunk < rows ? i0 + chunk : rows;
         if (r->start[i1] - r->start[i0] > widest) widest = r->start[i1] - r->start[i0];
     }
+    spn__bsr_refresh *k = keep ? *keep : NULL;
+    if (k && !(k->threads == nt && k->n == n && k->nc == nc && k->widest == widest)) {
+        spn__bsr_refresh_free(k); /* another level's or team's: not this call's */
+        k = *keep = NULL;
+    }
+    if (!k) {
+        k = calloc(1, sizeof *k + (size_t)nt * sizeof *k->s);
+        if (!k) return false;
+        k->threads = nt, k->n = n, k->nc = nc, k->widest = widest;
+    }
     int bad = 0;
 #pragma omp parallel num_threads(nt) reduction(+ : bad)
     {
-        refresh_scratch s = {0};
-        s.stride = avx ? ACC : 9;
-        s.seen = malloc((nc ? nc : 1) * sizeof *s.seen);
-        s.pos = malloc((nc ? nc : 1) * sizeof *s.pos);
-        s.slot = malloc((n ? n : 1) * sizeof *s.slot);
-        s.rows = malloc(((size_t)widest + 1) * sizeof *s.rows);
-        s.wstart = malloc(((size_t)widest + 2) * sizeof *s.wstart);
-        bool ok = s.seen && s.pos && s.slot && s.rows && s.wstart;
-        for (uint32_t k = 0; ok && k < nc; k++) s.seen[k] = 0;
-        for (uint32_t k = 0; ok && k < n; k++) s.slot[k] = UINT32_MAX;
+        refresh_scratch *s = &k->s[spn__thread_num()];
+        bool ok = scratch_ready(s, n, nc, widest, avx ? ACC : 9);
 #pragma omp for schedule(dynamic, 1)
         for (uint32_t ch = 0; ch < chunks; ch++) {
             const uint32_t i0 = ch * chunk, i1 = i0 + chunk < rows ? i0 + chunk : rows;
             if (!ok) continue;
-            gather_rows(r, i0, i1, &s);
+            gather_rows(r, i0, i1, s);
 #if SPN__AVX
             if (avx) {
-                ok = refresh_window_avx(a, p, &s);
-                for (uint32_t I = i0; ok && I < i1; I++) ok = refresh_row_avx(r, c, I, &s);
+                ok = refresh_window_avx(a, p, s);
+                for (uint32_t I = i0; ok && I < i1; I++) ok = refresh_row_avx(r, c, I, s);
                 continue;
             }
 #endif
-            ok = refresh_window(a, p, &s);
-            for (uint32_t I = i0; ok && I < i1; I++) ok = refresh_row(r, c, I, &s);
+            ok = refresh_window(a, p, s);
+            for (uint32_t I = i0; ok && I < i1; I++) ok = refresh_row(r, c, I, s);
         }
         bad += !ok;
-        free(s.seen), free(s.pos), free(s.slot), free(s.rows), free(s.wstart), free(s.wcol), free(s.wval), free(s.acc);
+    }
+    if (keep && !bad) *keep = k;
+    else {
+        spn__bsr_refresh_free(k);
+        if (keep) *keep = NULL;
     }
     if (bad) return false;
     mirror_lower(c, threads);

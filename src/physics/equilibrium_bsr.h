@@ -96,7 +96,13 @@ bool spn__bsr_galerkin_ap(const spn__bsr *a, const spn__bsr *p, const spn__bsr *
  * and R read in whatever form they have (spn__bsr_block). Each row of C is
  * summed in a fixed order: the same bits on any team. false on out of
  * memory. */
-bool spn__bsr_galerkin_refresh(const spn__bsr *a, const spn__bsr *p, const spn__bsr *r, spn__bsr *c, int threads);
+/* keep: NULL, or where the threads' scratch (the windows of A P, the row
+ * sums) is kept for the next call on the same level, created on the first;
+ * free it with spn__bsr_refresh_free. */
+typedef struct spn__bsr_refresh spn__bsr_refresh;
+bool spn__bsr_galerkin_refresh(const spn__bsr *a, const spn__bsr *p, const spn__bsr *r, spn__bsr *c, int threads,
+                               spn__bsr_refresh **keep);
+void spn__bsr_refresh_free(spn__bsr_refresh *keep);
 /* T = A^T (A in float64): its pattern, and perm[k], the entry of A that
  * T's entry k comes from. T's values are read from A through perm (no copy:
  * the Galerkin product is the only reader of R = P^T in float64) until

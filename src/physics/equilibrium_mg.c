@@ -129,6 +129,7 @@ typedef struct mg_level {
     double omega;       /* prolongator smoothing damping */
     spn__bsr P, R;      /* P = (I - omega D^-1 A) P0 (or P0), R = P^T */
     spn__lines *lines;  /* NULL: point Gauss-Seidel */
+    spn__bsr_refresh *keep; /* the scratch of forming the next level again (refresh), kept between Newton steps */
 } mg_level;
 
 struct spn__mg {
@@ -587,6 +588,7 @@ void spn__mg_free(spn__mg *mg)
         spn__bsr_free(&L->A), spn__bsr_free(&L->P), spn__bsr_free(&L->R);
         free(L->agg), free(L->x), free(L->b), free(L->r);
         spn__lines_free(L->lines);
+        spn__bsr_refresh_free(L->keep);
         if (l > 0) free(L->dinv);
     }
     free(mg->map0);
@@ -679,7 +681,7 @@ static spn_status refresh(spn__mg *mg)
 {
     for (int l = 0; l + 1 < mg->nlevels; l++) {
         mg_level *L = &mg->lv[l], *C = &mg->lv[l + 1];
-        if (!spn__bsr_galerkin_refresh(&L->A, &L->P, &L->R, &C->A, mg->threads)) return SPN_ERR_NOMEM;
+        if (!spn__bsr_galerkin_refresh(&L->A, &L->P, &L->R, &C->A, mg->threads, &L->keep)) return SPN_ERR_NOMEM;
         if (!level_inverse(C)) return SPN_ERR_UNSTABLE;
     }
     if (mg->dense && !dense_factor(mg)) return SPN_ERR_UNSTABLE;
