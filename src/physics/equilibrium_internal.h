@@ -55,7 +55,7 @@ typedef struct spn__eq {
     int32_t *lane_col;    /* SPN__EQ_LANES per slot: adj_col, or the row itself past a row's end */
     double *lane_val;     /* 6 SPN__EQ_LANES per slot: entry f of lane q at (6 slot + f) LANES + q */
     double *lane_diag;    /* 6 SPN__EQ_LANES per group, likewise */
-    float *lane_val32, *lane_diag32; /* the same rounded to float32, or NULL (spn__eq_matvec_mg) */
+    float *lane_val32, *lane_diag32; /* the same rounded to float32 once the multigrid asks (spn__eq_lanes32), or NULL */
     double *kscale; /* n: sum of incident k, the scale of the Levenberg shift */
     double lambda;  /* the shift of the last assembly */
     double *f;    /* 3 n: net force = -gradient */
@@ -102,6 +102,9 @@ double spn__eq_slack_limit(const spn__eq *e, const double *p, double cap);
 /* The product's lane copy of diag and offd (equilibrium_product.c): its
  * layout, made once; row i's blocks copied in after each assembly. */
 spn_status spn__eq_build_lanes(spn__eq *e);
+/* The lanes' float32 copy (lane_val32) from MATVEC32_MIN rows, made on first
+ * call (the multigrid's); then kept by spn__eq_lanes_store. */
+spn_status spn__eq_lanes32(spn__eq *e);
 void spn__eq_lanes_store(spn__eq *e, uint32_t i);
 /* y = A p over free particles; the _dot form also returns p . y
  * (equilibrium_product.c). */
@@ -127,7 +130,7 @@ typedef struct spn__precond {
     spn__cyc *cyc; /* SPN_PRECOND_CYCLIC: built by the caller, factored by setup */
 } spn__precond;
 
-spn_status spn__precond_setup(spn__precond *pc, const spn__eq *e);
+spn_status spn__precond_setup(spn__precond *pc, spn__eq *e);
 void spn__precond_apply(const spn__precond *pc, const spn__eq *e, const double *r, double *z);
 void spn__precond_free(spn__precond *pc);
 /* Symmetric block Gauss-Seidel with the inverted diagonal blocks inv. */

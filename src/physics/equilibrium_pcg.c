@@ -20,7 +20,7 @@
 static inline int team(const spn__eq *e) { return e->n < PAR_MIN ? 1 : e->threads; }
 #endif
 
-spn_status spn__precond_setup(spn__precond *pc, const spn__eq *e)
+spn_status spn__precond_setup(spn__precond *pc, spn__eq *e)
 {
     const uint32_t n = e->n;
     if (!pc->inv) {
@@ -45,7 +45,10 @@ spn_status spn__precond_setup(spn__precond *pc, const spn__eq *e)
         }
     }
     if (bad) return SPN_ERR_UNSTABLE; /* a particle without stiffness: the caller shifts the diagonal */
-    if (pc->kind == SPN_PRECOND_MULTIGRID) return spn__mg_setup(&pc->mg, e, pc->inv);
+    if (pc->kind == SPN_PRECOND_MULTIGRID) {
+        if (spn__eq_lanes32(e) != SPN_OK) return spn_error(SPN_ERR_NOMEM, "equilibrium: out of memory");
+        return spn__mg_setup(&pc->mg, e, pc->inv);
+    }
     if (pc->kind == SPN_PRECOND_CYCLIC) return spn__cyc_factor(pc->cyc, e) ? SPN_OK : SPN_ERR_UNSTABLE;
     return SPN_OK;
 }

@@ -51,11 +51,6 @@ spn_status spn__eq_build_lanes(spn__eq *e)
     e->lane_val = spn__big_calloc(6 * W * slots, sizeof *e->lane_val);
     e->lane_diag = spn__big_calloc(6 * W * (size_t)(groups ? groups : 1), sizeof *e->lane_diag);
     if (!e->lane_col || !e->lane_val || !e->lane_diag) return SPN_ERR_NOMEM;
-    if (n >= MATVEC32_MIN) {
-        e->lane_val32 = spn__big_calloc(6 * W * slots, sizeof *e->lane_val32);
-        e->lane_diag32 = spn__big_calloc(6 * W * (size_t)(groups ? groups : 1), sizeof *e->lane_diag32);
-        if (!e->lane_val32 || !e->lane_diag32) return SPN_ERR_NOMEM;
-    }
     for (uint32_t g = 0; g < groups; g++)
         for (uint32_t q = 0; q < W; q++) {
             const uint32_t i = W * g + q;
@@ -65,6 +60,33 @@ spn_status spn__eq_build_lanes(spn__eq *e)
                 e->lane_col[W * (size_t)(e->lane_start[g] + t) + q] = on ? e->adj_col[j] : (int32_t)(i < n ? i : 0);
             }
         }
+    return SPN_OK;
+}
+
+/* The float32 copy of the lanes, made when the multigrid first asks for it
+ * (spn__precond_setup) and kept up to date by every later store. Why not
+ * with the lanes: only the multigrid's residuals read it, and on the 1M web
+ * it is 132 MB that the cyclic preconditioner (what auto takes there) never
+ * read but every assembly wrote: the 1M solve 2.86-3.05 -> 2.67-2.82 s wall,
+ * peak 1.21 -> 1.10 GB (two threads, two runs each, alternating). Rounded
+ * from the float64 lanes as they stand, which is what the stores since the
+ * last assembly would have written: the same floats. */
+spn_status spn__eq_lanes32(spn__eq *e)
+{
+    const uint32_t n = e->n, W = SPN__EQ_LANES, groups = (n + W - 1) / W;
+    if (n < MATVEC32_MIN || e->lane_val32) return SPN_OK;
+    const size_t vals = 6 * W * (size_t)(e->lane_start[groups] ? e->lane_start[groups] : 1);
+    const size_t diags = 6 * W * (size_t)(groups ? groups : 1);
+    e->lane_val32 = spn__big_alloc(vals * sizeof *e->lane_val32);
+    e->lane_diag32 = spn__big_alloc(diags * sizeof *e->lane_diag32);
+    if (!e->lane_val32 || !e->lane_diag32) {
+        free(e->lane_val32), free(e->lane_diag32);
+        e->lane_val32 = NULL, e->lane_diag32 = NULL;
+        return SPN_ERR_NOMEM;
+    }
+#pragma omp parallel for schedule(static) num_threads(team(e, n))
+    for (size_t k = 0; k < vals; k++) e->lane_val32[k] = (float)e->lane_val[k];
+    for (size_t k = 0; k < diags; k++) e->lane_diag32[k] = (float)e->lane_diag[k];
     return SPN_OK;
 }
 
