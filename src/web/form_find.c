@@ -38,6 +38,8 @@
  * with form finding, wall s and peak memory: Zilla 1 m (50k particles) 0.9
  * s, 143 MB; 2 m (185k) 3.2 s, 424 MB; 3 m (406k) 10 s, 1.0 GB; 5 m (1.1M)
  * 30 s, 2.6 GB; the other species at 5 m (323k-653k) 6-8 s, 0.8-1.1 GB.
+ * With the multigrid refresh's scratch kept between Newton steps
+ * (2026-12-06): 3 m 7.5 s, 5 m 23 s.
  * Until the multigrid's thin-aggregate rule (equilibrium_mg.c) and the
  * halved Newton steps (equilibrium.c) the 5 m Zilla web had not finished
  * after 18 minutes and 3.7 GB, and the cap was 200,000. */
