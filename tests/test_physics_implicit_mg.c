@@ -7,7 +7,8 @@
  * 3. 1 vs 2 threads give bit-identical states;
  * 4. preconditioners the step does not have are refused, naming the choices;
  * 5. auto at short steps on a big web: the cyclic preconditioner on a rings
- *    x radials web, block Jacobi (bit for bit) on one that is no lattice;
+ *    x radials web; on one that is no lattice block Jacobi (bit for bit)
+ *    until a step takes it over a hundred iterations, then the multigrid;
  * 6. a change of preconditioner mid-run takes effect at the next step. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -18,6 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "physics/world_internal.h"
 #include "physics_util.h"
 
 enum { PLAIN, CONTACT, BREAK };
@@ -102,12 +104,15 @@ static void test_cyclic_matches_block_jacobi(void **state)
     compare(SPN_PRECOND_CYCLIC, BREAK);
 }
 
-/* auto at a short step (dt 1e-4 s, where the multigrid does not pay) on a
- * web of 5,001 particles: a rings x radials web takes the cyclic
- * preconditioner (block Jacobi needs some 150 iterations a step there);
- * the same web with a spring broken is no lattice and gets block Jacobi,
- * bit for bit. `broken`: break spring 1200 first. */
-static spn_vec3 *short_steps(spn_precond pc, bool broken, long *cg)
+/* auto at short steps on a web of 5,001 particles. A rings x radials web
+ * takes the cyclic preconditioner (block Jacobi needs some 175 iterations a
+ * step there at dt 1e-4 s). The same web with a spring broken is no
+ * lattice: at dt 1e-5 s, where block Jacobi needs a few tens of iterations,
+ * it keeps block Jacobi, bit for bit; at 1e-4 s its first step is block
+ * Jacobi's, bit for bit, and from the second on, since that one took more
+ * than a hundred, the multigrid's (SPN__IMPLICIT_BJ_MAX). `broken`: break
+ * spring 1200 first; `steps` steps of dt. */
+static spn_vec3 *short_steps(spn_precond pc, bool broken, double dt, int steps, long *cg)
 {
     spn_world_def wd = spn_world_def_default();
     wd.integrator = SPN_INTEGRATOR_IMPLICIT;
@@ -119,8 +124,8 @@ static spn_vec3 *short_steps(spn_precond pc, bool broken, long *cg)
     assert_int_equal(spn_world_set_solver_tolerance(w, 1e-10, 1000), SPN_OK);
     if (broken) spn_world_break_spring(w, 1200);
     *cg = 0;
-    for (int i = 0; i < 3; i++) {
-        assert_int_equal(spn_world_step(w, 1e-4), SPN_OK);
+    for (int i = 0; i < steps; i++) {
+        assert_int_equal(spn_world_step(w, dt), SPN_OK);
         *cg += spn_world_last_step(w).cg_iterations;
     }
     return util_take_state(w);
@@ -131,19 +136,37 @@ static void test_auto_at_short_steps(void **state)
     (void)state;
     const uint32_t n = spn_orb_scene_particles(40, 125);
     long cg_auto, cg_bj;
-    spn_vec3 *a = short_steps(SPN_PRECOND_AUTO, false, &cg_auto),
-             *b = short_steps(SPN_PRECOND_BLOCK_JACOBI, false, &cg_bj);
+    spn_vec3 *a = short_steps(SPN_PRECOND_AUTO, false, 1e-4, 3, &cg_auto),
+             *b = short_steps(SPN_PRECOND_BLOCK_JACOBI, false, 1e-4, 3, &cg_bj);
     double vmax;
-    const double dv = velocity_gap(a, b, n, &vmax);
+    double dv = velocity_gap(a, b, n, &vmax);
     print_message("lattice, dt 1e-4: CG %ld (auto) vs %ld (block Jacobi); max |dv| %.2e of %.2e\n", cg_auto, cg_bj, dv,
                   vmax);
     assert_true(vmax > 0);
     assert_true(dv <= 1e-6 * vmax);
     assert_true(cg_auto * 10 < cg_bj);
     free(a), free(b);
-    a = short_steps(SPN_PRECOND_AUTO, true, &cg_auto), b = short_steps(SPN_PRECOND_BLOCK_JACOBI, true, &cg_bj);
+    /* no lattice, a step block Jacobi takes in few iterations: block Jacobi */
+    a = short_steps(SPN_PRECOND_AUTO, true, 1e-5, 3, &cg_auto), b = short_steps(SPN_PRECOND_BLOCK_JACOBI, true, 1e-5, 3, &cg_bj);
+    print_message("no lattice, dt 1e-5: CG %ld (auto) vs %ld (block Jacobi)\n", cg_auto, cg_bj);
+    assert_true(cg_bj <= 3 * SPN__IMPLICIT_BJ_MAX);
     assert_int_equal(cg_auto, cg_bj);
     assert_memory_equal(a, b, 2 * n * sizeof *a);
+    free(a), free(b);
+    /* no lattice, a step that takes block Jacobi over a hundred: its first
+     * step block Jacobi's, then the multigrid */
+    a = short_steps(SPN_PRECOND_AUTO, true, 1e-4, 1, &cg_auto), b = short_steps(SPN_PRECOND_BLOCK_JACOBI, true, 1e-4, 1, &cg_bj);
+    assert_true(cg_bj > SPN__IMPLICIT_BJ_MAX);
+    assert_int_equal(cg_auto, cg_bj);
+    assert_memory_equal(a, b, 2 * n * sizeof *a);
+    free(a), free(b);
+    long first = cg_bj;
+    a = short_steps(SPN_PRECOND_AUTO, true, 1e-4, 3, &cg_auto), b = short_steps(SPN_PRECOND_BLOCK_JACOBI, true, 1e-4, 3, &cg_bj);
+    dv = velocity_gap(a, b, n, &vmax);
+    print_message("no lattice, dt 1e-4: CG %ld (auto; its first step %ld) vs %ld (block Jacobi); max |dv| %.2e of %.2e\n",
+                  cg_auto, first, cg_bj, dv, vmax);
+    assert_true(dv <= 1e-6 * vmax);
+    assert_true((cg_auto - first) * 4 < cg_bj - first); /* steps 2 and 3 */
     free(a), free(b);
 }
 

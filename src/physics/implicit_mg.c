@@ -68,6 +68,7 @@ spn_status spn_world_set_implicit_preconditioner(spn_world *w, spn_precond p)
         spn__imp_mg_free(w->imp_mg);
         w->imp_mg = NULL;
         w->implicit_pc = code;
+        w->imp_bj_long = 0;
     }
     return SPN_OK;
 }
@@ -205,9 +206,10 @@ bool spn__imp_mg_prepare(spn_world *w, double h)
      * where block Jacobi still needs hundreds of iterations (dt 1e-4 s:
      * 158, 614 and 1,000 on the 5k, 100k and 1M webs, the cyclic 2); block
      * Jacobi on small webs and on short steps of other webs, where it needs
-     * few iterations and nothing to set up */
+     * few iterations and nothing to set up, unless it took too many at this
+     * step length or a shorter one (imp_bj_long: a web of stiff silk) */
     const bool auto_big = w->implicit_pc == 0 && w->np >= SPN__IMPLICIT_MG_MIN;
-    const bool auto_mg = auto_big && h >= SPN__IMPLICIT_MG_DT;
+    const bool auto_mg = auto_big && (h >= SPN__IMPLICIT_MG_DT || (w->imp_bj_long > 0 && h >= w->imp_bj_long));
     const bool want = w->implicit_pc >= 2 || auto_mg || (auto_big && w->lat);
     if (!want) return false;
     const uint64_t sig = signature(w);

@@ -177,6 +177,8 @@ struct spn_world {
     double *pinv;         /* implicit: per-particle inverse 3x3 block, 6 each (on demand) */
     struct spn__imp_mg *imp_mg; /* implicit: the multigrid preconditioner (implicit_mg.c, on demand) */
     uint8_t implicit_pc;  /* implicit preconditioner: 0 auto, 1 block Jacobi, 2 multigrid, 3 cyclic */
+    double imp_bj_long;   /* auto: the shortest step at which block Jacobi took more than
+                           * SPN__IMPLICIT_BJ_MAX CG iterations (0: none yet); from it up, the multigrid */
     uint8_t energy_limit; /* implicit: which steps may not create energy (spn_energy_limit) */
     double *partial;      /* SPN_NSUMS per block */
     uint32_t npartial;    /* blocks the partial array holds */
@@ -424,6 +426,11 @@ void spn__invert_sym3(const double a[6], double out[6]);
  * 20k web: break-even near 2e-3 s; docs/physics-implicit-mg.md). */
 #define SPN__IMPLICIT_MG_MIN 4096u
 #define SPN__IMPLICIT_MG_DT 5e-3
+/* ... and at shorter steps too, from the step after one at which block
+ * Jacobi took more than this many CG iterations (at that step's length and
+ * longer): past about a hundred the V-cycle's few iterations cost less
+ * whatever the tolerance (docs/physics-implicit-mg.md, "Stiff webs"). */
+#define SPN__IMPLICIT_BJ_MAX 100
 typedef struct spn__imp_mg spn__imp_mg;
 void spn__imp_mg_free(spn__imp_mg *m);
 /* After w->jac and w->pinv are built for step h: (re)build or refresh the
