@@ -128,6 +128,26 @@ SPN_API spn_status spn_world_remove_springs(spn_world *w, const bool *remove);
 /// no particle.)
 SPN_API spn_status spn_world_remove_particles(spn_world *w, const uint32_t *ids, uint32_t count,
                                               uint32_t *particle_map, uint32_t *spring_map);
+/// Number the particles anew, in place: order[k] is the old id of the
+/// particle that becomes particle k (a permutation of 0 .. particle_count-1).
+/// Each particle keeps its state and fields bit for bit under its new id;
+/// springs keep their ids and order, their ends renumbered; contacts their
+/// order, their particle ids renumbered; everything else stays, as in
+/// spn_world_remove_particles. Why: the steps read a spring's two ends, and
+/// on two threads a spring whose ends lie in different threads' ranges moves
+/// data between cores every step; a numbering where particles near each other
+/// are near in number (spn_world_locality_order) makes the parallel general
+/// path pay (docs/physics.md, "Particle order"). The world compiles again at
+/// the next step. Not from a callback during a step. SPN_ERR_INVALID naming
+/// the order[] entry that is out of range or repeats an earlier one; the
+/// world is then unchanged.
+SPN_API spn_status spn_world_reorder_particles(spn_world *w, const uint32_t *order);
+/// An order for spn_world_reorder_particles that numbers particles near each
+/// other in space near each other: along a Z-order (Morton) curve through the
+/// positions' bounding box, 21 bits an axis, ties by id. order: particle_count
+/// entries. SPN_ERR_INVALID when w or order is NULL or a position is not
+/// finite (naming the particle).
+SPN_API spn_status spn_world_locality_order(const spn_world *w, uint32_t *order);
 /// Build the flat stepping arrays now (stepping does it when needed).
 SPN_API spn_status spn_world_compile(spn_world *w);
 /// How the next Euler, symplectic or RK4 step of a compiled world runs:

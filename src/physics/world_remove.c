@@ -1,4 +1,5 @@
-/* Taking particles out of a world in place (spn_world_remove_particles).
+/* Taking particles out of a world in place (spn_world_remove_particles), and
+ * numbering them anew (spn_world_reorder_particles).
  *
  * Why in place: a world carries much that its spn_world_def does not hold
  * (callbacks and their user pointers, air, colliders, tag diameters and
@@ -22,7 +23,9 @@
  * spheres fixed in space, tied to no particle, so they never stop a removal. */
 #include "world_internal.h"
 
+#include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 /* The first ids[] entry naming particle p (for the duplicate message). */
 static uint32_t first_entry(const uint32_t *ids, uint32_t p)
@@ -120,5 +123,113 @@ spn_status spn_world_remove_particles(spn_world *w, const uint32_t *ids, uint32_
     /* The compiled arrays hold old ids and sizes: drop them (the next step
      * compiles), as spn_world_compile would before rebuilding anyway. */
     spn__free_compiled(w);
+    return SPN_OK;
+}
+
+/* ---- renumbering (spn_world_reorder_particles) ---------------------------- */
+
+/* Each array of n elements of `size` bytes put in the new order: out[k] =
+ * in[order[k]], through scratch (n * size bytes). */
+static void permute(void *a, const uint32_t *order, uint32_t n, size_t size, unsigned char *scratch)
+{
+    const unsigned char *in = a;
+    for (uint32_t k = 0; k < n; k++) memcpy(scratch + (size_t)k * size, in + (size_t)order[k] * size, size);
+    memcpy(a, scratch, (size_t)n * size);
+}
+
+spn_status spn_world_reorder_particles(spn_world *w, const uint32_t *order)
+{
+    if (!w) return spn_error(SPN_ERR_INVALID, "reorder particles: world is NULL");
+    if (!order && w->np) return spn_error(SPN_ERR_INVALID, "reorder particles: order is NULL for %u particles", w->np);
+    const uint32_t np = w->np;
+    uint32_t *map = malloc(((size_t)np + 1) * sizeof *map);
+    unsigned char *scratch = malloc(((size_t)np + 1) * sizeof(spn_vec3));
+    if (!map || !scratch) {
+        free(map), free(scratch);
+        return spn_error(SPN_ERR_NOMEM, "out of memory renumbering a world of %u particles", np);
+    }
+    for (uint32_t i = 0; i < np; i++) map[i] = SPN_REMOVED;
+    for (uint32_t k = 0; k < np; k++) {
+        const uint32_t p = order[k];
+        spn_status st = SPN_OK;
+        if (p >= np)
+            st = spn_error(SPN_ERR_INVALID, "reorder particles: order[%u] = %u does not exist (the world has %u particles)",
+                           k, p, np);
+        else if (map[p] != SPN_REMOVED)
+            st = spn_error(SPN_ERR_INVALID, "reorder particles: order[%u] = %u repeats order[%u]", k, p, map[p]);
+        if (st != SPN_OK) {
+            free(map), free(scratch);
+            return st;
+        }
+        map[p] = k; /* the new id of old particle p */
+    }
+    permute(w->x, order, np, sizeof *w->x, scratch);
+    permute(w->v, order, np, sizeof *w->v, scratch);
+    permute(w->mass, order, np, sizeof *w->mass, scratch);
+    permute(w->inv_mass, order, np, sizeof *w->inv_mass, scratch);
+    permute(w->ptag, order, np, sizeof *w->ptag, scratch);
+    for (uint32_t s = 0; s < w->ns; s++) w->sa[s] = map[w->sa[s]], w->sb[s] = map[w->sb[s]];
+    for (uint32_t c = 0; c < w->ncontacts; c++) {
+        spn_contact *ct = &w->contacts[c];
+        ct->p = map[ct->p], ct->a = map[ct->a], ct->b = map[ct->b];
+    }
+    free(map), free(scratch);
+    spn__free_compiled(w);
+    return SPN_OK;
+}
+
+/* x's low 21 bits spread to every third bit. */
+static uint64_t spread3(uint64_t x)
+{
+    x &= 0x1fffff;
+    x = (x | x << 32) & 0x1f00000000ffffull;
+    x = (x | x << 16) & 0x1f0000ff0000ffull;
+    x = (x | x << 8) & 0x100f00f00f00f00full;
+    x = (x | x << 4) & 0x10c30c30c30c30c3ull;
+    x = (x | x << 2) & 0x1249249249249249ull;
+    return x;
+}
+
+typedef struct keyed {
+    uint64_t key;
+    uint32_t id;
+} keyed;
+
+static int by_key(const void *pa, const void *pb)
+{
+    const keyed *a = pa, *b = pb;
+    if (a->key != b->key) return a->key < b->key ? -1 : 1;
+    return a->id < b->id ? -1 : a->id > b->id;
+}
+
+spn_status spn_world_locality_order(const spn_world *w, uint32_t *order)
+{
+    if (!w || !order) return spn_error(SPN_ERR_INVALID, "locality order: %s is NULL", w ? "order" : "world");
+    const uint32_t np = w->np;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t i = 0; i < np; i++) {
+        const double c[3] = {w->x[i].x, w->x[i].y, w->x[i].z};
+        for (int d = 0; d < 3; d++) {
+            if (!isfinite(c[d]))
+                return spn_error(SPN_ERR_INVALID, "locality order: particle %u has a position that is not finite", i);
+            lo[d] = fmin(lo[d], c[d]), hi[d] = fmax(hi[d], c[d]);
+        }
+    }
+    keyed *k = malloc(((size_t)np + 1) * sizeof *k);
+    if (!k) return spn_error(SPN_ERR_NOMEM, "out of memory ordering %u particles", np);
+    const double cells = (double)((1u << 21) - 1);
+    for (uint32_t i = 0; i < np; i++) {
+        const double c[3] = {w->x[i].x, w->x[i].y, w->x[i].z};
+        uint64_t key = 0;
+        for (int d = 0; d < 3; d++) {
+            const double span = hi[d] - lo[d];
+            const uint64_t q = span > 0 ? (uint64_t)((c[d] - lo[d]) / span * cells) : 0;
+            key |= spread3(q) << d;
+        }
+        k[i] = (keyed){key, i};
+    }
+    qsort(k, np, sizeof *k, by_key);
+    for (uint32_t i = 0; i < np; i++) order[i] = k[i].id;
+    free(k);
     return SPN_OK;
 }

@@ -59,6 +59,8 @@ spn_status spn__web_check_strains(const spn_web_strains *s);
  * it at the tension each pulls with there (form_find.c); the web is left as
  * laid where the solve falls short or the web is too big (*found false).
  * Errors: out of memory. */
+/* Particles renumbered octant by octant around the web's centroid (weave.c). */
+spn_status spn__web_number_by_place(spn_world *w);
 spn_status spn__web_form_find(spn_world *w, const double prestrain[SPN_WEB_KINDS], bool *found);
 /* For tests: the most particles a web may have to be form-found and the
  * Newton steps its solve may take (FORM_FIND_MAX_PARTICLES and
