@@ -27,42 +27,50 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The first ids[] entry naming particle p (for the duplicate message). */
-static uint32_t first_entry(const uint32_t *ids, uint32_t p)
-{
-    uint32_t k = 0;
-    while (ids[k] != p) k++;
-    return k;
-}
+#define NOT_LISTED UINT32_MAX
 
-/* Mark the removed particles in map (SPN_REMOVED; others 0); SPN_ERR_INVALID
- * naming the ids[] entry that is out of range or a duplicate. */
-static spn_status mark_removed(const spn_world *w, const uint32_t *ids, uint32_t count, uint32_t *map)
+/* map[p] = k for each entry list[k] naming particle p, NOT_LISTED for the
+ * particles no entry names (map: particle_count entries); SPN_ERR_INVALID
+ * naming the entry (`what`: the call, `name`: the list) that is out of range
+ * or repeats an earlier one. The ids of spn_world_remove_particles and the
+ * order of spn_world_reorder_particles. */
+static spn_status index_entries(const spn_world *w, const uint32_t *list, uint32_t count, uint32_t *map,
+                                const char *what, const char *name)
 {
+    for (uint32_t i = 0; i < w->np; i++) map[i] = NOT_LISTED;
     for (uint32_t k = 0; k < count; k++) {
-        const uint32_t p = ids[k];
+        const uint32_t p = list[k];
         if (p >= w->np)
-            return spn_error(SPN_ERR_INVALID, "remove particles: ids[%u] = %u does not exist (the world has %u particles)",
-                             k, p, w->np);
-        if (map[p] == SPN_REMOVED)
-            return spn_error(SPN_ERR_INVALID, "remove particles: ids[%u] = %u repeats ids[%u]", k, p,
-                             first_entry(ids, p));
-        map[p] = SPN_REMOVED;
+            return spn_error(SPN_ERR_INVALID, "%s: %s[%u] = %u does not exist (the world has %u particles)", what, name, k,
+                             p, w->np);
+        if (map[p] != NOT_LISTED)
+            return spn_error(SPN_ERR_INVALID, "%s: %s[%u] = %u repeats %s[%u]", what, name, k, p, name, map[p]);
+        map[p] = k;
     }
     return SPN_OK;
 }
 
-/* A contact on a removed particle cannot be kept as it is: refuse. */
-static spn_status check_contacts(const spn_world *w, const uint32_t *ids, const uint32_t *map)
+/* Contacts' particle ids through map (old id -> new). */
+static void renumber_contacts(spn_world *w, const uint32_t *map)
+{
+    for (uint32_t c = 0; c < w->ncontacts; c++) {
+        spn_contact *ct = &w->contacts[c];
+        ct->p = map[ct->p], ct->a = map[ct->a], ct->b = map[ct->b];
+    }
+}
+
+/* A contact on a removed particle cannot be kept as it is: refuse (map as
+ * index_entries leaves it: each removed particle's ids[] entry). */
+static spn_status check_contacts(const spn_world *w, const uint32_t *map)
 {
     for (uint32_t c = 0; c < w->ncontacts; c++) {
         const uint32_t ends[3] = {w->contacts[c].p, w->contacts[c].a, w->contacts[c].b};
         for (int e = 0; e < 3; e++)
-            if (map[ends[e]] == SPN_REMOVED)
+            if (map[ends[e]] != NOT_LISTED)
                 return spn_error(SPN_ERR_INVALID,
                                  "remove particles: ids[%u] = %u is used by contact %u; change the contacts "
                                  "(spn_world_set_contacts) first",
-                                 first_entry(ids, ends[e]), ends[e], c);
+                                 map[ends[e]], ends[e], c);
     }
     return SPN_OK;
 }
@@ -102,21 +110,19 @@ spn_status spn_world_remove_particles(spn_world *w, const uint32_t *ids, uint32_
                                       uint32_t *spring_map)
 {
     if (count > 0 && !ids) return spn_error(SPN_ERR_INVALID, "remove particles: ids is NULL for %u particles", count);
-    uint32_t *map = calloc((size_t)w->np + 1, sizeof *map);
+    uint32_t *map = malloc(((size_t)w->np + 1) * sizeof *map);
     if (!map) return spn_error(SPN_ERR_NOMEM, "out of memory removing particles from a world of %u", w->np);
-    spn_status st = mark_removed(w, ids, count, map);
-    if (st == SPN_OK) st = check_contacts(w, ids, map);
+    spn_status st = index_entries(w, ids, count, map, "remove particles", "ids");
+    if (st == SPN_OK) st = check_contacts(w, map);
     if (st != SPN_OK) {
         free(map);
         return st;
     }
+    for (uint32_t i = 0; i < w->np; i++) map[i] = map[i] == NOT_LISTED ? 0 : SPN_REMOVED; /* compact_particles' marks */
     const uint32_t np_before = w->np;
     compact_particles(w, map);
     compact_springs(w, map, spring_map);
-    for (uint32_t c = 0; c < w->ncontacts; c++) {
-        spn_contact *ct = &w->contacts[c];
-        ct->p = map[ct->p], ct->a = map[ct->a], ct->b = map[ct->b];
-    }
+    renumber_contacts(w, map);
     if (particle_map)
         for (uint32_t i = 0; i < np_before; i++) particle_map[i] = map[i];
     free(map);
@@ -148,20 +154,11 @@ spn_status spn_world_reorder_particles(spn_world *w, const uint32_t *order)
         free(map), free(scratch);
         return spn_error(SPN_ERR_NOMEM, "out of memory renumbering a world of %u particles", np);
     }
-    for (uint32_t i = 0; i < np; i++) map[i] = SPN_REMOVED;
-    for (uint32_t k = 0; k < np; k++) {
-        const uint32_t p = order[k];
-        spn_status st = SPN_OK;
-        if (p >= np)
-            st = spn_error(SPN_ERR_INVALID, "reorder particles: order[%u] = %u does not exist (the world has %u particles)",
-                           k, p, np);
-        else if (map[p] != SPN_REMOVED)
-            st = spn_error(SPN_ERR_INVALID, "reorder particles: order[%u] = %u repeats order[%u]", k, p, map[p]);
-        if (st != SPN_OK) {
-            free(map), free(scratch);
-            return st;
-        }
-        map[p] = k; /* the new id of old particle p */
+    /* map[p]: the new id of old particle p (np entries, none repeated: every id) */
+    spn_status st = index_entries(w, order, np, map, "reorder particles", "order");
+    if (st != SPN_OK) {
+        free(map), free(scratch);
+        return st;
     }
     permute(w->x, order, np, sizeof *w->x, scratch);
     permute(w->v, order, np, sizeof *w->v, scratch);
@@ -169,10 +166,7 @@ spn_status spn_world_reorder_particles(spn_world *w, const uint32_t *order)
     permute(w->inv_mass, order, np, sizeof *w->inv_mass, scratch);
     permute(w->ptag, order, np, sizeof *w->ptag, scratch);
     for (uint32_t s = 0; s < w->ns; s++) w->sa[s] = map[w->sa[s]], w->sb[s] = map[w->sb[s]];
-    for (uint32_t c = 0; c < w->ncontacts; c++) {
-        spn_contact *ct = &w->contacts[c];
-        ct->p = map[ct->p], ct->a = map[ct->a], ct->b = map[ct->b];
-    }
+    renumber_contacts(w, map);
     free(map), free(scratch);
     spn__free_compiled(w);
     return SPN_OK;
