@@ -666,7 +666,7 @@ __attribute__((target("avx"))) static bool refresh_row_avx(const spn__bsr *r, sp
 #endif
 
 /* The scratch of every thread of spn__bsr_galerkin_refresh, kept between
- * calls on one level (spn__bsr_refresh_keep). */
+ * calls on one level (its `keep` argument). */
 struct spn__bsr_refresh {
     int threads;
     uint32_t n, nc, widest;

@@ -94,11 +94,10 @@ bool spn__bsr_galerkin_ap(const spn__bsr *a, const spn__bsr *p, const spn__bsr *
  * chunks, each forming just the rows of A P its rows of R read: C's blocks are
  * written as float32 (fval; C must have been rounded), the blocks of A, P
  * and R read in whatever form they have (spn__bsr_block). Each row of C is
- * summed in a fixed order: the same bits on any team. false on out of
- * memory. */
-/* keep: NULL, or where the threads' scratch (the windows of A P, the row
- * sums) is kept for the next call on the same level, created on the first;
- * free it with spn__bsr_refresh_free. */
+ * summed in a fixed order: the same bits on any team. keep: NULL, or where
+ * the threads' scratch (the windows of A P, the row sums) is kept for the
+ * next call on the same level, created on the first; free it with
+ * spn__bsr_refresh_free. false on out of memory. */
 typedef struct spn__bsr_refresh spn__bsr_refresh;
 bool spn__bsr_galerkin_refresh(const spn__bsr *a, const spn__bsr *p, const spn__bsr *r, spn__bsr *c, int threads,
                                spn__bsr_refresh **keep);

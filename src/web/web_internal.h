@@ -59,8 +59,6 @@ spn_status spn__web_check_strains(const spn_web_strains *s);
  * it at the tension each pulls with there (form_find.c); the web is left as
  * laid where the solve falls short or the web is too big (*found false).
  * Errors: out of memory. */
-/* Particles renumbered octant by octant around the web's centroid (weave.c). */
-spn_status spn__web_number_by_place(spn_world *w);
 spn_status spn__web_form_find(spn_world *w, const double prestrain[SPN_WEB_KINDS], bool *found);
 /* For tests: the most particles a web may have to be form-found and the
  * Newton steps its solve may take (FORM_FIND_MAX_PARTICLES and
@@ -91,8 +89,12 @@ void spn__meta_num(spn__meta *m, const char *key, double v);
 void spn__meta_str(spn__meta *m, const char *key, const char *v);
 /* Every thread kind's material, as "materials": {kind: {ea, ...}}. */
 void spn__meta_materials(spn__meta *m, const spn_web_materials *mat);
+/* Particles renumbered octant by octant around the web's centroid, in the
+ * weaver's order within each (weave.c). */
+spn_status spn__web_number_by_place(spn_world *w);
 /* The woven builders' (geometric, species) end: the world out of the
- * weaver (spn__weaver_finish), then, if form_find, its shape found
+ * weaver (spn__weaver_finish) and numbered by place
+ * (spn__web_number_by_place), then, if form_find, its shape found
  * (spn__web_form_find), then the metadata set, with the strains and the
  * outcome added ("prestrain", "capture_prestrain", "frame_prestrain",
  * "anchor_prestrain", "form_find": asked for, "form_found": done). *out
