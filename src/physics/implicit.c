@@ -310,9 +310,9 @@ static int solve(spn_world *w, double h, double scale, bool *unfinished)
         cg_direction(w, rz / rz_old);
     }
     *unfinished = rr > stop;
-    /* auto on a big web: block Jacobi that took this many iterations sends
+    /* auto, on any web: block Jacobi that took this many iterations sends
      * this step length and longer ones to the multigrid (spn__imp_mg_prepare) */
-    if (!mg && w->implicit_pc == 0 && w->np >= SPN__IMPLICIT_MG_MIN && it > SPN__IMPLICIT_BJ_MAX &&
+    if (!mg && w->implicit_pc == 0 && it > SPN__IMPLICIT_BJ_MAX &&
         !(w->imp_bj_long > 0 && w->imp_bj_long <= h))
         w->imp_bj_long = h;
     return it;

@@ -208,8 +208,9 @@ bool spn__imp_mg_prepare(spn_world *w, double h)
      * Jacobi on small webs and on short steps of other webs, where it needs
      * few iterations and nothing to set up, unless it took too many at this
      * step length or a shorter one (imp_bj_long: a web of stiff silk) */
-    const bool auto_big = w->implicit_pc == 0 && w->np >= SPN__IMPLICIT_MG_MIN;
-    const bool auto_mg = auto_big && (h >= SPN__IMPLICIT_MG_DT || (w->imp_bj_long > 0 && h >= w->imp_bj_long));
+    const bool auto_pc = w->implicit_pc == 0, auto_big = auto_pc && w->np >= SPN__IMPLICIT_MG_MIN;
+    const bool auto_mg =
+        (auto_big && h >= SPN__IMPLICIT_MG_DT) || (auto_pc && w->imp_bj_long > 0 && h >= w->imp_bj_long);
     const bool want = w->implicit_pc >= 2 || auto_mg || (auto_big && w->lat);
     if (!want) return false;
     const uint64_t sig = signature(w);
