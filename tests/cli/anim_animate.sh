@@ -24,6 +24,17 @@ cmp -s "$T/whole/frame_00000.png" "$T/whole/frame_00008.png" && fail "the wind d
 [ -f "$T/st/state_00002.json" ] || fail "--save-states wrote no state for frame 2"
 "$SPN" info "$T/st/state_00002.json" > /dev/null || fail "a saved state is not a readable web file"
 
+# A web of real silk on an explicit solver: the run says how many steps a
+# frame that takes and what the implicit solver would take; not when quiet,
+# nor on a web of soft threads.
+"$SPN" build --species araneus -o "$T/silk.json" > /dev/null 2>&1 || fail "species build"
+"$SPN" animate "$T/silk.json" -o "$T/silk" --duration 0 --size 64x64 2> "$T/hint" || fail "silk run"
+grep -q -- "symplectic takes [0-9]* steps a frame.*--solver implicit takes 20$" "$T/hint" || fail "no solver hint: $(cat "$T/hint")"
+"$SPN" animate "$T/silk.json" -o "$T/silk2" --duration 0 --size 64x64 --quiet 2> "$T/hint" || fail "quiet silk run"
+[ -s "$T/hint" ] && fail "--quiet printed: $(cat "$T/hint")"
+"$SPN" animate "$WEB" -o "$T/soft" --duration 0 --size 64x64 2> "$T/hint" || fail "soft run"
+grep -q -- "--solver implicit" "$T/hint" && fail "a hint on a soft web: $(cat "$T/hint")"
+
 # A prey report.
 "$SPN" animate "$WEB" -o "$T/prey" --duration 0.1 --fps 50 --size 64x64 --quiet \
   --impact "0.012,0.007,0.01;0,0,-8;2e-4;0.005" --report "$T/r.json" || fail "impact run"
