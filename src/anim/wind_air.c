@@ -38,6 +38,16 @@ typedef struct air_mode {
     double omega, phi;
 } air_mode;
 
+/* A time a step samples at, taken once for all its samples: the mean wind
+ * (six sines, a fifth of an explicit step in air before it was kept) and the
+ * two slices around it (NULL: not both ready) with the fraction between. */
+typedef struct air_time {
+    double t; /* NaN: none */
+    spn_vec3 mean;
+    const struct air_slice *a, *b;
+    double f;
+} air_time;
+
 typedef struct air_slice {
     int64_t index;    /* time = index * slice_dt; INT64_MIN when empty */
     spn_vec3 *u;      /* turbulent velocity at the grid nodes */
@@ -58,11 +68,9 @@ struct spn_air_field {
     /* fill_slice's scratch: per mode cos and sin of its phase along each
      * axis (n[0] + n[1] + n[2] of each), and a grid row's sums */
     double *axis_cos, *axis_sin, *row;
-    /* the mean wind at the times spn_air_prepare was last told of (t0, t1
-     * and their midpoint), which a step samples at every segment: six sines
-     * each, a fifth of an explicit step in air */
-    double mean_t[3];
-    spn_vec3 mean_at[3];
+    /* the times spn_air_prepare was last told of (t0, t1 and their
+     * midpoint), at which a step samples every segment */
+    air_time times[3];
 };
 
 spn_air_def spn_air_def_default(void)
@@ -161,7 +169,7 @@ spn_status spn_air_create(const spn_air_def *def, spn_air_field **out)
     make_gusts(air, &rng);
     make_modes(air, &rng);
     for (int i = 0; i < MAX_SLICES; i++) air->slices[i].index = INT64_MIN;
-    for (int i = 0; i < 3; i++) air->mean_t[i] = NAN;
+    for (int i = 0; i < 3; i++) air->times[i].t = NAN;
     *out = air;
     return SPN_OK;
 }
@@ -239,6 +247,7 @@ spn_status spn_air_set_grid(spn_air_field *air, spn_vec3 lo, spn_vec3 hi, int nx
     double *row = sn ? realloc(air->row, 3 * (size_t)nx * sizeof *row) : NULL;
     if (!row) return spn_error(SPN_ERR_NOMEM, "out of memory");
     air->row = row;
+    for (int i = 0; i < 3; i++) air->times[i].t = NAN; /* their slices are gone */
     air->grid = true;
     air->lo = lo;
     air->hi = hi;
@@ -320,20 +329,30 @@ static const air_slice *find_slice(const spn_air_field *air, int64_t index)
     return NULL;
 }
 
-/* The mean wind at t, from the times prepared when t is one of them (the
- * same bits: the same function of t). */
-static spn_vec3 mean_of(const spn_air_field *air, double t)
+/* Time t taken for sampling: its mean wind and the slices around it. */
+static air_time time_of(const spn_air_field *air, double t)
 {
-    for (int i = 0; i < 3; i++)
-        if (air->mean_t[i] == t) return air->mean_at[i];
-    return spn_air_mean(air, t);
+    air_time at = {t, spn_air_mean(air, t), NULL, NULL, 0};
+    if (!air->grid) return at;
+    const double g = t / air->slice_dt;
+    const int64_t idx = (int64_t)floor(g);
+    at.a = find_slice(air, idx), at.b = find_slice(air, idx + 1);
+    at.f = g - (double)idx;
+    return at;
+}
+
+static void prepare_times(spn_air_field *air, double t0, double t1)
+{
+    const double at[3] = {t0, t1, 0.5 * (t0 + t1)};
+    for (int i = 0; i < 3; i++) air->times[i] = time_of(air, at[i]);
 }
 
 spn_status spn_air_prepare(spn_air_field *air, double t0, double t1)
 {
-    const double at[3] = {t0, t1, 0.5 * (t0 + t1)};
-    for (int i = 0; i < 3; i++) air->mean_t[i] = at[i], air->mean_at[i] = spn_air_mean(air, at[i]);
-    if (!air->grid) return SPN_OK;
+    if (!air->grid) {
+        prepare_times(air, t0, t1);
+        return SPN_OK;
+    }
     int64_t a = (int64_t)floor(t0 / air->slice_dt), b = (int64_t)floor(t1 / air->slice_dt) + 1;
     if (b - a + 1 > MAX_SLICES) b = a + MAX_SLICES - 1;
     for (int64_t idx = a; idx <= b; idx++) {
@@ -347,10 +366,9 @@ spn_status spn_air_prepare(spn_air_field *air, double t0, double t1)
         }
         if (victim) fill_slice(air, victim, idx);
     }
+    prepare_times(air, t0, t1);
     return SPN_OK;
 }
-
-static spn_vec3 lerp3(spn_vec3 a, spn_vec3 b, double f) { return spn_v3_add(a, spn_v3_scale(spn_v3_sub(b, a), f)); }
 
 /* A point's grid cell (clamped to the box): its first node and the
  * fractions along each axis. */
@@ -377,31 +395,48 @@ static air_cell cell_of(const spn_air_field *air, spn_vec3 p)
     return cl;
 }
 
-/* Trilinear interpolation of a slice in a cell. */
-static spn_vec3 interpolate(const spn_air_field *air, const air_slice *s, const air_cell *cl)
+static double lerp(double a, double b, double f) { return a + (b - a) * f; }
+
+/* Trilinear interpolation of eight corner values q in a cell (fractions fr). */
+static double trilinear(const double q[8], const double fr[3])
+{
+    const double x00 = lerp(q[0], q[1], fr[0]), x10 = lerp(q[2], q[3], fr[0]);
+    const double x01 = lerp(q[4], q[5], fr[0]), x11 = lerp(q[6], q[7], fr[0]);
+    return lerp(lerp(x00, x10, fr[1]), lerp(x01, x11, fr[1]), fr[2]);
+}
+
+/* Slices a and b interpolated in a cell, then linearly between them by f,
+ * component by component on plain doubles (as spn_vec3 temporaries they
+ * went through the stack: 48 ns a sample). */
+static spn_vec3 interpolate2(const spn_air_field *air, const air_slice *a, const air_slice *b, double f,
+                             const air_cell *cl)
 {
     const size_t sx = 1, sy = (size_t)air->n[0], sz = sy * (size_t)air->n[1];
-    const spn_vec3 *u = s->u + cl->base;
-    const double *fr = cl->fr;
-    spn_vec3 x00 = lerp3(u[0], u[sx], fr[0]), x10 = lerp3(u[sy], u[sy + sx], fr[0]);
-    spn_vec3 x01 = lerp3(u[sz], u[sz + sx], fr[0]), x11 = lerp3(u[sz + sy], u[sz + sy + sx], fr[0]);
-    return lerp3(lerp3(x00, x10, fr[1]), lerp3(x01, x11, fr[1]), fr[2]);
+    const size_t at[8] = {0, sx, sy, sy + sx, sz, sz + sx, sz + sy, sz + sy + sx};
+    double q[2][3][8];
+    for (int k = 0; k < 2; k++) {
+        const spn_vec3 *u = (k ? b : a)->u + cl->base;
+        for (int j = 0; j < 8; j++) {
+            const spn_vec3 c = u[at[j]];
+            q[k][0][j] = c.x, q[k][1][j] = c.y, q[k][2][j] = c.z;
+        }
+    }
+    double out[3];
+    for (int c = 0; c < 3; c++) out[c] = lerp(trilinear(q[0][c], cl->fr), trilinear(q[1][c], cl->fr), f);
+    return spn_v3(out[0], out[1], out[2]);
 }
 
 spn_vec3 spn_air_sample(void *user, double t, spn_vec3 p)
 {
     const spn_air_field *air = user;
-    if (air->grid) {
-        double g = t / air->slice_dt;
-        int64_t idx = (int64_t)floor(g);
-        const air_slice *a = find_slice(air, idx), *b = find_slice(air, idx + 1);
-        if (a && b) {
-            const air_cell cl = cell_of(air, p);
-            spn_vec3 u = lerp3(interpolate(air, a, &cl), interpolate(air, b, &cl), g - (double)idx);
-            return spn_v3_add(mean_of(air, t), u);
-        }
-    }
-    return spn_air_velocity(air, t, p);
+    if (!air->grid) return spn_air_velocity(air, t, p);
+    const air_time *k = NULL;
+    for (int i = 0; i < 3 && !k; i++)
+        if (air->times[i].t == t) k = &air->times[i];
+    const air_time at = k ? *k : time_of(air, t);
+    if (!at.a || !at.b) return spn_air_velocity(air, t, p);
+    const air_cell cl = cell_of(air, p);
+    return spn_v3_add(at.mean, interpolate2(air, at.a, at.b, at.f, &cl));
 }
 
 void spn_air_attach(spn_air_field *air, spn_world *w)
