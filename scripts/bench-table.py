@@ -68,6 +68,11 @@ KNOWN = {
         ("emphasis", "emphasis"), ("settle", "settle"), ("particles", "particles"), ("how", "how"),
         ("converged", "at rest"), ("newton_steps", "Newton steps"), ("steps", "implicit steps"),
         ("simulated_s", "simulated s"), ("residual_n", "residual N"), ("ms", "wall ms"), ("cpu_ms", "CPU ms")]),
+    "air": ("Turbulent air (`--wind air`; bench/bench_air.c, 1 thread): a time slice of the cached field, a sample "
+            "of it, and the Araneus web (1,924 particles) animated in still air and in wind", [
+        ("case", "case"), ("nodes", "grid nodes"), ("ms_per_slice", "ms a slice"), ("ns_per_sample", "ns a sample"),
+        ("solver", "solver"), ("wind", "wind"), ("dt", "dt s"), ("cpu_s_per_sim_s", "CPU s per simulated s"),
+        ("cg_per_step", "CG a step"), ("ms_per_step", "ms a step"), ("ns_per_spring_step", "ns a spring-step")]),
 }
 
 
