@@ -29,6 +29,8 @@ commands=(
   "shoot --from 0,1.5,0 --to 3,3,0 -o OUT.json --max-time 1"
   "drop $DATA/hostile/tetra.obj -o OUT --max-time 0.3"
   "export $T/small.json -o OUT.obj --tubes 0.001 --dew"
+  "animate $T/small.json -o OUTf --save-states OUT --wind air --wind-speed 3 --duration 0.2 --fps 10 --size 48x48 --quiet"
+  "animate $T/small.json -o OUTf --save-states OUT --wind air --wind-speed 3 --duration 0.2 --fps 10 --size 48x48 --quiet --solver implicit"
 )
 
 differ=0
