@@ -55,7 +55,8 @@ static void bench_fill(int n, double load)
     spn_vec3 sum = spn_v3(0, 0, 0);
     c0 = bench_cpu_now();
     for (int i = 0; i < SAMPLES; i++) {
-        spn_vec3 p = spn_v3(spn_rng_range(&rng, -0.5, 0.5), spn_rng_range(&rng, -0.5, 0.5), spn_rng_range(&rng, -0.5, 0.5));
+        const double x = spn_rng_range(&rng, -0.5, 0.5), y = spn_rng_range(&rng, -0.5, 0.5);
+        const spn_vec3 p = spn_v3(x, y, spn_rng_range(&rng, -0.5, 0.5));
         sum = spn_v3_add(sum, spn_air_sample(air, 3.2e-3, p));
     }
     cpu = bench_cpu_now() - c0;
@@ -83,7 +84,8 @@ static void bench_web(bool wind, double span, double load)
     double c0 = bench_cpu_now();
     if (spn_animate(&w, &ad, NULL, NULL, &rep) != SPN_OK) fail("animate");
     double cpu = bench_cpu_now() - c0;
-    printf("{\"bench\":\"air\",\"case\":\"web\",\"particles\":%u,\"solver\":\"implicit\",\"wind\":\"%s\",\"steps\":%llu,"
+    printf("{\"bench\":\"air\",\"case\":\"web\",\"particles\":%u,\"solver\":\"implicit\",\"wind\":\"%s\","
+           "\"steps\":%llu,"
            "\"cpu_s_per_sim_s\":%.3f,\"load\":%.2f}\n",
            spn_world_particle_count(w), wind ? "air" : "none", (unsigned long long)rep.steps, cpu / span, load);
     spn_world_destroy(w);

@@ -90,8 +90,9 @@ SPN_API spn_status spn_air_set_grid(spn_air_field *air, spn_vec3 lo, spn_vec3 hi
 SPN_API spn_status spn_air_prepare(spn_air_field *air, double t0, double t1);
 /// A spn_air_fn: pass the field as `user` to spn_world_set_air.
 SPN_API spn_vec3 spn_air_sample(void *user, double t, spn_vec3 p);
-/// Attach the field to a world: spn_world_set_air with its rho and mu, and the
-/// thread diameters of spn_thread_diameter for every thread kind.
+/// Attach the field to a world: spn_world_set_air with its rho and mu (declared
+/// pure: spn_world_set_air_pure), and the thread diameters of
+/// spn_thread_diameter for every thread kind.
 SPN_API void spn_air_attach(spn_air_field *air, spn_world *w);
 
 /// Diameter [m] used for aerodynamic drag on a thread kind (spring tag):

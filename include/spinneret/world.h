@@ -252,6 +252,14 @@ typedef spn_vec3 (*spn_air_fn)(void *user, double t, spn_vec3 position);
 /// from the air velocity relative to them, normal component only, with a drag
 /// coefficient from the cylinder Reynolds number. rho [kg/m^3], mu [Pa s].
 SPN_API void spn_world_set_air(spn_world *w, spn_air_fn fn, void *user, double rho, double mu);
+/// Declare the air function pure: its result depends on its arguments and on
+/// nothing it changes, so it may be called from several threads at once and
+/// in any order (spn_air_sample is; spn_air_attach declares it). The samples
+/// of a force evaluation are then taken on the world's threads once there are
+/// enough tagged segments (the air makes a segment several times dearer than
+/// a spring: the spring pass takes threads from parallel_min / 8 segments
+/// with air). Same results on any thread count. spn_world_set_air clears it.
+SPN_API void spn_world_set_air_pure(spn_world *w, bool pure);
 /// The air function (NULL: still air); its user pointer, rho and mu into the
 /// arguments that are not NULL (rho 1.204, mu 1.81e-5 until set).
 SPN_API spn_air_fn spn_world_air(const spn_world *w, void **user, double *rho, double *mu);

@@ -268,9 +268,10 @@ static spn_vec3 node_position(const spn_air_field *air, int i, int j, int k)
 /* Slice `index`: the turbulent velocity at every grid node. Mode n's phase
  * at node (i, j, k) is k_n . (p - d X(t)) + w_n t + phi_n = A_i + B_j + C_k,
  * with A_i = k_x x_i, B_j = k_y y_j and C_k = k_z z_k plus the constant part.
- * Its cosine is cos(A + B) cos C - sin(A + B) sin C with the sums of angles
- * taken from each axis' cosines and sines, which libm gives once per node
- * of each axis: n0 + n1 + n2 of each per mode instead of n0 n1 n2 cosines.
+ * Its cosine is cos A cos(B + C) - sin A sin(B + C), the angle sum B + C
+ * by the same rule, from each axis' cosines and sines, which libm gives
+ * once per node of each axis: n0 + n1 + n2 of each per mode instead of
+ * n0 n1 n2 cosines.
  * The factors are within an ulp each, so a node's value is within a few ulp
  * of |xi_n| per mode of turbulence_at's (tests/test_anim_air.c checks the
  * nodes against it). The modes add in their order, as turbulence_at adds
@@ -307,7 +308,8 @@ static void fill_slice(spn_air_field *air, air_slice *s, int64_t index)
             if (air->def.turbulence != 0)
                 for (int n = 0; n < nm; n++) {
                     const air_mode *m = &air->modes[n];
-                    const double *restrict ca = air->axis_cos + (size_t)n * per, *restrict sa = air->axis_sin + (size_t)n * per;
+                    const double *restrict ca = air->axis_cos + (size_t)n * per;
+                    const double *restrict sa = air->axis_sin + (size_t)n * per;
                     /* e^(i (B_j + C_k)) */
                     const double cb = ca[nx + j], sb = sa[nx + j], cc = ca[nx + ny + k], sc = sa[nx + ny + k];
                     const double re = cb * cc - sb * sc, im = sb * cc + cb * sc;
@@ -442,6 +444,7 @@ spn_vec3 spn_air_sample(void *user, double t, spn_vec3 p)
 void spn_air_attach(spn_air_field *air, spn_world *w)
 {
     spn_world_set_air(w, spn_air_sample, air, air->def.rho, air->def.mu);
+    spn_world_set_air_pure(w, true); /* sampling only reads the field */
     for (uint32_t tag = 0; tag < 64; tag++) {
         double d = spn_thread_diameter(tag);
         if (d > 0) spn_world_set_tag_diameter(w, tag, d);

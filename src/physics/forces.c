@@ -100,11 +100,27 @@ static spn_vec3 air_force(const spn_world *w, uint32_t s, const spn_vec3 *x, con
     return spn_v3_scale(un, *c);
 }
 
-/* Air velocity at each tagged segment's midpoint, serially in the internal
- * spring order. */
-static void sample_air(spn_world *w, double t, const spn_vec3 *x)
+/* A segment in air costs the spring pass about this many springs: its
+ * sample of the air (40-90 ns with spn_air_sample) and drag law (a
+ * logarithm or more) against 5-10 ns for the spring (bench/bench_air.c:
+ * 90 against 11 ns a spring-step, Zen 5). So with air the pass takes
+ * threads from parallel_min / SPN__AIR_WEIGHT segments. */
+#define SPN__AIR_WEIGHT 8u
+
+/* Threads for the spring pass of n springs, air included or not. */
+static int pass_threads(const spn_world *w, uint32_t n, bool air)
 {
-    for (uint32_t s = 0; s < w->ns; s++) {
+    return spn__threads(w, air && n < UINT32_MAX / SPN__AIR_WEIGHT ? n * SPN__AIR_WEIGHT : n);
+}
+
+/* Air velocity at each tagged segment's midpoint: serially in the internal
+ * spring order, or, with a pure air function (spn_world_set_air_pure), on
+ * `threads` threads (each segment's sample its own, so the same values). */
+static void sample_air(spn_world *w, double t, const spn_vec3 *x, int threads)
+{
+    const uint32_t ns = w->ns;
+#pragma omp parallel for schedule(static) num_threads(w->air_pure ? threads : 1)
+    for (uint32_t s = 0; s < ns; s++) {
         if (!(w->sdiam[s] > 0)) continue;
         spn_vec3 mid = spn_v3_scale(spn_v3_add(x[w->hs[s].a], x[spn__end_b(w->hs[s])]), 0.5);
         w->wind[s] = w->air_fn(w->air_user, t, mid);
@@ -130,11 +146,12 @@ void spn__spring_pass(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 
 {
     const uint32_t ns = w->ns, nb = spn__blocks(ns);
     const bool air = spn__air_active(w);
-    if (air) sample_air(w, t, x);
+    const int threads = pass_threads(w, ns, air);
+    if (air) sample_air(w, t, x, threads);
     spn_vec3 *restrict fs = w->fs;
     const spn__spring *restrict hs = w->hs;
     double *partial = w->partial;
-#pragma omp parallel for schedule(static) num_threads(spn__threads(w, ns))
+#pragma omp parallel for schedule(static) num_threads(threads)
     for (uint32_t blk = 0; blk < nb; blk++) {
         const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < ns ? lo + SPN_BLOCK : ns;
         double sums[2] = {0, 0};

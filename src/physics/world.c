@@ -420,7 +420,10 @@ void spn_world_set_air(spn_world *w, spn_air_fn fn, void *user, double rho, doub
     w->air_user = user;
     w->air_rho = rho;
     w->air_mu = mu;
+    w->air_pure = false;
 }
+
+void spn_world_set_air_pure(spn_world *w, bool pure) { w->air_pure = pure; }
 
 spn_air_fn spn_world_air(const spn_world *w, void **user, double *rho, double *mu)
 {

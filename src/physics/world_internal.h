@@ -201,6 +201,7 @@ struct spn_world {
     spn_air_fn air_fn;
     void *air_user;
     double air_rho, air_mu;
+    bool air_pure;      /* air_fn may be called from several threads (spn_world_set_air_pure) */
     spn_tag_diameter *diam;
     uint32_t ndiam;
 
