@@ -31,6 +31,7 @@ commands=(
   "export $T/small.json -o OUT.obj --tubes 0.001 --dew"
   "animate $T/small.json -o OUTf --save-states OUT --wind air --wind-speed 3 --duration 0.2 --fps 10 --size 48x48 --quiet"
   "animate $T/small.json -o OUTf --save-states OUT --wind air --wind-speed 3 --duration 0.2 --fps 10 --size 48x48 --quiet --solver implicit"
+  "animate $T/big.json -o OUTf --save-states OUT --wind air --wind-speed 3 --duration 0.02 --fps 100 --substeps 4 --size 48x48 --quiet --solver implicit"
 )
 
 differ=0
