@@ -119,7 +119,7 @@ static int pass_threads(const spn_world *w, uint32_t n, bool air)
 static void sample_air(spn_world *w, double t, const spn_vec3 *x, int threads)
 {
     const uint32_t ns = w->ns;
-#pragma omp parallel for schedule(static) num_threads(w->air_pure ? threads : 1)
+#pragma omp parallel for schedule(static) num_threads(threads) if (w->air_pure && threads > 1)
     for (uint32_t s = 0; s < ns; s++) {
         if (!(w->sdiam[s] > 0)) continue;
         spn_vec3 mid = spn_v3_scale(spn_v3_add(x[w->hs[s].a], x[spn__end_b(w->hs[s])]), 0.5);
