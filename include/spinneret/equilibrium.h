@@ -39,7 +39,8 @@ SPN_API const char *spn_precond_name(spn_precond p);
 /// rings x radials web's rotational average solved exactly; the multigrid on other webs) or
 /// SPN_PRECOND_AUTO (the default: from 4,096 particles the cyclic preconditioner on such a web at
 /// any step and the multigrid on others at steps of 5 ms and up; on any web the multigrid from the
-/// step after one that took block Jacobi over 100 CG iterations, at that step's length and longer;
+/// step after one that took block Jacobi over 100 CG iterations, at that step's length and longer
+/// (under 4,096 particles not in steps with contacts);
 /// block Jacobi otherwise). Results agree to the
 /// solver tolerance; a clone of a world mid-run continues within it, not bit for bit
 /// (the clone builds its hierarchy afresh). Changing the choice drops a kept hierarchy (the next step

@@ -431,7 +431,7 @@ void spn__invert_sym3(const double a[6], double out[6]);
  * Jacobi took more than this many CG iterations (at that step's length and
  * longer): past about a hundred the V-cycle's few iterations cost less
  * whatever the tolerance and the web's size (docs/physics-implicit-mg.md,
- * "Stiff webs"). */
+ * "Stiff webs"), but for a small web's steps with contacts. */
 #define SPN__IMPLICIT_BJ_MAX 100
 typedef struct spn__imp_mg spn__imp_mg;
 void spn__imp_mg_free(spn__imp_mg *m);
