@@ -351,10 +351,7 @@ static void prepare_times(spn_air_field *air, double t0, double t1)
 
 spn_status spn_air_prepare(spn_air_field *air, double t0, double t1)
 {
-    if (!air->grid) {
-        prepare_times(air, t0, t1);
-        return SPN_OK;
-    }
+    if (!air->grid) return SPN_OK; /* (without a grid a sample is exact: no times kept) */
     int64_t a = (int64_t)floor(t0 / air->slice_dt), b = (int64_t)floor(t1 / air->slice_dt) + 1;
     if (b - a + 1 > MAX_SLICES) b = a + MAX_SLICES - 1;
     for (int64_t idx = a; idx <= b; idx++) {
