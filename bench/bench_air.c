@@ -12,11 +12,11 @@
  *   steps, still and in wind: ns a spring-step.
  *
  *   bench_air [--quick]   (--quick: the web figures only at 0.05 s) */
+#include "anim/anim_internal.h" /* spn__air_grid_over_web: the runner's grid */
 #include "common/bench_common.h"
 
 #include <spinneret/spinneret.h>
 
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -91,26 +91,14 @@ static void bench_web(bool wind, double span, double load)
     spn_world_destroy(w);
 }
 
-/* The web stepped as the runner steps it (src/anim/runner.c: air attached,
- * a grid over its box padded by half its size, five nodes per smallest
- * eddy, at most 48 an axis; slices prepared before each step), for its CG
- * iterations a step. */
+/* The web stepped as the runner steps it (air attached, the runner's grid
+ * over its box, spn__air_grid_over_web; slices prepared before each step),
+ * for its CG iterations a step. */
 static spn_air_field *attach_air(spn_world *w)
 {
     spn_air_field *air = make_air();
     spn_air_attach(air, w);
-    spn_vec3 lo = spn_world_position(w, 0), hi = lo;
-    for (uint32_t i = 1; i < spn_world_particle_count(w); i++) {
-        const spn_vec3 p = spn_world_position(w, i);
-        lo = spn_v3(fmin(lo.x, p.x), fmin(lo.y, p.y), fmin(lo.z, p.z));
-        hi = spn_v3(fmax(hi.x, p.x), fmax(hi.y, p.y), fmax(hi.z, p.z));
-    }
-    const double size = fmax(fmax(hi.x - lo.x, hi.y - lo.y), fmax(hi.z - lo.z, 1e-3)), pad = 0.5 * size;
-    lo = spn_v3_sub(lo, spn_v3(pad, pad, pad)), hi = spn_v3_add(hi, spn_v3(pad, pad, pad));
-    const double h = spn_air_def_default().small_scale / 5, ext[3] = {hi.x - lo.x, hi.y - lo.y, hi.z - lo.z};
-    int n[3];
-    for (int a = 0; a < 3; a++) n[a] = (int)fmin(48, fmax(3, ceil(ext[a] / h) + 1));
-    if (spn_air_set_grid(air, lo, hi, n[0], n[1], n[2], 5e-3) != SPN_OK) fail("grid");
+    if (spn__air_grid_over_web(air, w, spn_air_def_default().small_scale) != SPN_OK) fail("grid");
     return air;
 }
 

@@ -18,6 +18,11 @@ void spn__web_bounds(const spn_world *w, spn_vec3 *lo, spn_vec3 *hi);
  * kind get break_max = min(break_max, rest * (1 + strain * scale)). */
 spn_status spn__world_with_breaks(const spn_world *w, double scale, spn_world **out);
 
+/* Cache `air` on the grid the animation runner uses for web `w` (runner.c):
+ * its box grown by half its size, five nodes per smallest eddy of
+ * `small_scale` [m], slices 5 ms apart. */
+spn_status spn__air_grid_over_web(spn_air_field *air, const spn_world *w, double small_scale);
+
 /* True when this build's world applies aerodynamic drag (probed once on a
  * single segment in a steady wind), so the energy ledger counts the air's work
  * only when the air really acts. */
