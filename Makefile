@@ -18,7 +18,7 @@ BUILD_TYPE ?= RelWithDebInfo
 CMAKE_FLAGS ?=
 WERROR ?= ON
 
-DEPS := cmake pkg-config gcc make libcmocka-dev libcairo2-dev libcjson-dev fonts-dejavu-core \
+DEPS := cmake pkg-config gcc make libcmocka-dev libcairo2-dev libpng-dev libcjson-dev fonts-dejavu-core \
         libassimp-dev libglfw3-dev libgl-dev libgl1-mesa-dri xvfb xauth ffmpeg povray clang libclang-rt-14-dev
 BENCH_DEPS := libbullet-dev g++ libsuitesparse-dev
 # the showcase's contact sheets and onion skins (montage, convert)

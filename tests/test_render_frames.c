@@ -1,6 +1,8 @@
-/* Frame sequences: numbered PNGs that read back to the frames written, MP4 and
- * GIF through ffmpeg that decode back to the colour written, nothing left on
- * an abandoned encode, and a clear refusal when ffmpeg is missing. */
+/* Frame sequences: numbered PNGs that read back to the frames written (RGB
+ * when opaque, RGBA with straight alpha when not; rows unfiltered for line
+ * art, filtered "up" for a photograph; a write that fails leaves nothing),
+ * MP4 and GIF through ffmpeg that decode back to the colour written, nothing
+ * left on an abandoned encode, and a clear refusal when ffmpeg is missing. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -8,10 +10,15 @@
 #include <cmocka.h>
 
 #include <cairo.h>
+#include <png.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
+#include <zlib.h>
 #include <spinneret/spinneret.h>
 
 static char folder[512];
@@ -64,6 +71,155 @@ static void test_png_folder(void **state)
     }
     snprintf(path, sizeof path, "%s/frame_%05d.png", dir, 8);
     assert_int_equal(access(path, F_OK), -1);
+}
+
+/* A PNG file's colour type and each row's filter byte (IDAT inflated). */
+static void png_rows(const char *path, int w, int h, int *colour_type, uint8_t *filters)
+{
+    FILE *fp = fopen(path, "rb");
+    assert_non_null(fp);
+    fseek(fp, 0, SEEK_END);
+    long n = ftell(fp);
+    rewind(fp);
+    uint8_t *file = malloc((size_t)n), *idat = malloc((size_t)n);
+    assert_int_equal(fread(file, 1, (size_t)n, fp), (size_t)n);
+    fclose(fp);
+    size_t idat_len = 0;
+    for (long at = 8; at + 12 <= n;) {
+        uint32_t len = (uint32_t)file[at] << 24 | (uint32_t)file[at + 1] << 16 | (uint32_t)file[at + 2] << 8 | file[at + 3];
+        const uint8_t *type = file + at + 4, *data = file + at + 8;
+        if (memcmp(type, "IHDR", 4) == 0) *colour_type = data[9];
+        if (memcmp(type, "IDAT", 4) == 0) memcpy(idat + idat_len, data, len), idat_len += len;
+        at += 12 + (long)len;
+    }
+    int channels = *colour_type == 6 ? 4 : 3;
+    uLongf raw_len = (uLongf)h * (1 + (uLongf)w * channels);
+    uint8_t *raw = malloc(raw_len);
+    assert_int_equal(uncompress(raw, &raw_len, idat, idat_len), Z_OK);
+    assert_int_equal(raw_len, (uLongf)h * (1 + (uLongf)w * channels));
+    for (int y = 0; y < h; y++) filters[y] = raw[(size_t)y * (1 + (size_t)w * channels)];
+    free(raw);
+    free(idat);
+    free(file);
+}
+
+/* A pixel hash: the same noise every run. */
+static uint8_t noise(uint32_t i)
+{
+    i = (i ^ 61) ^ (i >> 16);
+    i *= 9;
+    i ^= i >> 4;
+    i *= 0x27d4eb2d;
+    return (uint8_t)(i >> 15);
+}
+
+static void write_one(const char *name, int w, int h, const uint8_t *px, char *path, size_t path_size)
+{
+    char dir[600];
+    snprintf(dir, sizeof dir, "%s/%s", folder, name);
+    spn_frames *f;
+    assert_int_equal(spn_frames_open(dir, w, h, 25, &f), SPN_OK);
+    assert_int_equal(spn_frames_add(f, px), SPN_OK);
+    assert_int_equal(spn_frames_close(f, true), SPN_OK);
+    snprintf(path, path_size, "%s/frame_00000.png", dir);
+}
+
+/* Line art on a flat colour is written unfiltered, a photograph (no pixel
+ * like its neighbour) filtered "up"; both opaque, so RGB, and both read back
+ * to the pixels written. */
+static void test_png_filters(void **state)
+{
+    (void)state;
+    enum { W = 97, H = 64 };
+    uint8_t *lines = solid(W, H, 10, 10, 30), *photo = malloc((size_t)W * H * 4);
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            uint8_t *p = lines + ((size_t)y * W + x) * 4;
+            if (x == y || x == 3 * y / 2 || y == 40) p[0] = p[1] = p[2] = 220;
+            uint8_t *q = photo + ((size_t)y * W + x) * 4;
+            for (int c = 0; c < 3; c++) q[c] = (uint8_t)(40 + x + y + (noise((uint32_t)(y * W + x) * 3 + c) & 15));
+            q[3] = 255;
+        }
+    const uint8_t *pictures[2] = {lines, photo};
+    const char *names[2] = {"lines", "photo"};
+    for (int k = 0; k < 2; k++) {
+        char path[700];
+        write_one(names[k], W, H, pictures[k], path, sizeof path);
+        int colour_type = -1;
+        uint8_t filters[H];
+        png_rows(path, W, H, &colour_type, filters);
+        assert_int_equal(colour_type, PNG_COLOR_TYPE_RGB);
+        for (int y = 0; y < H; y++) assert_int_equal(filters[y], k == 0 ? PNG_FILTER_VALUE_NONE : PNG_FILTER_VALUE_UP);
+        cairo_surface_t *s = cairo_image_surface_create_from_png(path);
+        assert_int_equal(cairo_surface_status(s), CAIRO_STATUS_SUCCESS);
+        const uint8_t *data = cairo_image_surface_get_data(s);
+        int stride = cairo_image_surface_get_stride(s);
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                uint32_t v = *(const uint32_t *)(const void *)(data + (size_t)y * stride + (size_t)x * 4);
+                const uint8_t *p = pictures[k] + ((size_t)y * W + x) * 4;
+                assert_int_equal(v, 0xff000000u | (uint32_t)p[0] << 16 | (uint32_t)p[1] << 8 | p[2]);
+            }
+        cairo_surface_destroy(s);
+    }
+    free(lines);
+    free(photo);
+}
+
+/* Frames with see-through pixels keep them: RGBA, straight alpha, exact. */
+static void test_png_alpha(void **state)
+{
+    (void)state;
+    enum { W = 40, H = 24 };
+    uint8_t *px = malloc((size_t)W * H * 4);
+    for (int i = 0; i < W * H; i++)
+        for (int c = 0; c < 4; c++) px[4 * i + c] = noise((uint32_t)(4 * i + c));
+    char path[700];
+    write_one("alpha", W, H, px, path, sizeof path);
+    png_image image;
+    memset(&image, 0, sizeof image);
+    image.version = PNG_IMAGE_VERSION;
+    assert_true(png_image_begin_read_from_file(&image, path));
+    assert_int_equal(image.format & PNG_FORMAT_FLAG_ALPHA, PNG_FORMAT_FLAG_ALPHA);
+    image.format = PNG_FORMAT_RGBA;
+    uint8_t *back = malloc(PNG_IMAGE_SIZE(image));
+    assert_true(png_image_finish_read(&image, NULL, back, 0, NULL));
+    assert_memory_equal(back, px, (size_t)W * H * 4);
+    free(back);
+    free(px);
+}
+
+/* A write that fails part way (here the file size limit, as a full disk
+ * would) is an I/O error naming the frame, and leaves no file behind. Run in
+ * a child, whose limit ends with it. */
+static void test_png_write_error(void **state)
+{
+    (void)state;
+    enum { W = 256, H = 256 };
+    char dir[600];
+    snprintf(dir, sizeof dir, "%s/full", folder);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        signal(SIGXFSZ, SIG_IGN);
+        struct rlimit lim = {4096, 4096};
+        setrlimit(RLIMIT_FSIZE, &lim);
+        uint8_t *px = malloc((size_t)W * H * 4);
+        for (int i = 0; i < W * H * 4; i++) px[i] = i % 4 == 3 ? 255 : noise((uint32_t)i);
+        spn_frames *f;
+        if (spn_frames_open(dir, W, H, 25, &f) != SPN_OK) _exit(2);
+        spn_status st = spn_frames_add(f, px);
+        bool named = strstr(spn_last_error(), "frame_00000.png: cannot write") != NULL;
+        spn_frames_close(f, true);
+        _exit(st == SPN_ERR_IO && named ? 0 : 3);
+    }
+    int status = 0;
+    assert_int_equal(waitpid(pid, &status, 0), pid);
+    assert_true(WIFEXITED(status));
+    assert_int_equal(WEXITSTATUS(status), 0);
+    char cmd[800];
+    snprintf(cmd, sizeof cmd, "test -z \"$(ls -A '%s')\"", dir);
+    assert_int_equal(system(cmd), 0);
 }
 
 /* A world straight into a sequence; a picture of the wrong size is refused. */
@@ -187,7 +343,8 @@ static void test_bad_arguments(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_png_folder), cmocka_unit_test(test_add_world), cmocka_unit_test(test_video), cmocka_unit_test(test_missing_ffmpeg),
+        cmocka_unit_test(test_png_folder), cmocka_unit_test(test_png_filters), cmocka_unit_test(test_png_alpha),
+        cmocka_unit_test(test_png_write_error), cmocka_unit_test(test_add_world), cmocka_unit_test(test_video), cmocka_unit_test(test_missing_ffmpeg),
         cmocka_unit_test(test_bad_arguments)};
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -10,7 +10,6 @@
  * an error from spn_frames_add instead of killing the program. */
 #include "render_internal.h"
 
-#include <cairo.h>
 #include <errno.h>
 #include <signal.h>
 #include <stdlib.h>
@@ -191,41 +190,13 @@ static spn_status write_all(int fd, const uint8_t *p, size_t n)
 
 static spn_status add_png(spn_frames *f, const uint8_t *rgba)
 {
-    cairo_surface_t *s = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, f->width, f->height);
-    if (cairo_surface_status(s) != CAIRO_STATUS_SUCCESS) {
-        cairo_surface_destroy(s);
-        return spn_error(SPN_ERR_NOMEM, "frames: out of memory");
-    }
-    cairo_surface_flush(s);
-    unsigned char *data = cairo_image_surface_get_data(s);
-    int stride = cairo_image_surface_get_stride(s);
-    for (int y = 0; y < f->height; y++)
-        for (int x = 0; x < f->width; x++) {
-            const uint8_t *p = rgba + ((size_t)y * f->width + x) * 4;
-            unsigned a = p[3];
-            uint32_t v = (uint32_t)a << 24;
-            for (int i = 0; i < 3; i++) v |= (uint32_t)((p[i] * a + 127) / 255) << (16 - 8 * i);
-            *(uint32_t *)(data + (size_t)y * stride + (size_t)x * 4) = v;
-        }
-    cairo_surface_mark_dirty(s);
     size_t n = strlen(f->dir) + 32;
     char *path = malloc(n);
-    spn_status st = path ? SPN_OK : spn_error(SPN_ERR_NOMEM, "out of memory");
-    spn_atomic_file af;
-    if (st == SPN_OK) {
-        snprintf(path, n, "%s/frame_%05d.png", f->dir, f->index);
-        st = spn_atomic_open(&af, path, false);
-    }
-    if (st == SPN_OK) {
-        if (cairo_surface_write_to_png(s, af.tmp_path) != CAIRO_STATUS_SUCCESS) {
-            st = spn_error(SPN_ERR_IO, "%s: cannot write", path);
-            spn_atomic_abort(&af);
-        } else {
-            st = spn_atomic_commit(&af);
-        }
-    }
+    if (!path) return spn_error(SPN_ERR_NOMEM, "out of memory");
+    snprintf(path, n, "%s/frame_%05d.png", f->dir, f->index);
+    spn__png_pixels px = {rgba, f->width, f->height, (size_t)f->width * 4, false};
+    spn_status st = spn__png_write(&px, SPN__PNG_LEVEL_FRAME, path);
     free(path);
-    cairo_surface_destroy(s);
     return st;
 }
 

@@ -140,16 +140,10 @@ spn_status spn_render_rgba(const spn_world *w, const spn_render_def *def, uint8_
     spn_status st = render_image(w, def, &s);
     if (st != SPN_OK) return st;
     const unsigned char *data = cairo_image_surface_get_data(s);
-    int stride = cairo_image_surface_get_stride(s);
+    size_t stride = (size_t)cairo_image_surface_get_stride(s);
     for (int y = 0; y < def->height; y++)
-        for (int x = 0; x < def->width; x++) {
-            uint32_t v = *(const uint32_t *)(data + (size_t)y * stride + (size_t)x * 4);
-            uint8_t *o = rgba + ((size_t)y * def->width + x) * 4;
-            unsigned a = v >> 24;
-            unsigned c[3] = {(v >> 16) & 255, (v >> 8) & 255, v & 255};
-            for (int i = 0; i < 3; i++) o[i] = (uint8_t)(a ? (c[i] * 255 + a / 2) / a : 0);
-            o[3] = (uint8_t)a;
-        }
+        spn__unpremultiply_row((const uint32_t *)(const void *)(data + (size_t)y * stride), def->width,
+                               rgba + (size_t)y * def->width * 4, 4);
     cairo_surface_destroy(s);
     return SPN_OK;
 }
@@ -172,17 +166,9 @@ static spn_status write_png(const spn_world *w, const spn_render_def *def, const
     cairo_surface_t *s = NULL;
     spn_status st = render_image(w, def, &s);
     if (st != SPN_OK) return st;
-    spn_atomic_file f;
-    st = spn_atomic_open(&f, path, false);
-    if (st == SPN_OK) {
-        cairo_status_t cs = cairo_surface_write_to_png(s, f.tmp_path);
-        if (cs != CAIRO_STATUS_SUCCESS) {
-            st = spn_error(SPN_ERR_IO, "%s: cannot write: %s", path, cairo_status_to_string(cs));
-            spn_atomic_abort(&f);
-        } else {
-            st = spn_atomic_commit(&f);
-        }
-    }
+    spn__png_pixels px = {cairo_image_surface_get_data(s), def->width, def->height,
+                          (size_t)cairo_image_surface_get_stride(s), true};
+    st = spn__png_write(&px, SPN__PNG_LEVEL_PICTURE, path);
     cairo_surface_destroy(s);
     return st;
 }

@@ -86,4 +86,25 @@ spn_status spn__cairo_draw(const spn_world *w, const spn_render_def *def, cairo_
 void spn__cairo_water_drop(cairo_t *cr, double x, double y, double r, double bg_luma, cairo_surface_t *bg,
                            const double bg_map[3]);
 
+/* ---- PNG files (png_write.c) -------------------------------------------- */
+
+/* Pixels to write: RGBA bytes (straight alpha), or cairo ARGB32 words
+ * (premultiplied, native byte order), `stride` bytes a row. */
+typedef struct spn__png_pixels {
+    const uint8_t *data;
+    int width, height;
+    size_t stride;
+    bool premultiplied;
+} spn__png_pixels;
+
+/* zlib levels: frames want speed, pictures size (png_write.c says why). */
+#define SPN__PNG_LEVEL_FRAME 1
+#define SPN__PNG_LEVEL_PICTURE 6
+
+/* Write `src` to `path` (a temporary renamed into place); an opaque picture
+ * as RGB, else RGBA. */
+spn_status spn__png_write(const spn__png_pixels *src, int level, const char *path);
+/* cairo ARGB32 words to straight RGB (channels 3) or RGBA (4) bytes. */
+void spn__unpremultiply_row(const uint32_t *src, int width, uint8_t *out, int channels);
+
 #endif
