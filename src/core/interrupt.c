@@ -2,41 +2,45 @@
  *
  * The handler may only do async-signal-safe things: it reads fixed slots of
  * temporary paths and unlinks them, formats numbers by hand into a stack
- * buffer, write()s one line and _exit()s. The slots are written by the main
- * thread between signals; a pointer store is atomic on every platform we
- * build for, and a slot is cleared before its string is freed. */
+ * buffer, write()s one line and _exit()s. The slots are lock-free atomic
+ * pointers: a thread takes a free one by compare-and-swap (`animate` writes
+ * frames on a second thread while the main one may save states), the
+ * handler loads them, and a slot is cleared before its string is freed. */
 #define _POSIX_C_SOURCE 200809L
 #include "spinneret/interrupt.h"
 
 #include "core_internal.h"
 
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
 
 enum { TEMP_SLOTS = 64 };
 
-static const char *volatile temps[TEMP_SLOTS];
+static _Atomic(const char *) temps[TEMP_SLOTS];
+_Static_assert(ATOMIC_POINTER_LOCK_FREE == 2, "the signal handler reads the slots: they must be lock-free");
 static volatile sig_atomic_t graceful, caught;
 static volatile uint64_t progress_done, progress_total;
 static char label[64] = "spinneret", unit[32] = "steps";
 
 void spn__temp_track(const char *tmp_path)
 {
-    for (int i = 0; i < TEMP_SLOTS; i++)
-        if (!temps[i]) {
-            temps[i] = tmp_path;
-            return;
-        }
+    for (int i = 0; i < TEMP_SLOTS; i++) {
+        const char *empty = NULL;
+        if (atomic_compare_exchange_strong(&temps[i], &empty, tmp_path)) return;
+    }
     /* More than 64 outputs open at once: the extra ones are not cleaned up
      * by a signal (they are still removed by abort and never renamed). */
 }
 
 void spn__temp_untrack(const char *tmp_path)
 {
-    for (int i = 0; i < TEMP_SLOTS; i++)
-        if (temps[i] == tmp_path) temps[i] = NULL;
+    for (int i = 0; i < TEMP_SLOTS; i++) {
+        const char *mine = tmp_path;
+        atomic_compare_exchange_strong(&temps[i], &mine, NULL);
+    }
 }
 
 const char *spn_signal_name(int sig)
@@ -65,8 +69,10 @@ static void put_number(char *buf, size_t *n, size_t cap, uint64_t v)
 
 static void die(int sig)
 {
-    for (int i = 0; i < TEMP_SLOTS; i++)
-        if (temps[i]) unlink(temps[i]);
+    for (int i = 0; i < TEMP_SLOTS; i++) {
+        const char *path = atomic_load(&temps[i]);
+        if (path) unlink(path);
+    }
     char line[256];
     size_t n = 0;
     put(line, &n, sizeof line, label);
