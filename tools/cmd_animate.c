@@ -6,6 +6,7 @@
  * SIGINT/SIGTERM stop after the current step: finished PNG frames and state
  * files stay, a video or report being written is abandoned. */
 #include "cli.h"
+#include "frame_pipe.h"
 #include "render_options.h"
 
 #include <errno.h>
@@ -237,6 +238,7 @@ typedef struct frame_ctx {
     spn_frames *frames;
     uint8_t *rgba;
     spn_progress *bar;
+    frame_pipe *pipe;
 } frame_ctx;
 
 /* Where the camera puts world point p, and how many pixels a metre there is. */
@@ -296,14 +298,22 @@ static void draw_prey(const frame_ctx *c, const spn_world *w)
     }
 }
 
-static spn_status on_frame(void *user, int frame, const spn_world *w)
+/* Draw and write one frame (on the frame pipe's thread, from a copy). */
+static spn_status draw_frame(void *user, int frame, const spn_world *w)
 {
+    (void)frame;
     frame_ctx *c = user;
     spn_status st = spn_render_rgba(w, &c->o->render, c->rgba);
     if (st != SPN_OK) return st;
     draw_prey(c, w);
-    st = spn_frames_add(c->frames, c->rgba);
-    if (st == SPN_OK && c->o->states) {
+    return spn_frames_add(c->frames, c->rgba);
+}
+
+static spn_status on_frame(void *user, int frame, const spn_world *w)
+{
+    frame_ctx *c = user;
+    spn_status st = SPN_OK;
+    if (c->o->states) {
         size_t n = strlen(c->o->states) + 32;
         char *path = malloc(n);
         if (!path) return spn_error(SPN_ERR_NOMEM, "out of memory");
@@ -311,7 +321,7 @@ static spn_status on_frame(void *user, int frame, const spn_world *w)
         st = spn_web_save(w, path);
         free(path);
     }
-    return st;
+    return st == SPN_OK ? frame_pipe_push(c->pipe, frame, w) : st;
 }
 
 static void on_progress(void *user, int frame, int frames)
@@ -370,6 +380,7 @@ static spn_status prepare(animate_options *o, spn_world **w, frame_ctx *c)
     double rate = o->playback_fps > 0 ? o->playback_fps : fmin(o->anim.fps, 240);
     st = spn_frames_open(o->output, o->render.width, o->render.height, rate, &c->frames);
     if (st == SPN_OK) spn_frames_set_first_index(c->frames, o->anim.first_frame);
+    if (st == SPN_OK) st = frame_pipe_open(&c->pipe, draw_frame, c);
     return st;
 }
 
@@ -397,7 +408,7 @@ static int animate_run(animate_options *o)
     spn_world *w = NULL;
     int code = render_load_world(CMD, o->input, &w);
     if (code) return code;
-    frame_ctx c = {o, NULL, NULL, NULL};
+    frame_ctx c = {o, NULL, NULL, NULL, NULL};
     spn_status st = prepare(o, &w, &c);
     if (st == SPN_OK) hint_solver(o, w);
     spn_anim_report rep;
@@ -415,6 +426,10 @@ static int animate_run(animate_options *o)
         o->anim.progress = on_progress;
         o->anim.progress_user = &c;
         st = spn_animate(&w, &o->anim, on_frame, &c, &rep);
+        /* the last frame is still being written */
+        spn_status pipe_st = frame_pipe_close(c.pipe);
+        c.pipe = NULL;
+        if (st == SPN_OK) st = pipe_st;
         spn_progress_end(c.bar);
         sigaction(SIGINT, &old_int, NULL);
         sigaction(SIGTERM, &old_term, NULL);
@@ -422,6 +437,7 @@ static int animate_run(animate_options *o)
     bool done = st == SPN_OK && !rep.interrupted;
     /* Interrupted, the complete frames are kept (a shorter video), as every
      * other frame-writing command does; the report needs the whole run. */
+    frame_pipe_close(c.pipe); /* when prepare failed after opening it */
     spn_status close_st = spn_frames_close(c.frames, st == SPN_OK && rep.frames > 0);
     if (st == SPN_OK) st = close_st;
     if (done && st == SPN_OK && o->report) st = write_report(o->report, &rep.impact);

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # spinneret animate: --frame-range frames are the same bits as the whole run's,
 # the impact report reads as JSON with the outcome, bad options are refused
-# with the option named and nothing written, and an interrupt keeps finished
-# frames and leaves no partial video.
+# with the option named and nothing written, a frame that cannot be written
+# fails the run, and an interrupt keeps finished frames and leaves no partial
+# video.
 . "$(dirname "$0")/lib/common.sh" "$@"
 WEB=$SPN_TEST_DATA/anim/orb.json
 
@@ -68,6 +69,15 @@ for b in bad1 bad2 bad3 bad4 bad5 bad6 bad7 bad8 r2.json; do
   [ -e "$T/$b" ] && fail "a refused run left $b behind"
 done
 [ -e "$T/bad6" ] && fail "frame-range failure left output"
+
+# A frame that cannot be written (the file size limit here, as a full disk
+# would) fails the run with the frame named, though frames are drawn and
+# written on a thread of their own (tools/frame_pipe.c); no partial file.
+( trap '' XFSZ; ulimit -f 16; "$SPN" animate "$WEB" -o "$T/full" --duration 1 --fps 10 --size 300x300 --quiet ) 2> "$T/err"
+code=$?
+[ $code -eq 1 ] || fail "a run whose frames cannot be written exited $code, expected 1"
+grep -q "full/frame_0000[0-9].png: cannot write" "$T/err" || fail "write failure message: $(cat "$T/err")"
+ls -a "$T/full" | grep -q tmp && fail "a failed frame left a temporary file"
 
 # Interrupt: finished frames stay (a shorter video), nothing partial.
 if command -v ffmpeg > /dev/null; then

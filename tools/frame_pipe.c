@@ -1,0 +1,108 @@
+/* See frame_pipe.h. One worker thread, one slot: `job` is the world copy
+ * being drawn (or waiting to be), `busy` while it is. Errors are per thread
+ * (spn_last_error), so the worker keeps the first failure's status and
+ * message, and the main thread raises them again as its own. */
+#include "frame_pipe.h"
+
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+struct frame_pipe {
+    frame_pipe_fn fn;
+    void *user;
+    pthread_t thread;
+    pthread_mutex_t lock;
+    pthread_cond_t changed;
+    spn_world *job;
+    int job_frame;
+    bool busy, quit;
+    spn_status failed;
+    char message[1024];
+};
+
+static void *worker(void *arg)
+{
+    frame_pipe *p = arg;
+    pthread_mutex_lock(&p->lock);
+    for (;;) {
+        while (!p->busy && !p->quit) pthread_cond_wait(&p->changed, &p->lock);
+        if (!p->busy) break;
+        spn_world *w = p->job;
+        int frame = p->job_frame;
+        bool skip = p->failed != SPN_OK;
+        pthread_mutex_unlock(&p->lock);
+        spn_status st = skip ? SPN_OK : p->fn(p->user, frame, w);
+        spn_world_destroy(w);
+        pthread_mutex_lock(&p->lock);
+        if (st != SPN_OK && p->failed == SPN_OK) {
+            p->failed = st;
+            snprintf(p->message, sizeof p->message, "%s", spn_last_error());
+        }
+        p->job = NULL;
+        p->busy = false;
+        pthread_cond_broadcast(&p->changed);
+    }
+    pthread_mutex_unlock(&p->lock);
+    return NULL;
+}
+
+spn_status frame_pipe_open(frame_pipe **pipe, frame_pipe_fn fn, void *user)
+{
+    *pipe = NULL;
+    frame_pipe *p = calloc(1, sizeof *p);
+    if (!p) return spn_error(SPN_ERR_NOMEM, "out of memory");
+    p->fn = fn;
+    p->user = user;
+    pthread_mutex_init(&p->lock, NULL);
+    pthread_cond_init(&p->changed, NULL);
+    if (pthread_create(&p->thread, NULL, worker, p) != 0) {
+        pthread_cond_destroy(&p->changed);
+        pthread_mutex_destroy(&p->lock);
+        free(p);
+        return spn_error(SPN_ERR_NOMEM, "cannot start the frame-writing thread");
+    }
+    *pipe = p;
+    return SPN_OK;
+}
+
+/* Wait until no frame is in flight (the lock held); the failure so far. */
+static spn_status drain(frame_pipe *p)
+{
+    while (p->busy) pthread_cond_wait(&p->changed, &p->lock);
+    return p->failed;
+}
+
+spn_status frame_pipe_push(frame_pipe *p, int frame, const spn_world *w)
+{
+    spn_world *copy = spn_world_clone(w);
+    if (!copy) return spn_error(SPN_ERR_NOMEM, "out of memory copying the world for frame %d", frame);
+    pthread_mutex_lock(&p->lock);
+    spn_status st = drain(p);
+    if (st == SPN_OK) {
+        p->job = copy;
+        p->job_frame = frame;
+        p->busy = true;
+        pthread_cond_broadcast(&p->changed);
+    }
+    pthread_mutex_unlock(&p->lock);
+    if (st == SPN_OK) return SPN_OK;
+    spn_world_destroy(copy);
+    return spn_error(st, "%s", p->message);
+}
+
+spn_status frame_pipe_close(frame_pipe *p)
+{
+    if (!p) return SPN_OK;
+    pthread_mutex_lock(&p->lock);
+    spn_status st = drain(p);
+    p->quit = true;
+    pthread_cond_broadcast(&p->changed);
+    pthread_mutex_unlock(&p->lock);
+    pthread_join(p->thread, NULL);
+    if (st != SPN_OK) spn_error(st, "%s", p->message);
+    pthread_cond_destroy(&p->changed);
+    pthread_mutex_destroy(&p->lock);
+    free(p);
+    return st;
+}
