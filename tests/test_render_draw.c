@@ -12,6 +12,7 @@
 
 #include <cairo.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -160,23 +161,36 @@ static void test_alpha_blend_and_joints(void **state)
     spn_world_destroy(w);
 }
 
-/* A 4 x 2 test image of four coloured quadrants, stretched over a square
- * canvas by cover scaling: the middle half of the image width shows. */
-static const char *write_test_background(char *path, size_t n)
+/* A 4 x 2 test image of four coloured quadrants (their colours turned by
+ * `turn` places), stretched over a square canvas by cover scaling: the
+ * middle half of the image width shows. */
+static const double quadrant_rgb[4][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}};
+
+static const char *write_test_background(char *path, size_t n, int turn)
 {
     snprintf(path, n, "%s/render_bg_%ld.png", SPN_BUILD_DIR, (long)getpid());
     cairo_surface_t *s = cairo_image_surface_create(CAIRO_FORMAT_RGB24, 400, 200);
     cairo_t *cr = cairo_create(s);
-    const double q[4][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}};
     for (int i = 0; i < 4; i++) {
+        const double *q = quadrant_rgb[(i + turn) % 4];
         cairo_rectangle(cr, (i % 2) * 200, (i / 2) * 100, 200, 100);
-        cairo_set_source_rgb(cr, q[i][0], q[i][1], q[i][2]);
+        cairo_set_source_rgb(cr, q[0], q[1], q[2]);
         cairo_fill(cr);
     }
     cairo_destroy(cr);
     assert_int_equal(cairo_surface_write_to_png(s, path), CAIRO_STATUS_SUCCESS);
     cairo_surface_destroy(s);
     return path;
+}
+
+/* Canvas quadrants show image quadrants: the image is 2:1, scaled by 1 to
+ * 200 px high and cropped to its middle 200 px. */
+static void assert_quadrants(const uint8_t *px, int turn)
+{
+    const int probe[4][2] = {{50, 40}, {150, 40}, {50, 160}, {150, 160}};
+    for (int k = 0; k < 4; k++)
+        for (int c = 0; c < 3; c++)
+            assert_int_equal(px[(probe[k][1] * SIDE + probe[k][0]) * 4 + c], 255 * quadrant_rgb[(k + turn) % 4][c]);
 }
 
 static void test_background_shows_where_no_thread(void **state)
@@ -186,24 +200,75 @@ static void test_background_shows_where_no_thread(void **state)
     const double seg[1][4] = {{-0.5, 0.0, 0.5, 0.0}};
     spn_world *w = segments_world(seg, 1, SPN_THREAD_GENERIC);
     spn_render_def d = known_def(4);
-    d.background_png = write_test_background(path, sizeof path);
+    d.background_png = write_test_background(path, sizeof path, 0);
     uint8_t *px = malloc(SIDE * SIDE * 4);
     assert_int_equal(spn_render_rgba(w, &d, px), SPN_OK);
-    /* Canvas quadrants show image quadrants: the image is 2:1, scaled by 1
-     * to 200 px high and cropped to its middle 200 px. */
-    const int probe[4][2] = {{50, 40}, {150, 40}, {50, 160}, {150, 160}};
-    const uint8_t want[4][3] = {{255, 0, 0}, {0, 255, 0}, {0, 0, 255}, {255, 255, 0}};
-    for (int k = 0; k < 4; k++)
-        for (int c = 0; c < 3; c++) assert_int_equal(px[(probe[k][1] * SIDE + probe[k][0]) * 4 + c], want[k][c]);
+    assert_quadrants(px, 0);
     /* The thread covers the image on its line. */
     assert_int_equal(px[(100 * SIDE + 30) * 4 + 2], 255);
     assert_int_equal(px[(100 * SIDE + 30) * 4 + 1], 255);
+    /* The decoded image is kept between pictures, but a file written again
+     * at once (the same size, the same path) is what the next one shows. */
+    for (int turn = 1; turn < 4; turn++) {
+        write_test_background(path, sizeof path, turn);
+        for (int again = 0; again < 2; again++) {
+            memset(px, 0, SIDE * SIDE * 4);
+            assert_int_equal(spn_render_rgba(w, &d, px), SPN_OK);
+            assert_quadrants(px, turn);
+        }
+    }
     remove(path);
     d.background_png = "/nonexistent/sky.png";
     assert_int_equal(spn_render_rgba(w, &d, px), SPN_ERR_IO);
     assert_non_null(strstr(spn_last_error(), "/nonexistent/sky.png"));
+    assert_non_null(strstr(spn_last_error(), "background"));
     free(px);
     spn_world_destroy(w);
+    spn_render_release_caches();
+}
+
+/* A thread that draws over a background and ends leaves nothing behind (its
+ * decoded image goes with it: the sanitizer build's leak check sees to
+ * that), and draws what the main thread draws. */
+typedef struct drawing {
+    const spn_world *w;
+    const spn_render_def *d;
+    uint8_t *px;
+    spn_status st;
+} drawing;
+
+static void *draw_on_thread(void *arg)
+{
+    drawing *job = arg;
+    job->st = spn_render_rgba(job->w, job->d, job->px);
+    return NULL;
+}
+
+static void test_background_on_threads(void **state)
+{
+    (void)state;
+    char path[512];
+    const double seg[1][4] = {{-0.5, 0.0, 0.5, 0.0}};
+    spn_world *w = segments_world(seg, 1, SPN_THREAD_GENERIC);
+    spn_render_def d = known_def(4);
+    d.background_png = write_test_background(path, sizeof path, 2);
+    uint8_t *mine = malloc(SIDE * SIDE * 4), *theirs[2] = {malloc(SIDE * SIDE * 4), malloc(SIDE * SIDE * 4)};
+    assert_int_equal(spn_render_rgba(w, &d, mine), SPN_OK);
+    drawing jobs[2] = {{w, &d, theirs[0], SPN_ERR_INVALID}, {w, &d, theirs[1], SPN_ERR_INVALID}};
+    pthread_t t[2];
+    for (int i = 0; i < 2; i++) assert_int_equal(pthread_create(&t[i], NULL, draw_on_thread, &jobs[i]), 0);
+    for (int i = 0; i < 2; i++) {
+        assert_int_equal(pthread_join(t[i], NULL), 0);
+        assert_int_equal(jobs[i].st, SPN_OK);
+        assert_memory_equal(theirs[i], mine, SIDE * SIDE * 4);
+    }
+    assert_quadrants(mine, 2);
+    remove(path);
+    free(mine);
+    free(theirs[0]);
+    free(theirs[1]);
+    spn_world_destroy(w);
+    spn_render_release_caches();
 }
 
 typedef struct counts {
@@ -517,7 +582,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_ink_where_expected),      cmocka_unit_test(test_kind_widths),
         cmocka_unit_test(test_alpha_blend_and_joints),
-        cmocka_unit_test(test_background_shows_where_no_thread), cmocka_unit_test(test_orb_web_strands),
+        cmocka_unit_test(test_background_shows_where_no_thread), cmocka_unit_test(test_background_on_threads),
+        cmocka_unit_test(test_orb_web_strands),
         cmocka_unit_test(test_dew_spacing_and_radius),  cmocka_unit_test(test_deterministic_pixels),
         cmocka_unit_test(test_colour_by_tension),       cmocka_unit_test(test_bad_definitions),
         cmocka_unit_test(test_vector_outputs),          cmocka_unit_test(test_perspective_projection),

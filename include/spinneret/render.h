@@ -159,9 +159,10 @@ SPN_API spn_status spn_frames_add_world(spn_frames *frames, const spn_world *w, 
 SPN_API void spn_frames_size(const spn_frames *frames, int *width, int *height);
 
 /// Release the font and surface caches cairo and fontconfig keep for the
-/// life of the process (legend text fills them), so leak checkers see a clean
-/// exit. Call once, just before exiting, when nothing else uses cairo; the
-/// commands that draw do.
+/// life of the process (legend text fills them) and the calling thread's
+/// decoded background image (each thread keeps the last one it drew, until it
+/// ends), so leak checkers see a clean exit. Call once, just before exiting,
+/// when nothing else uses cairo; the commands that draw do.
 SPN_API void spn_render_release_caches(void);
 
 /* ---- progress on stderr ------------------------------------------------ */

@@ -2,10 +2,9 @@
 #ifndef SPN_MESH_INTERNAL_H
 #define SPN_MESH_INTERNAL_H
 
+#include "core/read_file.h"
 #include "spinneret/mesh.h"
 
-/* Read a whole file (NUL-terminated); messages name `path`. */
-spn_status spn__read_file(const char *path, char **data, size_t *size);
 /* Grow *arr (element size `elem`) so that it holds at least `need` elements. */
 bool spn__grow(void **arr, uint32_t *cap, uint32_t need, size_t elem);
 /* Add a group name to a mesh being built; its id in *id. */

@@ -25,30 +25,12 @@ static spn_status load_background(canvas *c)
     const spn_render_def *d = c->def;
     c->bg_luma = 0.2126 * d->background_rgb[0] + 0.7152 * d->background_rgb[1] + 0.0722 * d->background_rgb[2];
     if (!d->background_png) return SPN_OK;
-    cairo_surface_t *s = cairo_image_surface_create_from_png(d->background_png);
-    if (cairo_surface_status(s) != CAIRO_STATUS_SUCCESS) {
-        cairo_status_t why = cairo_surface_status(s);
-        cairo_surface_destroy(s);
-        return spn_error(why == CAIRO_STATUS_FILE_NOT_FOUND || why == CAIRO_STATUS_READ_ERROR ? SPN_ERR_IO
-                                                                                            : SPN_ERR_FORMAT,
-                         "%s: cannot read background: %s", d->background_png, cairo_status_to_string(why));
-    }
-    int bw = cairo_image_surface_get_width(s), bh = cairo_image_surface_get_height(s);
-    c->bg = s;
+    spn_status st = spn__backdrop_get(d->background_png, &c->bg, &c->bg_luma);
+    if (st != SPN_OK) return st;
+    int bw = cairo_image_surface_get_width(c->bg), bh = cairo_image_surface_get_height(c->bg);
     c->bg_scale = fmax(c->view.width / bw, c->view.height / bh);
     c->bg_ox = 0.5 * (c->view.width - bw * c->bg_scale);
     c->bg_oy = 0.5 * (c->view.height - bh * c->bg_scale);
-    /* Average brightness from a coarse grid: chooses how drop rims are lit. */
-    const unsigned char *px = cairo_image_surface_get_data(s);
-    int stride = cairo_image_surface_get_stride(s);
-    double sum = 0;
-    int n = 0;
-    for (int y = bh / 32; y < bh; y += bh / 16 + 1)
-        for (int x = bw / 32; x < bw; x += bw / 16 + 1, n++) {
-            uint32_t v = *(const uint32_t *)(px + (size_t)y * stride + (size_t)x * 4);
-            sum += (0.2126 * ((v >> 16) & 255) + 0.7152 * ((v >> 8) & 255) + 0.0722 * (v & 255)) / 255.0;
-        }
-    if (n) c->bg_luma = sum / n;
     return SPN_OK;
 }
 

@@ -232,6 +232,7 @@ extern void FcFini(void) __attribute__((weak));
 
 void spn_render_release_caches(void)
 {
+    spn__backdrop_forget();
     cairo_debug_reset_static_data();
 #if defined(__GNUC__)
     if (FcFini) FcFini();

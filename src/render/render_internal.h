@@ -86,6 +86,15 @@ spn_status spn__cairo_draw(const spn_world *w, const spn_render_def *def, cairo_
 void spn__cairo_water_drop(cairo_t *cr, double x, double y, double r, double bg_luma, cairo_surface_t *bg,
                            const double bg_map[3]);
 
+/* ---- background images (backdrop.c) -------------------------------------- */
+
+/* The PNG at `path`, decoded (or this thread's copy from the last call with
+ * the same unchanged file): a new reference for the caller to destroy, and
+ * its mean brightness 0..1. */
+spn_status spn__backdrop_get(const char *path, cairo_surface_t **image, double *luma);
+/* Free this thread's decoded background. */
+void spn__backdrop_forget(void);
+
 /* ---- PNG files (png_write.c) -------------------------------------------- */
 
 /* Pixels to write: RGBA bytes (straight alpha), or cairo ARGB32 words
