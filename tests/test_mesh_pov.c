@@ -1,7 +1,9 @@
 /* The film maker's scenes: declarations read from mesh2 objects, the scene
  * written back unchanged apart from number formatting when nothing moved,
  * only vertex numbers changed when something did, and malformed scenes in
- * tests/data/bad/ refused with the line named. */
+ * tests/data/bad/ refused with the line named; frame folders rendered by
+ * several povray processes at once, each frame its own picture, the first
+ * frame that fails named. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -13,6 +15,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
+#include <cairo.h>
 #include <spinneret/spinneret.h>
 
 static const char scene[] =
@@ -133,12 +137,58 @@ static void test_bad_scenes_name_the_line(void **state)
     assert_non_null(strstr(spn_last_error(), "e.pov:2:"));
 }
 
+/* Frame i: nothing but a background of linear red i/8 (or a syntax error). */
+static void write_frame(const char *dir, int i, bool broken)
+{
+    char path[600];
+    snprintf(path, sizeof path, "%s/frame_%05d.pov", dir, i);
+    FILE *fp = fopen(path, "w");
+    assert_non_null(fp);
+    fprintf(fp, broken ? "#version 3.7;\nbackground { color rgb <\n" : "#version 3.7;\nbackground { color rgb <%g, 0, 1> }\n",
+            i / 8.0);
+    fclose(fp);
+}
+
+static void test_render_frames_at_once(void **state)
+{
+    (void)state;
+    if (!spn_program_available("povray")) {
+        printf("skipped: povray is not installed\n");
+        skip();
+    }
+    char dir[512], cmd[600];
+    snprintf(dir, sizeof dir, "%s/pov_frames_XXXXXX", SPN_BUILD_DIR);
+    assert_non_null(mkdtemp(dir));
+    enum { N = 9 };
+    for (int i = 0; i < N; i++) write_frame(dir, i, i == 4 || i == 6);
+    assert_int_equal(spn_pov_render_frames(dir, N, 16, 12, 10, NULL), SPN_ERR_IO);
+    assert_non_null(strstr(spn_last_error(), "frame_00004.pov: povray failed"));
+    write_frame(dir, 4, false);
+    write_frame(dir, 6, false);
+    assert_int_equal(spn_pov_render_frames(dir, N, 16, 12, 10, NULL), SPN_OK);
+    for (int i = 0; i < N; i++) {
+        char path[600];
+        snprintf(path, sizeof path, "%s/frame_%05d.png", dir, i);
+        cairo_surface_t *png = cairo_image_surface_create_from_png(path);
+        assert_int_equal(cairo_surface_status(png), CAIRO_STATUS_SUCCESS);
+        uint32_t v = *(const uint32_t *)(const void *)cairo_image_surface_get_data(png);
+        /* povray writes sRGB: the scene's linear i/8 encoded */
+        double c = i / 8.0, srgb = c <= 0.0031308 ? 12.92 * c : 1.055 * pow(c, 1 / 2.4) - 0.055;
+        int red = (int)((v >> 16) & 255), want = (int)lround(255 * srgb);
+        if (abs(red - want) > 2) fail_msg("frame %d: red %d, expected %d (its own scene's)", i, red, want);
+        cairo_surface_destroy(png);
+    }
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    assert_int_equal(system(cmd), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_declarations),
         cmocka_unit_test(test_round_trip),
         cmocka_unit_test(test_bad_scenes_name_the_line),
+        cmocka_unit_test(test_render_frames_at_once),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -115,11 +115,11 @@ bool spn_program_available(const char *program)
     return false;
 }
 
-/* Run argv[0] with its output discarded, from `dir` (NULL: here); exit status or -1. */
-static int run(char *const argv[], const char *dir)
+/* Start argv[0] with its output discarded, from `dir` (NULL: here); its
+ * pid, or -1. */
+static pid_t start(char *const argv[], const char *dir)
 {
     pid_t pid = fork();
-    if (pid < 0) return -1;
     if (pid == 0) {
         int null = open("/dev/null", O_WRONLY);
         if (null >= 0) {
@@ -130,11 +130,21 @@ static int run(char *const argv[], const char *dir)
         execvp(argv[0], argv);
         _exit(127);
     }
+    return pid;
+}
+
+/* Wait for `pid` (-1: it never started); its exit status, or -1. */
+static int finish(pid_t pid)
+{
+    if (pid < 0) return -1;
     int status;
     while (waitpid(pid, &status, 0) < 0)
         if (errno != EINTR) return -1;
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
+
+/* Run argv[0] to its end; exit status or -1. */
+static int run(char *const argv[], const char *dir) { return finish(start(argv, dir)); }
 
 /* Exactly `count` frames: older frames with higher numbers may lie in the folder. */
 static spn_status encode_movie(const char *dir, int count, double fps, const char *movie)
@@ -155,6 +165,9 @@ static spn_status encode_movie(const char *dir, int count, double fps, const cha
     return spn_atomic_commit(&f);
 }
 
+/* povray processes run at once by spn_pov_render_frames. */
+#define POV_JOBS 6
+
 spn_status spn_pov_render_frames(const char *dir, int count, int width, int height, double fps, const char *movie)
 {
     if (!spn_program_available("povray"))
@@ -163,15 +176,30 @@ spn_status spn_pov_render_frames(const char *dir, int count, int width, int heig
         return spn_error(SPN_ERR_UNSUPPORTED, "a movie needs the ffmpeg program (Debian package ffmpeg)");
     if (width < 1 || height < 1 || width > 8192 || height > 8192)
         return spn_error(SPN_ERR_INVALID, "render size %dx%d out of range", width, height);
-    char in[64], out[64], w[32], h[32];
+    char w[32], h[32];
     snprintf(w, sizeof w, "+W%d", width);
     snprintf(h, sizeof h, "+H%d", height);
-    for (int i = 0; i < count; i++) {
-        snprintf(in, sizeof in, "+Iframe_%05d.pov", i);
-        snprintf(out, sizeof out, "+Oframe_%05d.png", i);
-        char *argv[] = {"povray", in, out, w, h, "+FN", "-D", "-V", "+A0.3", NULL};
-        if (run(argv, dir) != 0)
-            return spn_error(SPN_ERR_IO, "%s/frame_%05d.pov: povray failed to render it", dir, i);
+    /* POV_JOBS frames at once, waited for in the order they were started:
+     * a povray process spends most of its time idle (a 320x240 frame of the
+     * drop: 0.78 s of wall time for 0.2 s of CPU), so one after another the
+     * demo's 51 frames took 41 s; frames take about as long as each other,
+     * so waiting for the oldest loses little. Only our own children are
+     * waited for (no waitpid(-1): the program may have others). */
+    pid_t jobs[POV_JOBS];
+    int started = 0, done = 0, failed = -1;
+    while (done < started || (started < count && failed < 0)) {
+        if (started < count && failed < 0 && started - done < POV_JOBS) {
+            char in[64], out[64];
+            snprintf(in, sizeof in, "+Iframe_%05d.pov", started);
+            snprintf(out, sizeof out, "+Oframe_%05d.png", started);
+            char *argv[] = {"povray", in, out, w, h, "+FN", "-D", "-V", "+A0.3", NULL};
+            jobs[started % POV_JOBS] = start(argv, dir);
+            started++;
+            continue;
+        }
+        if (finish(jobs[done % POV_JOBS]) != 0 && failed < 0) failed = done;
+        done++;
     }
+    if (failed >= 0) return spn_error(SPN_ERR_IO, "%s/frame_%05d.pov: povray failed to render it", dir, failed);
     return movie ? encode_movie(dir, count, fps, movie) : SPN_OK;
 }
