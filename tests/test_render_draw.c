@@ -193,14 +193,21 @@ static void assert_quadrants(const uint8_t *px, int turn)
             assert_int_equal(px[(probe[k][1] * SIDE + probe[k][0]) * 4 + c], 255 * quadrant_rgb[(k + turn) % 4][c]);
 }
 
+/* One line across the middle over the quadrant image turned `turn` places. */
+static spn_world *line_over_background(spn_render_def *d, char *path, size_t n, int turn)
+{
+    const double seg[1][4] = {{-0.5, 0.0, 0.5, 0.0}};
+    *d = known_def(4);
+    d->background_png = write_test_background(path, n, turn);
+    return segments_world(seg, 1, SPN_THREAD_GENERIC);
+}
+
 static void test_background_shows_where_no_thread(void **state)
 {
     (void)state;
     char path[512];
-    const double seg[1][4] = {{-0.5, 0.0, 0.5, 0.0}};
-    spn_world *w = segments_world(seg, 1, SPN_THREAD_GENERIC);
-    spn_render_def d = known_def(4);
-    d.background_png = write_test_background(path, sizeof path, 0);
+    spn_render_def d;
+    spn_world *w = line_over_background(&d, path, sizeof path, 0);
     uint8_t *px = malloc(SIDE * SIDE * 4);
     assert_int_equal(spn_render_rgba(w, &d, px), SPN_OK);
     assert_quadrants(px, 0);
@@ -248,10 +255,8 @@ static void test_background_on_threads(void **state)
 {
     (void)state;
     char path[512];
-    const double seg[1][4] = {{-0.5, 0.0, 0.5, 0.0}};
-    spn_world *w = segments_world(seg, 1, SPN_THREAD_GENERIC);
-    spn_render_def d = known_def(4);
-    d.background_png = write_test_background(path, sizeof path, 2);
+    spn_render_def d;
+    spn_world *w = line_over_background(&d, path, sizeof path, 2);
     uint8_t *mine = malloc(SIDE * SIDE * 4), *theirs[2] = {malloc(SIDE * SIDE * 4), malloc(SIDE * SIDE * 4)};
     assert_int_equal(spn_render_rgba(w, &d, mine), SPN_OK);
     drawing jobs[2] = {{w, &d, theirs[0], SPN_ERR_INVALID}, {w, &d, theirs[1], SPN_ERR_INVALID}};
