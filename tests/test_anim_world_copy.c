@@ -164,6 +164,48 @@ static void test_copy_keeps_lattice_and_precision(void **state)
     }
 }
 
+/* spn_world_copy_into gives what spn_world_clone gives, into a world that
+ * already exists: from an empty one (its arrays grown), again into the same
+ * (its arrays kept: the positions stay where they were), then from a smaller
+ * web; and the copy steps on as the clone does. */
+static void test_copy_into_is_a_clone(void **state)
+{
+    (void)state;
+    spn_world *w = util_small_orb(SPN_INTEGRATOR_IMPLICIT);
+    set_everything(w);
+    for (int k = 0; k < 3; k++) assert_int_equal(spn_world_step(w, 1e-3), SPN_OK);
+    spn_world *dst = spn_world_create(NULL);
+    assert_int_equal(spn_world_copy_into(dst, w), SPN_OK);
+    const spn_vec3 *kept = spn_world_positions(dst);
+    assert_int_equal(spn_world_step(dst, 1e-3), SPN_OK); /* compiled state of its own, dropped by the next copy */
+    assert_int_equal(spn_world_copy_into(dst, w), SPN_OK);
+    assert_ptr_equal(spn_world_positions(dst), kept);
+    spn_world *c = spn_world_clone(w);
+    util_same_settings(c, dst);
+    same_state(c, dst);
+    uint32_t n;
+    spn_world_contacts(dst, &n);
+    assert_int_equal(n, 0); /* as the clone: contacts are the step's, not copied */
+    for (int k = 0; k < 4; k++) {
+        assert_int_equal(spn_world_step(c, 1e-3), SPN_OK);
+        assert_int_equal(spn_world_step(dst, 1e-3), SPN_OK);
+    }
+    same_state(c, dst);
+    spn_world *small = spn_world_create(NULL);
+    spn_particle_def p = spn_particle_def_default();
+    assert_int_equal(spn_world_add_particle(small, &p, NULL), SPN_OK);
+    assert_int_equal(spn_world_copy_into(dst, small), SPN_OK);
+    assert_int_equal(spn_world_particle_count(dst), 1);
+    assert_int_equal(spn_world_spring_count(dst), 0);
+    assert_int_equal(spn_world_step(dst, 1e-3), SPN_OK);
+    assert_true(spn_world_position(dst, 0).y < 0); /* it falls */
+    assert_int_equal(spn_world_copy_into(dst, dst), SPN_OK);
+    spn_world_destroy(small);
+    spn_world_destroy(c);
+    spn_world_destroy(dst);
+    spn_world_destroy(w);
+}
+
 /* Through the animation's own door: prey added to a world keep its settings. */
 static void test_prey_world_keeps_settings(void **state)
 {
@@ -214,6 +256,7 @@ int main(void)
         cmocka_unit_test(test_copy_carries_every_setting),
         cmocka_unit_test(test_copy_mid_run_steps_on_alike),
         cmocka_unit_test(test_copy_keeps_lattice_and_precision),
+        cmocka_unit_test(test_copy_into_is_a_clone),
         cmocka_unit_test(test_prey_world_keeps_settings),
         cmocka_unit_test(test_break_setter_rejects_nan),
     };

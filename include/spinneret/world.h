@@ -98,6 +98,12 @@ SPN_API spn_world *spn_world_create(const spn_world_def *def);
 SPN_API void spn_world_destroy(spn_world *w);
 /// A deep copy (particles, springs, state, settings; callbacks too).
 SPN_API spn_world *spn_world_clone(const spn_world *w);
+/// Make `dst` what spn_world_clone(src) would give, reusing dst's particle and
+/// spring arrays where they are large enough: a snapshot taken every frame
+/// into the same world costs no new memory (a clone of a 1M-particle web
+/// spent most of its time on fresh pages). dst's own state, compiled data
+/// and contacts are dropped. SPN_ERR_NOMEM leaves dst valid to destroy.
+SPN_API spn_status spn_world_copy_into(spn_world *dst, const spn_world *src);
 SPN_API const spn_world_def *spn_world_get_def(const spn_world *w);
 
 /* ---- construction ---------------------------------------------------- */

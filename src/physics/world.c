@@ -7,6 +7,7 @@
 #include "spinneret/limits.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -541,4 +542,74 @@ spn_world *spn_world_clone(const spn_world *w)
         return NULL;
     }
     return c;
+}
+
+/* The particle and the spring arrays spn_world_clone copies, by offset, with
+ * the size of one element. */
+typedef struct world_array {
+    size_t offset, size;
+} world_array;
+
+#define WORLD_ARRAY(field) {offsetof(spn_world, field), sizeof *((spn_world *)0)->field}
+static const world_array particle_arrays[] = {WORLD_ARRAY(x), WORLD_ARRAY(v), WORLD_ARRAY(mass),
+                                              WORLD_ARRAY(inv_mass), WORLD_ARRAY(ptag)};
+static const world_array spring_arrays[] = {WORLD_ARRAY(sa),     WORLD_ARRAY(sb),    WORLD_ARRAY(k),
+                                            WORLD_ARRAY(kd),     WORLD_ARRAY(rest),  WORLD_ARRAY(bmin),
+                                            WORLD_ARRAY(bmax),   WORLD_ARRAY(sflags), WORLD_ARRAY(stag),
+                                            WORLD_ARRAY(sstage), WORLD_ARRAY(sorder)};
+#undef WORLD_ARRAY
+
+static void **array_at(spn_world *w, const world_array *a) { return (void **)((char *)w + a->offset); }
+
+/* Each of `n` arrays of dst large enough for `count` elements (grown to it
+ * when `cap` is short); false, with the ones done grown, when memory ran out. */
+static bool fit_arrays(spn_world *dst, const world_array *arrays, size_t n, uint32_t cap, uint32_t count)
+{
+    if (count <= cap) return true;
+    for (size_t i = 0; i < n; i++) {
+        void **p = array_at(dst, &arrays[i]), *bigger = realloc(*p, (size_t)count * arrays[i].size);
+        if (!bigger) return false;
+        *p = bigger;
+    }
+    return true;
+}
+
+spn_status spn_world_copy_into(spn_world *dst, const spn_world *src)
+{
+    if (dst == src) return SPN_OK;
+    spn__free_compiled(dst);
+    spn__silk_free(dst); /* the contacts too */
+    enum { NP = sizeof particle_arrays / sizeof *particle_arrays, NS = sizeof spring_arrays / sizeof *spring_arrays };
+    if (!fit_arrays(dst, particle_arrays, NP, dst->cap_p, src->np) ||
+        !fit_arrays(dst, spring_arrays, NS, dst->cap_s, src->ns))
+        return spn_error(SPN_ERR_NOMEM, "out of memory copying a world (%u particles, %u springs)", src->np, src->ns);
+    /* grown arrays hold at least this many (each array grew, or none did) */
+    uint32_t cap_p = dst->cap_p > src->np ? dst->cap_p : src->np, cap_s = dst->cap_s > src->ns ? dst->cap_s : src->ns;
+    void *keep_p[NP], *keep_s[NS];
+    for (size_t i = 0; i < NP; i++) keep_p[i] = *array_at(dst, &particle_arrays[i]);
+    for (size_t i = 0; i < NS; i++) keep_s[i] = *array_at(dst, &spring_arrays[i]);
+    free(dst->diam), free(dst->colliders), free(dst->metadata);
+    *dst = *src;
+    spn__forget_compiled(dst);
+    dst->diam = NULL, dst->colliders = NULL, dst->metadata = NULL;
+    dst->cap_p = cap_p, dst->cap_s = cap_s;
+    for (size_t i = 0; i < NP; i++) {
+        void **p = array_at(dst, &particle_arrays[i]);
+        *p = keep_p[i];
+        if (src->np) memcpy(*p, *array_at((spn_world *)src, &particle_arrays[i]), (size_t)src->np * particle_arrays[i].size);
+    }
+    for (size_t i = 0; i < NS; i++) {
+        void **p = array_at(dst, &spring_arrays[i]);
+        *p = keep_s[i];
+        if (src->ns) memcpy(*p, *array_at((spn_world *)src, &spring_arrays[i]), (size_t)src->ns * spring_arrays[i].size);
+    }
+    bool ok = dup_array((void **)&dst->diam, src->diam, src->ndiam, sizeof *src->diam) &&
+              dup_array((void **)&dst->colliders, src->colliders, src->ncolliders, sizeof *src->colliders) &&
+              dup_array((void **)&dst->metadata, src->metadata, src->metadata ? strlen(src->metadata) + 1 : 0, 1) &&
+              spn__silk_clone(dst, src);
+    if (ok) return SPN_OK;
+    /* what failed is NULL: a smaller world, but one that can be destroyed */
+    if (!dst->diam) dst->ndiam = 0;
+    if (!dst->colliders) dst->ncolliders = 0;
+    return spn_error(SPN_ERR_NOMEM, "out of memory copying a world");
 }
