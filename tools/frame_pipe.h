@@ -2,9 +2,9 @@
  * `spinneret animate` spent as long drawing and compressing a frame of a
  * species web (30 + 12 ms at 1200 x 1200) as stepping it through a frame, one
  * after the other; with the pipe the next frame's steps run while the last
- * frame is drawn. Each frame is drawn from a copy of the world
- * (spn_world_clone) taken when it is handed over, so the pictures are the
- * same bits as drawing in turn. One frame is in flight at a time: handing
+ * frame is drawn. Each frame is drawn from a copy of the world taken when
+ * it is handed over (two copies take turns, refilled by spn_world_copy_into),
+ * so the pictures are the same bits as drawing in turn. One frame is in flight at a time: handing
  * over the next waits for the one before. A frame that fails is reported by
  * the next hand-over or by the close, with its own message. */
 #ifndef SPN_FRAME_PIPE_H
