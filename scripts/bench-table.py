@@ -73,6 +73,9 @@ KNOWN = {
         ("case", "case"), ("nodes", "grid nodes"), ("ms_per_slice", "ms a slice"), ("ns_per_sample", "ns a sample"),
         ("solver", "solver"), ("wind", "wind"), ("dt", "dt s"), ("cpu_s_per_sim_s", "CPU s per simulated s"),
         ("cg_per_step", "CG a step"), ("ms_per_step", "ms a step"), ("ns_per_spring_step", "ns a spring-step")]),
+    "frames": ("A frame of `spinneret animate` besides the physics: the Araneus web drawn at 1,200 x 1,200 and written "
+               "as a PNG (bench/bench_frames.c, 1 thread, CPU)", [
+        ("case", "look"), ("draw_ms", "draw ms"), ("write_ms", "write ms"), ("bytes", "bytes a frame")]),
 }
 
 
