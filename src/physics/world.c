@@ -498,54 +498,8 @@ static bool dup_array(void **dst, const void *src, size_t n, size_t size)
     return true;
 }
 
-spn_world *spn_world_clone(const spn_world *w)
-{
-    spn_world *c = calloc(1, sizeof *c);
-    if (!c) return NULL;
-    *c = *w;
-    spn__forget_compiled(c);
-    /* Nothing may alias w's arrays if a copy below fails and c is destroyed. */
-    c->x = c->v = NULL;
-    c->mass = c->inv_mass = c->k = c->kd = c->rest = c->bmin = c->bmax = NULL;
-    c->ptag = c->sa = c->sb = c->stag = c->sstage = c->sorder = NULL;
-    c->sflags = NULL;
-    c->diam = NULL;
-    c->colliders = NULL;
-    c->metadata = NULL;
-    c->hyst = NULL;
-    c->contacts = NULL;
-    c->ncontacts = c->cap_contacts = 0;
-    c->cap_p = w->np;
-    c->cap_s = w->ns;
-    bool ok = dup_array((void **)&c->x, w->x, w->np, sizeof *w->x) &&
-              dup_array((void **)&c->v, w->v, w->np, sizeof *w->v) &&
-              dup_array((void **)&c->mass, w->mass, w->np, sizeof *w->mass) &&
-              dup_array((void **)&c->inv_mass, w->inv_mass, w->np, sizeof *w->inv_mass) &&
-              dup_array((void **)&c->ptag, w->ptag, w->np, sizeof *w->ptag) &&
-              dup_array((void **)&c->sa, w->sa, w->ns, sizeof *w->sa) &&
-              dup_array((void **)&c->sb, w->sb, w->ns, sizeof *w->sb) &&
-              dup_array((void **)&c->k, w->k, w->ns, sizeof *w->k) &&
-              dup_array((void **)&c->kd, w->kd, w->ns, sizeof *w->kd) &&
-              dup_array((void **)&c->rest, w->rest, w->ns, sizeof *w->rest) &&
-              dup_array((void **)&c->bmin, w->bmin, w->ns, sizeof *w->bmin) &&
-              dup_array((void **)&c->bmax, w->bmax, w->ns, sizeof *w->bmax) &&
-              dup_array((void **)&c->sflags, w->sflags, w->ns, sizeof *w->sflags) &&
-              dup_array((void **)&c->stag, w->stag, w->ns, sizeof *w->stag) &&
-              dup_array((void **)&c->sstage, w->sstage, w->ns, sizeof *w->sstage) &&
-              dup_array((void **)&c->sorder, w->sorder, w->ns, sizeof *w->sorder) &&
-              dup_array((void **)&c->diam, w->diam, w->ndiam, sizeof *w->diam) &&
-              dup_array((void **)&c->colliders, w->colliders, w->ncolliders, sizeof *w->colliders) &&
-              dup_array((void **)&c->metadata, w->metadata, w->metadata ? strlen(w->metadata) + 1 : 0, 1) &&
-              spn__silk_clone(c, w);
-    if (!ok) {
-        spn_world_destroy(c);
-        return NULL;
-    }
-    return c;
-}
-
-/* The particle and the spring arrays spn_world_clone copies, by offset, with
- * the size of one element. */
+/* The particle and the spring arrays a copy of a world holds (spn_world_copy_into,
+ * spn_world_clone), by offset, with the size of one element. */
 typedef struct world_array {
     size_t offset, size;
 } world_array;
@@ -612,4 +566,15 @@ spn_status spn_world_copy_into(spn_world *dst, const spn_world *src)
     if (!dst->diam) dst->ndiam = 0;
     if (!dst->colliders) dst->ncolliders = 0;
     return spn_error(SPN_ERR_NOMEM, "out of memory copying a world");
+}
+
+/* A clone is a copy into an empty world: one list of what a world owns
+ * (particle_arrays, spring_arrays and spn_world_copy_into's rest). */
+spn_world *spn_world_clone(const spn_world *w)
+{
+    spn_world *c = calloc(1, sizeof *c);
+    if (!c) return NULL;
+    if (spn_world_copy_into(c, w) == SPN_OK) return c;
+    spn_world_destroy(c);
+    return NULL;
 }
