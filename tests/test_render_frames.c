@@ -246,6 +246,80 @@ static void test_add_world(void **state)
     spn_world_destroy(w);
 }
 
+/* The whole of a file; its size in *n. */
+static uint8_t *slurp(const char *path, size_t *n)
+{
+    FILE *fp = fopen(path, "rb");
+    assert_non_null(fp);
+    fseek(fp, 0, SEEK_END);
+    *n = (size_t)ftell(fp);
+    rewind(fp);
+    uint8_t *b = malloc(*n ? *n : 1);
+    assert_int_equal(fread(b, 1, *n, fp), *n);
+    fclose(fp);
+    return b;
+}
+
+/* Frames encoded apart (as threads drawing frames at once do) and added in
+ * order give the files spn_frames_add writes, byte for byte; an encoded
+ * frame of the wrong size is refused by a video. */
+static void test_encoded(void **state)
+{
+    (void)state;
+    enum { W = 64, H = 40 };
+    char dir[2][600], path[2][1300];
+    uint8_t *px[3];
+    for (int i = 0; i < 3; i++) {
+        px[i] = malloc((size_t)W * H * 4);
+        for (int k = 0; k < W * H * 4; k++) px[i][k] = k % 4 == 3 ? (uint8_t)(i == 2 ? 128 : 255) : noise((uint32_t)(k + 77 * i));
+    }
+    for (int v = 0; v < 2; v++) {
+        snprintf(dir[v], sizeof dir[v], "%s/enc%d", folder, v);
+        spn_frames *f;
+        assert_int_equal(spn_frames_open(dir[v], W, H, 25, &f), SPN_OK);
+        uint8_t *bytes[3];
+        size_t size[3];
+        if (v == 1) /* all encoded first, in reverse, then added in order */
+            for (int i = 2; i >= 0; i--) assert_int_equal(spn_frames_encode(f, px[i], &bytes[i], &size[i]), SPN_OK);
+        for (int i = 0; i < 3; i++) {
+            if (v == 0) {
+                assert_int_equal(spn_frames_add(f, px[i]), SPN_OK);
+            } else {
+                assert_true(size[i] > 8 && memcmp(bytes[i], "\x89PNG", 4) == 0);
+                assert_int_equal(spn_frames_add_encoded(f, bytes[i], size[i]), SPN_OK);
+                free(bytes[i]);
+            }
+        }
+        assert_int_equal(spn_frames_close(f, true), SPN_OK);
+    }
+    for (int i = 0; i < 3; i++) {
+        size_t n[2];
+        uint8_t *b[2];
+        for (int v = 0; v < 2; v++) {
+            snprintf(path[v], sizeof path[v], "%s/frame_%05d.png", dir[v], i);
+            b[v] = slurp(path[v], &n[v]);
+        }
+        assert_int_equal(n[0], n[1]);
+        assert_memory_equal(b[0], b[1], n[0]);
+        free(b[0]), free(b[1]), free(px[i]);
+    }
+    if (spn_frames_have_ffmpeg()) {
+        snprintf(path[0], sizeof path[0], "%s/enc.mp4", folder);
+        spn_frames *f;
+        assert_int_equal(spn_frames_open(path[0], 32, 32, 10, &f), SPN_OK);
+        uint8_t *one = solid(32, 32, 10, 20, 30), *bytes;
+        size_t size;
+        assert_int_equal(spn_frames_encode(f, one, &bytes, &size), SPN_OK);
+        assert_int_equal(size, 32 * 32 * 4);
+        assert_memory_equal(bytes, one, size);
+        assert_int_equal(spn_frames_add_encoded(f, bytes, size - 4), SPN_ERR_INVALID);
+        assert_non_null(strstr(spn_last_error(), "bytes"));
+        assert_int_equal(spn_frames_add_encoded(f, bytes, size), SPN_OK);
+        free(bytes), free(one);
+        assert_int_equal(spn_frames_close(f, true), SPN_OK);
+    }
+}
+
 /* Decode the first frame of a video with ffmpeg; its middle pixel. */
 static void first_pixel(const char *video, int w, int h, int rgb[3])
 {
@@ -344,7 +418,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_png_folder), cmocka_unit_test(test_png_filters), cmocka_unit_test(test_png_alpha),
-        cmocka_unit_test(test_png_write_error), cmocka_unit_test(test_add_world), cmocka_unit_test(test_video), cmocka_unit_test(test_missing_ffmpeg),
+        cmocka_unit_test(test_png_write_error), cmocka_unit_test(test_add_world), cmocka_unit_test(test_encoded), cmocka_unit_test(test_video), cmocka_unit_test(test_missing_ffmpeg),
         cmocka_unit_test(test_bad_arguments)};
     return cmocka_run_group_tests(tests, setup, teardown);
 }

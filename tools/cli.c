@@ -2,6 +2,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -198,6 +199,19 @@ void cli_interruptible(uint64_t total)
 {
     spn_interrupt_progress(0, total);
     spn_interrupt_graceful(true);
+}
+
+int cli_start_helper(pthread_t *thread, void *(*run)(void *), void *arg)
+{
+    sigset_t stops, old;
+    sigemptyset(&stops);
+    sigaddset(&stops, SIGINT);
+    sigaddset(&stops, SIGTERM);
+    sigaddset(&stops, SIGALRM);
+    pthread_sigmask(SIG_BLOCK, &stops, &old); /* the new thread inherits the mask */
+    int started = pthread_create(thread, NULL, run, arg);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    return started;
 }
 
 int cli_report_interrupt(const char *cmd, uint64_t done, uint64_t total, const char *kept, int code)

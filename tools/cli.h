@@ -5,6 +5,7 @@
 #define SPN_CLI_H
 
 #include <getopt.h>
+#include <pthread.h>
 #include <stdio.h>
 
 #include <spinneret/spinneret.h>
@@ -52,6 +53,11 @@ void cli_interruptible(uint64_t total);
 /* When a signal stopped the loop after `done` units: print how far it got and
  * what was kept, and return 128 + the signal; otherwise return `code`. */
 int cli_report_interrupt(const char *cmd, uint64_t done, uint64_t total, const char *kept, int code);
+/* Start a helper thread (pthread_create's arguments) with the stop signals
+ * (SIGINT, SIGTERM, SIGALRM) blocked in it: they reach the main thread,
+ * whose handler stops the run between frames, and never cut a helper's
+ * write short. pthread_create's result. */
+int cli_start_helper(pthread_t *thread, void *(*run)(void *), void *arg);
 
 /* Before a long computation: can `path` be written? (Makes and removes a
  * temporary beside it.) False after printing "cannot write: REASON". */

@@ -4,6 +4,7 @@
  * by the builder), --settle brings the web to rest, --frames renders the web
  * being built, spring by spring in construction order. */
 #include "cli.h"
+#include "frame_fan.h"
 
 #include <getopt.h>
 #include <math.h>
@@ -271,10 +272,29 @@ static spn_status build(opts *o, spn_world **w)
 /* Frames of the construction: the springs laid so far, framed like the whole web. */
 static int frames_done; /* for the message when a signal stops the frames */
 
+typedef struct construction_job {
+    const spn_world *w;
+    spn_render_def rd;
+    int count;
+} construction_job;
+
+/* Frame i: the web once (i + 1) / count of it is laid (frame_fan_fn; any thread). */
+static spn_status construction_frame(void *user, int slot, int i, uint8_t *rgba)
+{
+    (void)slot;
+    const construction_job *j = user;
+    spn_world *part = NULL;
+    spn_status st = spn_web_construction_state(j->w, (double)(i + 1) / j->count, &part);
+    if (st == SPN_OK) st = spn_render_rgba(part, &j->rd, rgba);
+    spn_world_destroy(part);
+    return st;
+}
+
 static spn_status write_frames(const spn_world *w, const char *dir, int count)
 {
-    spn_render_def rd = spn_render_def_default();
-    rd.width = rd.height = 800;
+    construction_job job = {w, spn_render_def_default(), count};
+    spn_render_def *rd = &job.rd;
+    rd->width = rd->height = 800;
     uint32_t np = spn_world_particle_count(w);
     spn_vec3 lo = spn_world_position(w, 0), hi = lo;
     for (uint32_t i = 0; i < np; i++) {
@@ -282,28 +302,16 @@ static spn_status write_frames(const spn_world *w, const char *dir, int count)
         lo = spn_v3(fmin(lo.x, p.x), fmin(lo.y, p.y), fmin(lo.z, p.z));
         hi = spn_v3(fmax(hi.x, p.x), fmax(hi.y, p.y), fmax(hi.z, p.z));
     }
-    rd.camera.fixed_bounds = true;
-    rd.camera.bounds_min = lo;
-    rd.camera.bounds_max = hi;
-    uint8_t *rgba = malloc((size_t)rd.width * (size_t)rd.height * 4);
+    rd->camera.fixed_bounds = true;
+    rd->camera.bounds_min = lo;
+    rd->camera.bounds_max = hi;
     spn_frames *fr = NULL;
-    spn_status st = rgba ? spn_frames_open(dir, rd.width, rd.height, 24, &fr) : SPN_ERR_NOMEM;
+    spn_status st = spn_frames_open(dir, rd->width, rd->height, 24, &fr);
+    if (st != SPN_OK) return st;
     cli_interruptible((uint64_t)count);
-    for (int f = 1; f <= count && st == SPN_OK && !spn_interrupted(); f++) {
-        spn_interrupt_progress((uint64_t)f - 1, (uint64_t)count);
-        spn_world *part = NULL;
-        st = spn_web_construction_state(w, (double)f / count, &part);
-        if (st == SPN_OK) st = spn_render_rgba(part, &rd, rgba);
-        if (st == SPN_OK) st = spn_frames_add(fr, rgba);
-        if (st == SPN_OK) frames_done = f;
-        spn_world_destroy(part);
-    }
-    if (fr) {
-        spn_status cs = spn_frames_close(fr, st == SPN_OK);
-        if (st == SPN_OK) st = cs;
-    }
-    free(rgba);
-    return st;
+    st = frame_fan_run(fr, count, frame_fan_threads(count), construction_frame, &job, NULL, &frames_done);
+    spn_status cs = spn_frames_close(fr, st == SPN_OK);
+    return st == SPN_OK ? cs : st;
 }
 
 int cmd_build(int argc, char **argv)

@@ -2,6 +2,7 @@
  * (spn_render_file). With --turntable N, a perspective camera circles the web
  * and the frames go to a video or a PNG folder (spn_frames_*). The picture
  * options are shared with `export` (render_options.h). */
+#include "frame_fan.h"
 #include "render_options.h"
 
 #include <stdio.h>
@@ -83,6 +84,25 @@ static int parse(int argc, char **argv, cmd_options *o)
 
 /* The camera swings from -yaw to +yaw and back (a planar web seen edge-on
  * shows nothing, so it does not go all the way round). */
+typedef struct turntable_job {
+    const cmd_options *o;
+    const spn_world *w;
+    double swing;
+} turntable_job;
+
+/* Frame i of the turntable (frame_fan_fn: any thread; the world is only read). */
+static spn_status turntable_frame(void *user, int slot, int i, uint8_t *rgba)
+{
+    (void)slot;
+    const turntable_job *j = user;
+    spn_render_def d = j->o->ro.def;
+    double yaw = j->swing * sin(2 * SPN_PI * (double)i / (double)j->o->turntable);
+    spn_camera cam = spn_camera_orbit(j->w, yaw, j->o->ro.pitch, d.camera.fov_degrees);
+    d.camera.eye = cam.eye;
+    d.camera.target = cam.target;
+    return spn_render_rgba(j->w, &d, rgba);
+}
+
 static int turntable(cmd_options *o, const spn_world *w)
 {
     spn_render_def *d = &o->ro.def;
@@ -90,20 +110,12 @@ static int turntable(cmd_options *o, const spn_world *w)
     spn_frames *frames;
     if (spn_frames_open(o->out, d->width, d->height, o->fps, &frames) != SPN_OK)
         return cli_fail(CMD, "%s", spn_last_error());
-    spn_progress *bar = spn_progress_begin("render", (uint64_t)o->turntable, o->quiet);
-    double swing = o->ro.yaw != 0 ? o->ro.yaw : 25;
-    spn_status st = SPN_OK;
-    long i = 0;
-    cli_interruptible((uint64_t)o->turntable);
-    for (; i < o->turntable && st == SPN_OK && !spn_interrupted(); i++) {
-        double yaw = swing * sin(2 * SPN_PI * (double)i / (double)o->turntable);
-        spn_camera cam = spn_camera_orbit(w, yaw, o->ro.pitch, d->camera.fov_degrees);
-        d->camera.eye = cam.eye;
-        d->camera.target = cam.target;
-        st = spn_frames_add_world(frames, w, d);
-        spn_progress_update(bar, (uint64_t)i + 1);
-        spn_interrupt_progress((uint64_t)i + 1, (uint64_t)o->turntable);
-    }
+    const int count = (int)o->turntable;
+    spn_progress *bar = spn_progress_begin("render", (uint64_t)count, o->quiet);
+    turntable_job job = {o, w, o->ro.yaw != 0 ? o->ro.yaw : 25};
+    int done = 0;
+    cli_interruptible((uint64_t)count);
+    spn_status st = frame_fan_run(frames, count, frame_fan_threads(count), turntable_frame, &job, bar, &done);
     spn_progress_end(bar);
     if (st != SPN_OK) {
         spn_interrupt_graceful(false);
@@ -112,7 +124,7 @@ static int turntable(cmd_options *o, const spn_world *w)
     }
     /* Interrupted or not, the complete frames are kept (a shorter video). */
     int code = spn_frames_close(frames, true) == SPN_OK ? 0 : cli_fail(CMD, "%s", spn_last_error());
-    return cli_report_interrupt(CMD, (uint64_t)i, (uint64_t)o->turntable,
+    return cli_report_interrupt(CMD, (uint64_t)done, (uint64_t)count,
                                 code ? "nothing kept" : "the complete frames are kept", code);
 }
 

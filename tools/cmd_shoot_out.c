@@ -6,6 +6,7 @@
  * the scenery (a ground grid and the character as an orange wireframe
  * octahedron), always opaque. */
 #include "cmd_shoot.h"
+#include "frame_fan.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -175,80 +176,98 @@ static spn_render_def render_def(const video_options *o, const view *v)
     return d;
 }
 
-typedef struct renderer {
+/* What one drawing thread keeps: its own strand and scenery worlds (each
+ * frame moves their particles) and the strand's picture. */
+typedef struct render_slot {
     spn_world *strand, *scenery;
     uint32_t marker_first;
-    uint8_t *a, *b;
-    spn_frames *frames;
+    uint8_t *a;
+} render_slot;
+
+typedef struct renderer {
+    const recording *r;
+    spn_render_def d;
+    double radius; /* the view's */
+    render_slot slot[8];
+    int slots;
 } renderer;
 
-/* An open sequence is closed without commit: no partial video is left. */
 static void renderer_free(renderer *q)
 {
-    if (q->frames) spn_frames_close(q->frames, false);
-    spn_world_destroy(q->strand);
-    spn_world_destroy(q->scenery);
-    free(q->a);
-    free(q->b);
+    for (int i = 0; i < q->slots; i++) {
+        spn_world_destroy(q->slot[i].strand);
+        spn_world_destroy(q->slot[i].scenery);
+        free(q->slot[i].a);
+    }
 }
 
-static spn_status render_frame(renderer *q, const recording *r, uint32_t f, spn_render_def d, const view *v)
+static spn_status slot_init(render_slot *s, const recording *r, const view *v, size_t bytes)
 {
+    s->strand = spn_world_create(NULL);
+    s->scenery = spn_world_create(NULL);
+    s->a = malloc(bytes);
+    if (!s->strand || !s->scenery || !s->a) return spn_error(SPN_ERR_NOMEM, "out of memory for the frames");
+    spn_status st = build_strand(s->strand, r->n);
+    return st == SPN_OK ? build_scenery(s->scenery, v, &s->marker_first) : st;
+}
+
+/* Frame f into b (frame_fan_fn: slot `slot`'s worlds and buffer). */
+static spn_status render_frame(void *user, int slot, int frame, uint8_t *b)
+{
+    const renderer *q = user;
+    const recording *r = q->r;
+    const render_slot *s = &q->slot[slot];
+    const uint32_t f = (uint32_t)frame;
+    spn_render_def d = q->d;
     /* Camera shake: a small wobble of eye and target, at two unrelated rates. */
-    double amp = 0.02 * v->radius * r->shake[f], t = r->t[f];
+    double amp = 0.02 * q->radius * r->shake[f], t = r->t[f];
     spn_vec3 off = spn_v3(amp * sin(2 * SPN_PI * 11 * t), amp * sin(2 * SPN_PI * 17 * t + 1), 0);
     d.camera.eye = spn_v3_add(d.camera.eye, off);
     d.camera.target = spn_v3_add(d.camera.target, off);
-    place_marker(q->scenery, q->marker_first, r->character[f], 0.025 * v->radius);
+    place_marker(s->scenery, s->marker_first, r->character[f], 0.025 * q->radius);
     spn_render_def ds = d;
     ds.colour_by = SPN_COLOUR_KIND;
-    spn_status st = spn_render_rgba(q->scenery, &ds, q->b);
+    spn_status st = spn_render_rgba(s->scenery, &ds, b);
     size_t bytes = (size_t)d.width * d.height * 4;
     if (st == SPN_OK && r->count[f] > 0) {
         const spn_vec3 *p = r->strand + (size_t)f * r->n;
-        for (uint32_t i = 0; i < r->n; i++) spn_world_set_position(q->strand, i, p[i]);
+        for (uint32_t i = 0; i < r->n; i++) spn_world_set_position(s->strand, i, p[i]);
         d.alpha = r->alpha[f];
-        st = spn_render_rgba(q->strand, &d, q->a);
+        st = spn_render_rgba(s->strand, &d, s->a);
         for (size_t i = 0; i < bytes && st == SPN_OK; i++)
-            if (q->a[i] > q->b[i]) q->b[i] = q->a[i];
+            if (s->a[i] > b[i]) b[i] = s->a[i];
     }
-    return st == SPN_OK ? spn_frames_add(q->frames, q->b) : st;
+    return st;
 }
 
 int shoot_write_video(const char *cmd, const char *path, const recording *r, const video_options *o)
 {
     const int width = o->width, height = o->height;
     view v = frame_all(r);
-    spn_render_def d = render_def(o, &v);
     renderer q;
     memset(&q, 0, sizeof q);
-    q.strand = spn_world_create(NULL);
-    q.scenery = spn_world_create(NULL);
-    q.a = malloc((size_t)width * height * 4);
-    q.b = malloc((size_t)width * height * 4);
-    if (!q.strand || !q.scenery || !q.a || !q.b) {
-        renderer_free(&q);
-        return cli_fail(cmd, "out of memory for %dx%d frames", width, height);
-    }
-    spn_status st = build_strand(q.strand, r->n);
-    if (st == SPN_OK) st = build_scenery(q.scenery, &v, &q.marker_first);
-    if (st == SPN_OK) st = spn_frames_open(path, width, height, o->fps, &q.frames);
+    q.r = r;
+    q.d = render_def(o, &v);
+    q.radius = v.radius;
+    const int threads = frame_fan_threads((int)r->frames);
+    spn_status st = SPN_OK;
+    for (; q.slots < threads && st == SPN_OK; q.slots++)
+        st = slot_init(&q.slot[q.slots], r, &v, (size_t)width * height * 4);
+    spn_frames *frames = NULL;
+    if (st == SPN_OK) st = spn_frames_open(path, width, height, o->fps, &frames);
     spn_progress *bar = spn_progress_begin("shoot", r->frames, o->quiet);
-    uint32_t f = 0;
+    int done = 0;
     cli_interruptible(r->frames);
-    for (; f < r->frames && st == SPN_OK && !spn_interrupted(); f++) {
-        st = render_frame(&q, r, f, d, &v);
-        spn_progress_update(bar, f + 1);
-        spn_interrupt_progress(f + 1, r->frames);
-    }
+    if (st == SPN_OK) st = frame_fan_run(frames, (int)r->frames, q.slots, render_frame, &q, bar, &done);
     spn_progress_end(bar);
-    if (st == SPN_OK) { /* interrupted or not: the complete frames */
-        st = spn_frames_close(q.frames, true);
-        q.frames = NULL;
+    /* Interrupted or not, the complete frames; after a failure no partial video. */
+    if (frames) {
+        spn_status cs = spn_frames_close(frames, st == SPN_OK);
+        if (st == SPN_OK) st = cs;
     }
     renderer_free(&q);
     if (st != SPN_OK) return spn_interrupt_graceful(false), cli_fail_status(cmd, st);
-    if (spn_interrupted()) return cli_report_interrupt(cmd, f, r->frames, "the complete frames are kept", 0);
+    if (spn_interrupted()) return cli_report_interrupt(cmd, (uint64_t)done, r->frames, "the complete frames are kept", 0);
     spn_interrupt_graceful(false);
     fprintf(stderr, "shoot: wrote %s\n", path);
     return 0;

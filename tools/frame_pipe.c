@@ -7,8 +7,9 @@
  * status and message, and the main thread raises them again as its own. */
 #include "frame_pipe.h"
 
+#include "cli.h"
+
 #include <pthread.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -58,17 +59,9 @@ spn_status frame_pipe_open(frame_pipe **pipe, frame_pipe_fn fn, void *user)
     p->user = user;
     pthread_mutex_init(&p->lock, NULL);
     pthread_cond_init(&p->changed, NULL);
-    /* The thread starts with the stop signals blocked (it inherits the mask):
-     * they reach the main thread, whose handler stops the run between
-     * steps, and never interrupt a frame's write half way. */
-    sigset_t stops, old;
-    sigemptyset(&stops);
-    sigaddset(&stops, SIGINT);
-    sigaddset(&stops, SIGTERM);
-    sigaddset(&stops, SIGALRM);
-    pthread_sigmask(SIG_BLOCK, &stops, &old);
-    int started = pthread_create(&p->thread, NULL, worker, p);
-    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    /* Stop signals reach the main thread, whose handler stops the run
+     * between steps, and never interrupt a frame's write half way. */
+    int started = cli_start_helper(&p->thread, worker, p);
     if (started != 0) {
         pthread_cond_destroy(&p->changed);
         pthread_mutex_destroy(&p->lock);

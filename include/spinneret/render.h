@@ -75,6 +75,14 @@ SPN_API spn_status spn_frames_open(const char *out, int width, int height, doubl
 /// Number to give the first frame written (for --frame-range); default 0.
 SPN_API void spn_frames_set_first_index(spn_frames *frames, int index);
 SPN_API spn_status spn_frames_add(spn_frames *frames, const uint8_t *rgba);
+/// Frames drawn on several threads: spn_frames_encode turns a picture into the
+/// bytes the sequence stores (a frame's PNG file for a folder, the RGBA itself
+/// for a video) into a new buffer `*bytes` (free it with free()). It only reads
+/// the sequence's settings, so several threads may encode at once.
+/// spn_frames_add_encoded then adds them as the next frame, in order, one
+/// thread at a time: the same file or video as spn_frames_add of the picture.
+SPN_API spn_status spn_frames_encode(const spn_frames *frames, const uint8_t *rgba, uint8_t **bytes, size_t *size);
+SPN_API spn_status spn_frames_add_encoded(spn_frames *frames, const uint8_t *bytes, size_t size);
 SPN_API spn_status spn_frames_close(spn_frames *frames, bool commit);
 
 

@@ -188,24 +188,66 @@ static spn_status write_all(int fd, const uint8_t *p, size_t n)
     return SPN_OK;
 }
 
-static spn_status add_png(spn_frames *f, const uint8_t *rgba)
+/* Frame `index`'s PNG file in the folder; NULL when out of memory. */
+static char *png_path(const spn_frames *f, int index)
 {
     size_t n = strlen(f->dir) + 32;
     char *path = malloc(n);
+    if (path) snprintf(path, n, "%s/frame_%05d.png", f->dir, index);
+    return path;
+}
+
+spn_status spn_frames_encode(const spn_frames *frames, const uint8_t *rgba, uint8_t **bytes, size_t *size)
+{
+    *bytes = NULL, *size = 0;
+    const size_t raw = (size_t)frames->width * frames->height * 4;
+    if (frames->kind != FRAMES_PNG) {
+        if (!(*bytes = malloc(raw))) return spn_error(SPN_ERR_NOMEM, "frames: out of memory");
+        memcpy(*bytes, rgba, raw);
+        *size = raw;
+        return SPN_OK;
+    }
+    spn__png_pixels px = {rgba, frames->width, frames->height, (size_t)frames->width * 4, false};
+    return spn__png_encode_memory(&px, SPN__PNG_LEVEL_FRAME, bytes, size);
+}
+
+/* Encoded bytes into the next PNG file: a temporary renamed into place. */
+static spn_status add_png(spn_frames *f, const uint8_t *bytes, size_t size)
+{
+    char *path = png_path(f, f->index);
     if (!path) return spn_error(SPN_ERR_NOMEM, "out of memory");
-    snprintf(path, n, "%s/frame_%05d.png", f->dir, f->index);
-    spn__png_pixels px = {rgba, f->width, f->height, (size_t)f->width * 4, false};
-    spn_status st = spn__png_write(&px, SPN__PNG_LEVEL_FRAME, path);
+    spn_atomic_file out;
+    spn_status st = spn_atomic_open(&out, path, true);
+    if (st == SPN_OK) {
+        if (fwrite(bytes, 1, size, out.fp) != size || fflush(out.fp) != 0) {
+            st = spn_error(SPN_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
+            spn_atomic_abort(&out);
+        } else {
+            st = spn_atomic_commit(&out);
+        }
+    }
     free(path);
+    return st;
+}
+
+spn_status spn_frames_add_encoded(spn_frames *frames, const uint8_t *bytes, size_t size)
+{
+    const size_t raw = (size_t)frames->width * frames->height * 4;
+    if (frames->kind != FRAMES_PNG && size != raw)
+        return spn_error(SPN_ERR_INVALID, "frames: an encoded video frame is %zu bytes, not %zu", size, raw);
+    spn_status st = frames->kind == FRAMES_PNG ? add_png(frames, bytes, size) : write_all(frames->pipe_fd, bytes, size);
+    if (st == SPN_OK) frames->index++;
     return st;
 }
 
 spn_status spn_frames_add(spn_frames *frames, const uint8_t *rgba)
 {
-    spn_status st = frames->kind == FRAMES_PNG
-                        ? add_png(frames, rgba)
-                        : write_all(frames->pipe_fd, rgba, (size_t)frames->width * frames->height * 4);
-    if (st == SPN_OK) frames->index++;
+    if (frames->kind != FRAMES_PNG) return spn_frames_add_encoded(frames, rgba, (size_t)frames->width * frames->height * 4);
+    uint8_t *bytes;
+    size_t size;
+    spn_status st = spn_frames_encode(frames, rgba, &bytes, &size);
+    if (st == SPN_OK) st = spn_frames_add_encoded(frames, bytes, size);
+    free(bytes);
     return st;
 }
 

@@ -82,10 +82,37 @@ static void on_warning(png_structp png, png_const_charp message)
     (void)message;
 }
 
-/* Everything libpng does, between one setjmp and its cleanup. No local that
- * outlives a longjmp changes after the setjmp (`row`, `png` and `info` are
- * set before it). */
-static spn_status encode(const spn__png_pixels *src, int level, FILE *fp, const char *path)
+/* A PNG growing in memory (spn__png_encode_memory). glibc's open_memstream
+ * zero-fills each larger buffer: on a turntable of dew frames that cost more
+ * than the compression. */
+typedef struct png_memory {
+    uint8_t *data;
+    size_t size, capacity;
+} png_memory;
+
+static void memory_write(png_structp png, png_bytep bytes, png_size_t n)
+{
+    png_memory *m = png_get_io_ptr(png);
+    if (n > m->capacity - m->size) {
+        size_t cap = m->capacity ? m->capacity : 65536;
+        while (n > cap - m->size) {
+            if (cap > SIZE_MAX / 2) png_error(png, "out of memory");
+            cap *= 2;
+        }
+        uint8_t *grown = realloc(m->data, cap);
+        if (!grown) png_error(png, "out of memory");
+        m->data = grown, m->capacity = cap;
+    }
+    memcpy(m->data + m->size, bytes, n);
+    m->size += n;
+}
+
+static void memory_flush(png_structp png) { (void)png; }
+
+/* Everything libpng does, between one setjmp and its cleanup, into the file
+ * `fp` or else into memory `mem`. No local that outlives a longjmp changes
+ * after the setjmp (`row`, `png` and `info` are set before it). */
+static spn_status encode(const spn__png_pixels *src, int level, FILE *fp, png_memory *mem, const char *path)
 {
     uint8_t *row = malloc((size_t)src->width * 4);
     png_failure fail;
@@ -101,7 +128,8 @@ static spn_status encode(const spn__png_pixels *src, int level, FILE *fp, const 
     if (setjmp(fail.jump) == 0) {
         bool alpha = !opaque(src);
         int filter = mostly_flat(src) ? PNG_FILTER_NONE : PNG_FILTER_UP;
-        png_init_io(png, fp);
+        if (fp) png_init_io(png, fp);
+        else png_set_write_fn(png, mem, memory_write, memory_flush);
         png_set_IHDR(png, info, (png_uint_32)src->width, (png_uint_32)src->height, 8,
                      alpha ? PNG_COLOR_TYPE_RGB_ALPHA : PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                      PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
@@ -126,9 +154,21 @@ spn_status spn__png_write(const spn__png_pixels *src, int level, const char *pat
     spn_atomic_file f;
     spn_status st = spn_atomic_open(&f, path, true);
     if (st != SPN_OK) return st;
-    st = encode(src, level, f.fp, path);
+    st = encode(src, level, f.fp, NULL, path);
     if (st == SPN_OK) return spn_atomic_commit(&f);
     spn_atomic_abort(&f);
+    return st;
+}
+
+spn_status spn__png_encode_memory(const spn__png_pixels *src, int level, uint8_t **bytes, size_t *size)
+{
+    png_memory m = {NULL, 0, 0};
+    spn_status st = encode(src, level, NULL, &m, "frame");
+    if (st != SPN_OK) {
+        free(m.data);
+        m.data = NULL, m.size = 0;
+    }
+    *bytes = m.data, *size = m.size;
     return st;
 }
 

@@ -113,6 +113,8 @@ typedef struct spn__png_pixels {
 /* Write `src` to `path` (a temporary renamed into place); an opaque picture
  * as RGB, else RGBA. */
 spn_status spn__png_write(const spn__png_pixels *src, int level, const char *path);
+/* The same PNG in memory: a new buffer *bytes (free()) of *size bytes. */
+spn_status spn__png_encode_memory(const spn__png_pixels *src, int level, uint8_t **bytes, size_t *size);
 /* cairo ARGB32 words to straight RGB (channels 3) or RGBA (4) bytes. */
 void spn__unpremultiply_row(const uint32_t *src, int width, uint8_t *out, int channels);
 

@@ -129,6 +129,24 @@ if command -v ffmpeg >/dev/null 2>&1; then
 else
     echo "ffmpeg not installed: skipped the GIF turntable"
 fi
+# Frames are drawn on as many threads as OpenMP would use, and added in
+# order: one thread and two give the same files, byte for byte.
+OMP_NUM_THREADS=1 "$SPN" render scene:orb:8x12 -o "$T/tt1" --turntable 9 --size 96x80 --dew --quiet ||
+    fail "turntable on one thread"
+OMP_NUM_THREADS=2 "$SPN" render scene:orb:8x12 -o "$T/tt2" --turntable 9 --size 96x80 --dew --quiet ||
+    fail "turntable on two threads"
+[ "$(ls "$T/tt2" | wc -l)" -eq 9 ] && diff -r "$T/tt1" "$T/tt2" >/dev/null ||
+    fail "turntable frames differ between one and two threads"
+# A frame that cannot be written (its name taken by a folder) stops the run
+# there: the frames before it stay, none after it is written, the message
+# names the file, and no temporary is left.
+mkdir -p "$T/ttbad/frame_00004.png"
+OMP_NUM_THREADS=2 "$SPN" render scene:orb:8x12 -o "$T/ttbad" --turntable 9 --size 96x80 --quiet 2>"$T/err"
+[ $? -eq 1 ] || fail "turntable with an unwritable frame should exit 1"
+grep -q 'frame_00004.png' "$T/err" || fail "turntable write error does not name the frame: $(cat "$T/err")"
+[ "$(ls "$T/ttbad" | tr '\n' ' ')" = "frame_00000.png frame_00001.png frame_00002.png frame_00003.png frame_00004.png " ] ||
+    fail "turntable after a failed frame holds: $(ls "$T/ttbad")"
+! ls -a "$T/ttbad" | grep -q tmp || fail "turntable left a temporary: $(ls -a "$T/ttbad")"
 SPN_FFMPEG=/nonexistent/ffmpeg "$SPN" render "$CROSS" -o "$T/spin.mp4" --turntable 2 --quiet 2>"$T/err"
 [ $? -eq 1 ] || fail "turntable without ffmpeg should exit 1"
 grep -q 'ffmpeg' "$T/err" && grep -q 'PNG' "$T/err" || fail "turntable without ffmpeg: $(cat "$T/err")"

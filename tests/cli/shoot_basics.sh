@@ -44,9 +44,14 @@ python3 -c "
 import json,sys; d=json.load(open('$tmp/b.json')); ph=[f['phase'] for f in d['frames']]
 assert set(ph) <= {'thwip','done'} and ph[-1]=='done', ph" || fail "--phases thwip ends at contact"
 
-"$SPN" shoot --from 0,0,0 --to 8,3,0 --phases thwip --size 64x48 --eye 4,2,12 --look-at 4,1.5,0 --quiet -o "$tmp/frames" 2>/dev/null || fail "frames run"
+OMP_NUM_THREADS=2 "$SPN" shoot --from 0,0,0 --to 8,3,0 --phases thwip --size 64x48 --eye 4,2,12 --look-at 4,1.5,0 --quiet -o "$tmp/frames" 2>/dev/null || fail "frames run"
 n=$(ls "$tmp/frames" | grep -c '^frame_.*\.png$')
 [ "$n" -gt 5 ] || fail "expected PNG frames, got $n"
+# Frames are drawn on as many threads as OpenMP would use (each thread its
+# own strand and scenery worlds) and added in order: the same files on one.
+OMP_NUM_THREADS=1 "$SPN" shoot --from 0,0,0 --to 8,3,0 --phases thwip --size 64x48 --eye 4,2,12 --look-at 4,1.5,0 \
+    --quiet -o "$tmp/frames1" 2>/dev/null || fail "frames run on one thread"
+diff -r "$tmp/frames" "$tmp/frames1" >/dev/null || fail "shoot frames differ between one thread and several"
 
 # Unreachable: a clear error naming the speed needed; --auto-speed fixes it.
 "$SPN" shoot --from 0,0,0 --to 100,0,0 --speed 10 -o "$tmp/c.json" 2> "$tmp/err"

@@ -19,8 +19,12 @@ cmp -s "$T/a.json" "$T/c.json" && fail "another seed should give another web"
 grep -q '"builder": *"physical"' "$T/p.json" || grep -q 'physical' "$T/p.json" || fail "metadata names the builder"
 
 # A building animation: N frames, the web file without the auxiliary spiral.
-"$SPN" build --species araneus --seed 2 --frames "$T/frames" --frame-count 6 -o "$T/f.json" || fail "build --frames"
+OMP_NUM_THREADS=2 "$SPN" build --species araneus --seed 2 --frames "$T/frames" --frame-count 6 -o "$T/f.json" || fail "build --frames"
 [ "$(ls "$T/frames" | grep -c '\.png$')" -eq 6 ] || fail "6 frames expected, got $(ls "$T/frames")"
+OMP_NUM_THREADS=1 "$SPN" build --species araneus --seed 2 --frames "$T/frames1" --frame-count 6 -o "$T/f1.json" ||
+    fail "build --frames on one thread"
+diff -r "$T/frames" "$T/frames1" >/dev/null && cmp -s "$T/f.json" "$T/f1.json" ||
+    fail "build --frames: one thread and several differ"
 "$SPN" info --json "$T/f.json" | grep -Eq '"aux-spiral":[[:space:]]*[0-9]' && fail "the auxiliary spiral should be gone from the file"
 # Frames grow: the last frame has more ink than the first (bigger PNG of the same size).
 first=$(stat -c %s "$T/frames/$(ls "$T/frames" | head -1)")
