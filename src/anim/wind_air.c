@@ -26,6 +26,8 @@
  * e^(i a_i) e^(i b_j) e^(i c_k), factors taken once per axis node (fill_slice). */
 #include "anim_internal.h"
 
+#include "core/kernel.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -265,6 +267,34 @@ static spn_vec3 node_position(const spn_air_field *air, int i, int j, int k)
                   air->lo.z + (air->hi.z - air->lo.z) * k / (air->n[2] - 1));
 }
 
+/* Grid row (j, k) of a slice into `out`: each node's turbulent velocity,
+ * the modes added in their order (see fill_slice); `ux` is 3 n[0] doubles
+ * of scratch. A plain loop over the row's nodes for each mode, vectorised
+ * for each instruction set (CMakeLists.txt compiles this file with the
+ * physics kernels' flags); no contraction, so every version gives the same
+ * bits. */
+SPN__KERNEL static void slice_row(const spn_air_field *air, int j, int k, double *restrict ux, spn_vec3 *restrict out)
+{
+    const int nx = air->n[0], ny = air->n[1], nm = air->nmodes;
+    const size_t per = (size_t)nx + ny + air->n[2];
+    double *restrict uy = ux + nx, *restrict uz = uy + nx;
+    memset(ux, 0, 3 * (size_t)nx * sizeof *ux);
+    if (air->def.turbulence != 0)
+        for (int n = 0; n < nm; n++) {
+            const double *restrict ca = air->axis_cos + (size_t)n * per;
+            const double *restrict sa = air->axis_sin + (size_t)n * per;
+            /* e^(i (B_j + C_k)) */
+            const double cb = ca[nx + j], sb = sa[nx + j], cc = ca[nx + ny + k], sc = sa[nx + ny + k];
+            const double re = cb * cc - sb * sc, im = sb * cc + cb * sc;
+            const spn_vec3 xi = air->modes[n].xi;
+            for (int i = 0; i < nx; i++) {
+                const double v = ca[i] * re - sa[i] * im;
+                ux[i] += xi.x * v, uy[i] += xi.y * v, uz[i] += xi.z * v;
+            }
+        }
+    for (int i = 0; i < nx; i++) out[i] = spn_v3(ux[i], uy[i], uz[i]);
+}
+
 /* Slice `index`: the turbulent velocity at every grid node. Mode n's phase
  * at node (i, j, k) is k_n . (p - d X(t)) + w_n t + phi_n = A_i + B_j + C_k,
  * with A_i = k_x x_i, B_j = k_y y_j and C_k = k_z z_k plus the constant part.
@@ -276,8 +306,10 @@ static spn_vec3 node_position(const spn_air_field *air, int i, int j, int k)
  * of |xi_n| per mode of turbulence_at's (tests/test_anim_air.c checks the
  * nodes against it). The modes add in their order, as turbulence_at adds
  * them. 48^3 nodes of 64 modes, the runner's largest grid: 137 ms a slice
- * with a cosine each, 10.7 ms now; 16^3: 5.7 and 0.26 ms (Zen 5,
- * bench/bench_air.c). */
+ * with a cosine each, 10.7 ms with the factors; 16^3: 5.7 and 0.26 ms (Zen
+ * 5, bench/bench_air.c, which then timed the first touches of the slice
+ * buffers too). Since the rows are a vectorised kernel (slice_row) a 48^3
+ * slice takes 3.3-3.7 ms against 4.2-4.3 in steady use. */
 static void fill_slice(spn_air_field *air, air_slice *s, int64_t index)
 {
     const double t = (double)index * air->slice_dt, shift = advection(air, t);
@@ -300,27 +332,8 @@ static void fill_slice(spn_air_field *air, air_slice *s, int64_t index)
             c[nx + ny + k] = cos(g), sn[nx + ny + k] = sin(g);
         }
     }
-    double *restrict ux = air->row, *restrict uy = ux + nx, *restrict uz = uy + nx;
-    size_t q = 0;
     for (int k = 0; k < nz; k++)
-        for (int j = 0; j < ny; j++) {
-            memset(ux, 0, 3 * (size_t)nx * sizeof *ux);
-            if (air->def.turbulence != 0)
-                for (int n = 0; n < nm; n++) {
-                    const air_mode *m = &air->modes[n];
-                    const double *restrict ca = air->axis_cos + (size_t)n * per;
-                    const double *restrict sa = air->axis_sin + (size_t)n * per;
-                    /* e^(i (B_j + C_k)) */
-                    const double cb = ca[nx + j], sb = sa[nx + j], cc = ca[nx + ny + k], sc = sa[nx + ny + k];
-                    const double re = cb * cc - sb * sc, im = sb * cc + cb * sc;
-                    const double xx = m->xi.x, xy = m->xi.y, xz = m->xi.z;
-                    for (int i = 0; i < nx; i++) {
-                        const double v = ca[i] * re - sa[i] * im;
-                        ux[i] += xx * v, uy[i] += xy * v, uz[i] += xz * v;
-                    }
-                }
-            for (int i = 0; i < nx; i++) s->u[q++] = spn_v3(ux[i], uy[i], uz[i]);
-        }
+        for (int j = 0; j < ny; j++) slice_row(air, j, k, air->row, s->u + ((size_t)k * ny + j) * nx);
     s->index = index;
 }
 
