@@ -9,6 +9,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "common/scratch.h"
+
 #include <cairo.h>
 #include <png.h>
 #include <signal.h>
@@ -26,16 +28,13 @@ static char folder[512];
 static int setup(void **state)
 {
     (void)state;
-    snprintf(folder, sizeof folder, "%s/frames_test_XXXXXX", SPN_BUILD_DIR);
-    return mkdtemp(folder) ? 0 : -1;
+    return spn_test_scratch_make(folder, sizeof folder, "frames_test");
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    char cmd[600];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", folder);
-    return system(cmd) == 0 ? 0 : -1;
+    return spn_test_scratch_remove(folder);
 }
 
 static uint8_t *solid(int w, int h, uint8_t r, uint8_t g, uint8_t b)

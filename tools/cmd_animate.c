@@ -6,6 +6,7 @@
  * SIGINT/SIGTERM stop after the current step: finished PNG frames and state
  * files stay, a video or report being written is abandoned. */
 #include "cli.h"
+#include "frame_fan.h"
 #include "frame_pipe.h"
 #include "render_options.h"
 
@@ -236,7 +237,6 @@ static void on_signal(int sig)
 typedef struct frame_ctx {
     animate_options *o;
     spn_frames *frames;
-    uint8_t *rgba;
     spn_progress *bar;
     frame_pipe *pipe;
 } frame_ctx;
@@ -286,27 +286,26 @@ static void draw_disk(uint8_t *rgba, int w, int h, double cx, double cy, double 
         }
 }
 
-static void draw_prey(const frame_ctx *c, const spn_world *w)
+static void draw_prey(const frame_ctx *c, const spn_world *w, uint8_t *rgba)
 {
     int k = 0;
     for (uint32_t i = 0; i < spn_world_particle_count(w) && k < c->o->anim.nprey; i++) {
         if (spn_world_particle_tag(w, i) != SPN_PARTICLE_PREY) continue;
         double px, py, scale;
         if (project(&c->o->render, spn_world_position(w, i), &px, &py, &scale))
-            draw_disk(c->rgba, c->o->render.width, c->o->render.height, px, py, fmax(1.5, c->o->prey[k].radius * scale));
+            draw_disk(rgba, c->o->render.width, c->o->render.height, px, py, fmax(1.5, c->o->prey[k].radius * scale));
         k++;
     }
 }
 
-/* Draw and write one frame (on the frame pipe's thread, from a copy). */
-static spn_status draw_frame(void *user, int frame, const spn_world *w)
+/* Draw one frame (on a frame pipe thread, from a copy; the pipe writes it). */
+static spn_status draw_frame(void *user, int slot, int frame, const spn_world *w, uint8_t *rgba)
 {
-    (void)frame;
-    frame_ctx *c = user;
-    spn_status st = spn_render_rgba(w, &c->o->render, c->rgba);
-    if (st != SPN_OK) return st;
-    draw_prey(c, w);
-    return spn_frames_add(c->frames, c->rgba);
+    (void)slot, (void)frame;
+    const frame_ctx *c = user;
+    spn_status st = spn_render_rgba(w, &c->o->render, rgba);
+    if (st == SPN_OK) draw_prey(c, w, rgba);
+    return st;
 }
 
 static spn_status on_frame(void *user, int frame, const spn_world *w)
@@ -375,12 +374,10 @@ static spn_status prepare(animate_options *o, spn_world **w, frame_ctx *c)
                          frames - 1);
     if (o->states && mkdir(o->states, 0777) != 0 && errno != EEXIST)
         return spn_error(SPN_ERR_IO, "%s: cannot create the folder: %s", o->states, strerror(errno));
-    c->rgba = malloc((size_t)o->render.width * o->render.height * 4);
-    if (!c->rgba) return spn_error(SPN_ERR_NOMEM, "out of memory for %dx%d frames", o->render.width, o->render.height);
     double rate = o->playback_fps > 0 ? o->playback_fps : fmin(o->anim.fps, 240);
     st = spn_frames_open(o->output, o->render.width, o->render.height, rate, &c->frames);
     if (st == SPN_OK) spn_frames_set_first_index(c->frames, o->anim.first_frame);
-    if (st == SPN_OK) st = frame_pipe_open(&c->pipe, draw_frame, c);
+    if (st == SPN_OK) st = frame_pipe_open(&c->pipe, c->frames, frame_fan_threads(frames), draw_frame, c);
     return st;
 }
 
@@ -408,7 +405,7 @@ static int animate_run(animate_options *o)
     spn_world *w = NULL;
     int code = render_load_world(CMD, o->input, &w);
     if (code) return code;
-    frame_ctx c = {o, NULL, NULL, NULL, NULL};
+    frame_ctx c = {o, NULL, NULL, NULL};
     spn_status st = prepare(o, &w, &c);
     if (st == SPN_OK) hint_solver(o, w);
     spn_anim_report rep;
@@ -441,7 +438,6 @@ static int animate_run(animate_options *o)
     spn_status close_st = spn_frames_close(c.frames, st == SPN_OK && rep.frames > 0);
     if (st == SPN_OK) st = close_st;
     if (done && st == SPN_OK && o->report) st = write_report(o->report, &rep.impact);
-    free(c.rgba);
     spn_world_destroy(w);
     if (rep.interrupted) {
         fprintf(stderr, "spinneret %s: interrupted; %d frame(s) finished and kept%s\n", CMD, rep.frames,

@@ -1,10 +1,14 @@
-/* See frame_pipe.h. One worker thread, one slot: `job` is the world copy
- * being drawn (or waiting to be), `busy` while it is. Two copies take turns:
- * the main thread refills `spare` (spn_world_copy_into, no new memory once
- * the sizes are reached: a fresh clone of a 1M-particle web took about a
- * second, most of it on new pages) while the worker draws the other. Errors
- * are per thread (spn_last_error), so the worker keeps the first failure's
- * status and message, and the main thread raises them again as its own. */
+/* See frame_pipe.h. Each drawing thread is a slot: its world copy, its
+ * picture and, while `busy`, the frame it draws and that frame's place in
+ * the order of hand-overs (`seq`). The main thread refills an idle slot's
+ * world (spn_world_copy_into: no new memory once the sizes are reached; a
+ * fresh clone of a 1M-particle web took about a second, most of it on new
+ * pages) and marks it busy; the slot's thread draws and encodes, then waits
+ * until `turn` reaches its `seq` to add the frame, so frames go out in the
+ * order they came in. Every slot takes its turn even after a failure (it
+ * then adds nothing), so the turns never stall. Errors are per thread
+ * (spn_last_error): the first failure's status and message are kept and
+ * raised again on the main thread. */
 #include "frame_pipe.h"
 
 #include "cli.h"
@@ -13,105 +17,150 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+enum { MAX_SLOTS = 8 };
+
+typedef struct pipe_slot {
+    frame_pipe *p;
+    int index;
+    pthread_t thread;
+    spn_world *world;
+    uint8_t *rgba;
+    int frame;
+    long seq;
+    bool busy;
+} pipe_slot;
+
 struct frame_pipe {
+    spn_frames *frames;
     frame_pipe_fn fn;
     void *user;
-    pthread_t thread;
     pthread_mutex_t lock;
     pthread_cond_t changed;
-    spn_world *job, *spare;
-    int job_frame;
-    bool busy, quit;
+    pipe_slot slot[MAX_SLOTS];
+    int nslots;
+    long pushed, turn;
+    bool quit;
     spn_status failed;
     char message[1024];
 };
 
+/* The first failure wins (the lock held). */
+static void fail(frame_pipe *p, spn_status st)
+{
+    if (p->failed != SPN_OK) return;
+    p->failed = st;
+    snprintf(p->message, sizeof p->message, "%s", spn_last_error());
+}
+
+/* Draw and encode the slot's frame (none after a failure); NULL bytes then. */
+static spn_status draw(pipe_slot *s, bool skip, uint8_t **bytes, size_t *size)
+{
+    frame_pipe *p = s->p;
+    *bytes = NULL, *size = 0;
+    if (skip) return SPN_OK;
+    spn_status st = p->fn(p->user, s->index, s->frame, s->world, s->rgba);
+    return st == SPN_OK ? spn_frames_encode(p->frames, s->rgba, bytes, size) : st;
+}
+
 static void *worker(void *arg)
 {
-    frame_pipe *p = arg;
+    pipe_slot *s = arg;
+    frame_pipe *p = s->p;
     pthread_mutex_lock(&p->lock);
     for (;;) {
-        while (!p->busy && !p->quit) pthread_cond_wait(&p->changed, &p->lock);
-        if (!p->busy) break;
-        spn_world *w = p->job;
-        int frame = p->job_frame;
-        bool skip = p->failed != SPN_OK;
+        while (!s->busy && !p->quit) pthread_cond_wait(&p->changed, &p->lock);
+        if (!s->busy) break;
+        const bool skip = p->failed != SPN_OK;
         pthread_mutex_unlock(&p->lock);
-        spn_status st = skip ? SPN_OK : p->fn(p->user, frame, w);
+        uint8_t *bytes;
+        size_t size;
+        spn_status st = draw(s, skip, &bytes, &size);
         pthread_mutex_lock(&p->lock);
-        if (st != SPN_OK && p->failed == SPN_OK) {
-            p->failed = st;
-            snprintf(p->message, sizeof p->message, "%s", spn_last_error());
+        while (p->turn != s->seq) pthread_cond_wait(&p->changed, &p->lock);
+        if (st == SPN_OK && bytes && p->failed == SPN_OK) {
+            pthread_mutex_unlock(&p->lock); /* only the turn's holder touches the sequence */
+            st = spn_frames_add_encoded(p->frames, bytes, size);
+            pthread_mutex_lock(&p->lock);
         }
-        p->busy = false; /* `job` stays until the next hand-over swaps it for the spare */
+        if (st != SPN_OK) fail(p, st);
+        free(bytes);
+        p->turn++;
+        s->busy = false; /* the world stays until the next hand-over refills it */
         pthread_cond_broadcast(&p->changed);
     }
     pthread_mutex_unlock(&p->lock);
     return NULL;
 }
 
-spn_status frame_pipe_open(frame_pipe **pipe, frame_pipe_fn fn, void *user)
+spn_status frame_pipe_open(frame_pipe **pipe, spn_frames *frames, int threads, frame_pipe_fn fn, void *user)
 {
     *pipe = NULL;
     frame_pipe *p = calloc(1, sizeof *p);
     if (!p) return spn_error(SPN_ERR_NOMEM, "out of memory");
-    p->fn = fn;
-    p->user = user;
+    p->frames = frames, p->fn = fn, p->user = user;
     pthread_mutex_init(&p->lock, NULL);
     pthread_cond_init(&p->changed, NULL);
-    /* Stop signals reach the main thread, whose handler stops the run
-     * between steps, and never interrupt a frame's write half way. */
-    int started = cli_start_helper(&p->thread, worker, p);
-    if (started != 0) {
-        pthread_cond_destroy(&p->changed);
-        pthread_mutex_destroy(&p->lock);
-        free(p);
-        return spn_error(SPN_ERR_NOMEM, "cannot start the frame-writing thread");
+    int width, height;
+    spn_frames_size(frames, &width, &height);
+    if (threads < 1) threads = 1;
+    if (threads > MAX_SLOTS) threads = MAX_SLOTS;
+    for (; p->nslots < threads; p->nslots++) {
+        pipe_slot *s = &p->slot[p->nslots];
+        s->p = p, s->index = p->nslots;
+        if (!(s->rgba = malloc((size_t)width * height * 4))) break;
+        /* stop signals reach the main thread, whose handler stops the run
+         * between steps, and never interrupt a frame's write half way */
+        if (cli_start_helper(&s->thread, worker, s) != 0) {
+            free(s->rgba);
+            break;
+        }
+    }
+    if (p->nslots == 0) {
+        frame_pipe_close(p);
+        return spn_error(SPN_ERR_NOMEM, "cannot start a frame-drawing thread");
     }
     *pipe = p;
     return SPN_OK;
 }
 
-/* Wait until no frame is in flight (the lock held); the failure so far. */
-static spn_status drain(frame_pipe *p)
-{
-    while (p->busy) pthread_cond_wait(&p->changed, &p->lock);
-    return p->failed;
-}
-
 spn_status frame_pipe_push(frame_pipe *p, int frame, const spn_world *w)
 {
-    /* `spare` is the main thread's alone: the worker only reads `job` */
-    spn_status st = SPN_OK;
-    if (p->spare) st = spn_world_copy_into(p->spare, w);
-    else if (!(p->spare = spn_world_clone(w))) st = spn_error(SPN_ERR_NOMEM, "out of memory copying the world for frame %d", frame);
+    pthread_mutex_lock(&p->lock);
+    pipe_slot *s = NULL;
+    while (p->failed == SPN_OK && !s) {
+        for (int i = 0; i < p->nslots && !s; i++)
+            if (!p->slot[i].busy) s = &p->slot[i];
+        if (!s) pthread_cond_wait(&p->changed, &p->lock);
+    }
+    spn_status st = p->failed;
+    pthread_mutex_unlock(&p->lock);
+    if (st != SPN_OK) return spn_error(st, "%s", p->message);
+    /* an idle slot's world is the main thread's alone */
+    if (s->world) st = spn_world_copy_into(s->world, w);
+    else if (!(s->world = spn_world_clone(w))) st = spn_error(SPN_ERR_NOMEM, "out of memory copying the world for frame %d", frame);
     if (st != SPN_OK) return st;
     pthread_mutex_lock(&p->lock);
-    st = drain(p);
-    if (st == SPN_OK) {
-        spn_world *drawn = p->job;
-        p->job = p->spare;
-        p->spare = drawn;
-        p->job_frame = frame;
-        p->busy = true;
-        pthread_cond_broadcast(&p->changed);
-    }
+    s->frame = frame, s->seq = p->pushed++, s->busy = true;
+    pthread_cond_broadcast(&p->changed);
     pthread_mutex_unlock(&p->lock);
-    return st == SPN_OK ? SPN_OK : spn_error(st, "%s", p->message);
+    return SPN_OK;
 }
 
 spn_status frame_pipe_close(frame_pipe *p)
 {
     if (!p) return SPN_OK;
     pthread_mutex_lock(&p->lock);
-    spn_status st = drain(p);
+    while (p->turn != p->pushed) pthread_cond_wait(&p->changed, &p->lock);
+    spn_status st = p->failed;
     p->quit = true;
     pthread_cond_broadcast(&p->changed);
     pthread_mutex_unlock(&p->lock);
-    pthread_join(p->thread, NULL);
+    for (int i = 0; i < p->nslots; i++) {
+        pthread_join(p->slot[i].thread, NULL);
+        spn_world_destroy(p->slot[i].world);
+        free(p->slot[i].rgba);
+    }
     if (st != SPN_OK) spn_error(st, "%s", p->message);
-    spn_world_destroy(p->job);
-    spn_world_destroy(p->spare);
     pthread_cond_destroy(&p->changed);
     pthread_mutex_destroy(&p->lock);
     free(p);

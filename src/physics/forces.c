@@ -118,6 +118,7 @@ static int pass_threads(const spn_world *w, uint32_t n, bool air)
  * `threads` threads (each segment's sample its own, so the same values). */
 static void sample_air(spn_world *w, double t, const spn_vec3 *x, int threads)
 {
+    (void)threads; /* (used by the OpenMP pragma only) */
     const uint32_t ns = w->ns;
 #pragma omp parallel for schedule(static) num_threads(threads) if (w->air_pure && threads > 1)
     for (uint32_t s = 0; s < ns; s++) {

@@ -79,6 +79,22 @@ code=$?
 grep -q "full/frame_0000[0-9].png: cannot write" "$T/err" || fail "write failure message: $(cat "$T/err")"
 ls -a "$T/full" | grep -q tmp && fail "a failed frame left a temporary file"
 
+# Frames are drawn on as many threads as OpenMP would use, each from its own
+# copy of the world, and added in the order they were handed over: one
+# thread and two give the same files. A frame that cannot be written (its
+# name taken by a folder) ends the run there: the frames before it stay,
+# none after it is written.
+OMP_NUM_THREADS=1 "$SPN" animate "$WEB" -o "$T/one" "${common[@]}" --dew || fail "frames on one thread"
+OMP_NUM_THREADS=2 "$SPN" animate "$WEB" -o "$T/two" "${common[@]}" --dew || fail "frames on two threads"
+diff -r "$T/one" "$T/two" > /dev/null || fail "frames differ between one drawing thread and two"
+mkdir -p "$T/gap/frame_00004.png"
+OMP_NUM_THREADS=2 "$SPN" animate "$WEB" -o "$T/gap" "${common[@]}" 2> "$T/err"
+code=$?
+[ $code -eq 1 ] || fail "a run with an unwritable frame exited $code, expected 1"
+grep -q "gap/frame_00004.png: cannot write" "$T/err" || fail "unwritable frame message: $(cat "$T/err")"
+[ "$(ls "$T/gap" | tr '\n' ' ')" = "frame_00000.png frame_00001.png frame_00002.png frame_00003.png frame_00004.png " ] ||
+  fail "after an unwritable frame the folder holds: $(ls "$T/gap")"
+
 # Interrupt: finished frames stay (a shorter video), nothing partial.
 if command -v ffmpeg > /dev/null; then
   "$SPN" animate "$WEB" -o "$T/v.mp4" --wind thesis --duration 60 --fps 25 --size 64x64 --quiet &
