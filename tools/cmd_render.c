@@ -82,15 +82,15 @@ static int parse(int argc, char **argv, cmd_options *o)
     return check_output(o);
 }
 
-/* The camera swings from -yaw to +yaw and back (a planar web seen edge-on
- * shows nothing, so it does not go all the way round). */
 typedef struct turntable_job {
     const cmd_options *o;
     const spn_world *w;
     double swing;
 } turntable_job;
 
-/* Frame i of the turntable (frame_fan_fn: any thread; the world is only read). */
+/* Frame i of the turntable (frame_fan_fn: any thread; the world is only
+ * read). The camera swings from -yaw to +yaw and back (a planar web seen
+ * edge-on shows nothing, so it does not go all the way round). */
 static spn_status turntable_frame(void *user, int slot, int i, uint8_t *rgba)
 {
     (void)slot;
