@@ -1,8 +1,8 @@
-/* The program's frame threads (tools/frame_pipe.c for `animate`,
- * tools/frame_fan.c for turntables, construction frames and shots), driven
- * directly: frames drawn on two threads land in order even when a later
- * frame is drawn first (even frames here take 30 ms, odd ones none), and a
- * frame that fails ends the sequence there: the frames before it are
+/* The program's frame threads (tools/frame_pipe.c: worlds handed over by
+ * `animate`, and frame_pipe_run for turntables, construction frames and
+ * shots), driven directly on two threads: frames land in order even when a
+ * later frame is drawn first (even frames here take 30 ms, odd ones none),
+ * and a frame that fails ends the sequence there: the frames before it are
  * written, none after it, and the failure's own message comes back. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -12,7 +12,6 @@
 
 #include "common/scratch.h"
 
-#include "frame_fan.h"
 #include "frame_pipe.h"
 
 #include <cairo.h>
@@ -21,6 +20,9 @@
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 enum { W = 16, H = 8, COUNT = 10, BAD = 4 };
 
@@ -51,18 +53,14 @@ static spn_status paint(int frame, uint8_t *rgba)
     return SPN_OK;
 }
 
-static spn_status pipe_draw(void *user, int slot, int frame, const spn_world *w, uint8_t *rgba)
+/* A world handed over (user non-NULL) must arrive as a copy of one
+ * particle, none otherwise. (No cmocka assertion off the main thread: a
+ * wrong world or slot is an error.) */
+static spn_status draw(void *user, int slot, int frame, const spn_world *w, uint8_t *rgba)
 {
-    (void)user, (void)slot;
-    /* (no cmocka assertion off the main thread: a wrong world is an error) */
-    if (spn_world_particle_count(w) != 1) return spn_error(SPN_ERR_INVALID, "frame %d: not the world handed over", frame);
-    return paint(frame, rgba);
-}
-
-static spn_status fan_draw(void *user, int slot, int frame, uint8_t *rgba)
-{
-    (void)user;
-    if (slot < 0 || slot >= 2) return spn_error(SPN_ERR_INVALID, "frame %d: slot %d of 2", frame, slot);
+    if (user ? !w || spn_world_particle_count(w) != 1 : w != NULL)
+        return spn_error(SPN_ERR_INVALID, "frame %d: not the world handed over", frame);
+    if (slot < 0 || slot >= frame_pipe_threads(COUNT)) return spn_error(SPN_ERR_INVALID, "frame %d: slot %d", frame, slot);
     return paint(frame, rgba);
 }
 
@@ -95,10 +93,10 @@ static void run_pipe(const char *name, bool fail, int expect)
     spn_particle_def pd = spn_particle_def_default();
     assert_int_equal(spn_world_add_particle(w, &pd, NULL), SPN_OK);
     frame_pipe *pipe;
-    assert_int_equal(frame_pipe_open(&pipe, frames, 2, pipe_draw, NULL), SPN_OK);
+    assert_int_equal(frame_pipe_open(&pipe, frames, 2, draw, w), SPN_OK);
     spn_status st = SPN_OK;
     for (int f = 0; f < COUNT && st == SPN_OK; f++) st = frame_pipe_push(pipe, f, w);
-    spn_status closed = frame_pipe_close(pipe);
+    spn_status closed = frame_pipe_close(pipe, NULL);
     if (st == SPN_OK) st = closed;
     if (fail) {
         assert_int_equal(st, SPN_ERR_INVALID);
@@ -123,7 +121,7 @@ static void test_pipe_failure(void **state)
     run_pipe("pipe_bad", true, BAD);
 }
 
-static void run_fan(const char *name, bool fail, int expect)
+static void run_free(const char *name, bool fail, int expect)
 {
     char dir[600];
     snprintf(dir, sizeof dir, "%s/%s", folder, name);
@@ -131,7 +129,7 @@ static void run_fan(const char *name, bool fail, int expect)
     spn_frames *frames;
     assert_int_equal(spn_frames_open(dir, W, H, 25, &frames), SPN_OK);
     int added = -1;
-    spn_status st = frame_fan_run(frames, COUNT, 2, fan_draw, NULL, NULL, &added);
+    spn_status st = frame_pipe_run(frames, COUNT, draw, NULL, NULL, &added);
     assert_int_equal(st, fail ? SPN_ERR_INVALID : SPN_OK);
     if (fail) assert_non_null(strstr(spn_last_error(), "frame 4 would not draw"));
     assert_int_equal(added, expect);
@@ -139,21 +137,24 @@ static void run_fan(const char *name, bool fail, int expect)
     check_folder(dir, expect);
 }
 
-static void test_fan_order(void **state)
+static void test_run_order(void **state)
 {
     (void)state;
-    run_fan("fan", false, COUNT);
+    run_free("run", false, COUNT);
 }
 
-static void test_fan_failure(void **state)
+static void test_run_failure(void **state)
 {
     (void)state;
-    run_fan("fan_bad", true, BAD);
+    run_free("run_bad", true, BAD);
 }
 
 int main(void)
 {
+#ifdef _OPENMP
+    omp_set_num_threads(2); /* frame_pipe_run's threads, whatever the machine */
+#endif
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_pipe_order), cmocka_unit_test(test_pipe_failure),
-                                       cmocka_unit_test(test_fan_order), cmocka_unit_test(test_fan_failure)};
+                                       cmocka_unit_test(test_run_order), cmocka_unit_test(test_run_failure)};
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -6,7 +6,6 @@
  * SIGINT/SIGTERM stop after the current step: finished PNG frames and state
  * files stay, a video or report being written is abandoned. */
 #include "cli.h"
-#include "frame_fan.h"
 #include "frame_pipe.h"
 #include "render_options.h"
 
@@ -377,7 +376,7 @@ static spn_status prepare(animate_options *o, spn_world **w, frame_ctx *c)
     double rate = o->playback_fps > 0 ? o->playback_fps : fmin(o->anim.fps, 240);
     st = spn_frames_open(o->output, o->render.width, o->render.height, rate, &c->frames);
     if (st == SPN_OK) spn_frames_set_first_index(c->frames, o->anim.first_frame);
-    if (st == SPN_OK) st = frame_pipe_open(&c->pipe, c->frames, frame_fan_threads(frames), draw_frame, c);
+    if (st == SPN_OK) st = frame_pipe_open(&c->pipe, c->frames, frame_pipe_threads(frames), draw_frame, c);
     return st;
 }
 
@@ -424,7 +423,7 @@ static int animate_run(animate_options *o)
         o->anim.progress_user = &c;
         st = spn_animate(&w, &o->anim, on_frame, &c, &rep);
         /* the last frame is still being written */
-        spn_status pipe_st = frame_pipe_close(c.pipe);
+        spn_status pipe_st = frame_pipe_close(c.pipe, NULL);
         c.pipe = NULL;
         if (st == SPN_OK) st = pipe_st;
         spn_progress_end(c.bar);
@@ -434,7 +433,7 @@ static int animate_run(animate_options *o)
     bool done = st == SPN_OK && !rep.interrupted;
     /* Interrupted, the complete frames are kept (a shorter video), as every
      * other frame-writing command does; the report needs the whole run. */
-    frame_pipe_close(c.pipe); /* when prepare failed after opening it */
+    frame_pipe_close(c.pipe, NULL); /* when prepare failed after opening it */
     spn_status close_st = spn_frames_close(c.frames, st == SPN_OK && rep.frames > 0);
     if (st == SPN_OK) st = close_st;
     if (done && st == SPN_OK && o->report) st = write_report(o->report, &rep.impact);

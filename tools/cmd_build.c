@@ -4,7 +4,7 @@
  * by the builder), --settle brings the web to rest, --frames renders the web
  * being built, spring by spring in construction order. */
 #include "cli.h"
-#include "frame_fan.h"
+#include "frame_pipe.h"
 
 #include <getopt.h>
 #include <math.h>
@@ -278,10 +278,10 @@ typedef struct construction_job {
     int count;
 } construction_job;
 
-/* Frame i: the web once (i + 1) / count of it is laid (frame_fan_fn; any thread). */
-static spn_status construction_frame(void *user, int slot, int i, uint8_t *rgba)
+/* Frame i: the web once (i + 1) / count of it is laid (frame_pipe_fn; any thread). */
+static spn_status construction_frame(void *user, int slot, int i, const spn_world *none, uint8_t *rgba)
 {
-    (void)slot;
+    (void)slot, (void)none;
     const construction_job *j = user;
     spn_world *part = NULL;
     spn_status st = spn_web_construction_state(j->w, (double)(i + 1) / j->count, &part);
@@ -309,7 +309,7 @@ static spn_status write_frames(const spn_world *w, const char *dir, int count)
     spn_status st = spn_frames_open(dir, rd->width, rd->height, 24, &fr);
     if (st != SPN_OK) return st;
     cli_interruptible((uint64_t)count);
-    st = frame_fan_run(fr, count, frame_fan_threads(count), construction_frame, &job, NULL, &frames_done);
+    st = frame_pipe_run(fr, count, construction_frame, &job, NULL, &frames_done);
     spn_status cs = spn_frames_close(fr, st == SPN_OK);
     return st == SPN_OK ? cs : st;
 }

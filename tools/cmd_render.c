@@ -2,7 +2,7 @@
  * (spn_render_file). With --turntable N, a perspective camera circles the web
  * and the frames go to a video or a PNG folder (spn_frames_*). The picture
  * options are shared with `export` (render_options.h). */
-#include "frame_fan.h"
+#include "frame_pipe.h"
 #include "render_options.h"
 
 #include <stdio.h>
@@ -88,12 +88,12 @@ typedef struct turntable_job {
     double swing;
 } turntable_job;
 
-/* Frame i of the turntable (frame_fan_fn: any thread; the world is only
+/* Frame i of the turntable (frame_pipe_fn: any thread; the web is only
  * read). The camera swings from -yaw to +yaw and back (a planar web seen
  * edge-on shows nothing, so it does not go all the way round). */
-static spn_status turntable_frame(void *user, int slot, int i, uint8_t *rgba)
+static spn_status turntable_frame(void *user, int slot, int i, const spn_world *none, uint8_t *rgba)
 {
-    (void)slot;
+    (void)slot, (void)none;
     const turntable_job *j = user;
     spn_render_def d = j->o->ro.def;
     double yaw = j->swing * sin(2 * SPN_PI * (double)i / (double)j->o->turntable);
@@ -115,7 +115,7 @@ static int turntable(cmd_options *o, const spn_world *w)
     turntable_job job = {o, w, o->ro.yaw != 0 ? o->ro.yaw : 25};
     int done = 0;
     cli_interruptible((uint64_t)count);
-    spn_status st = frame_fan_run(frames, count, frame_fan_threads(count), turntable_frame, &job, bar, &done);
+    spn_status st = frame_pipe_run(frames, count, turntable_frame, &job, bar, &done);
     spn_progress_end(bar);
     if (st != SPN_OK) {
         spn_interrupt_graceful(false);

@@ -6,7 +6,7 @@
  * the scenery (a ground grid and the character as an orange wireframe
  * octahedron), always opaque. */
 #include "cmd_shoot.h"
-#include "frame_fan.h"
+#include "frame_pipe.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -211,9 +211,10 @@ static spn_status slot_init(render_slot *s, const recording *r, const view *v, s
     return st == SPN_OK ? build_scenery(s->scenery, v, &s->marker_first) : st;
 }
 
-/* Frame f into b (frame_fan_fn: slot `slot`'s worlds and buffer). */
-static spn_status render_frame(void *user, int slot, int frame, uint8_t *b)
+/* Frame f into b (frame_pipe_fn: slot `slot`'s worlds and buffer). */
+static spn_status render_frame(void *user, int slot, int frame, const spn_world *none, uint8_t *b)
 {
+    (void)none;
     const renderer *q = user;
     const recording *r = q->r;
     const render_slot *s = &q->slot[slot];
@@ -249,7 +250,7 @@ int shoot_write_video(const char *cmd, const char *path, const recording *r, con
     q.r = r;
     q.d = render_def(o, &v);
     q.radius = v.radius;
-    const int threads = frame_fan_threads((int)r->frames);
+    const int threads = frame_pipe_threads((int)r->frames);
     spn_status st = SPN_OK;
     for (; q.slots < threads && st == SPN_OK; q.slots++)
         st = slot_init(&q.slot[q.slots], r, &v, (size_t)width * height * 4);
@@ -258,7 +259,7 @@ int shoot_write_video(const char *cmd, const char *path, const recording *r, con
     spn_progress *bar = spn_progress_begin("shoot", r->frames, o->quiet);
     int done = 0;
     cli_interruptible(r->frames);
-    if (st == SPN_OK) st = frame_fan_run(frames, (int)r->frames, q.slots, render_frame, &q, bar, &done);
+    if (st == SPN_OK) st = frame_pipe_run(frames, (int)r->frames, render_frame, &q, bar, &done);
     spn_progress_end(bar);
     /* Interrupted or not, the complete frames; after a failure no partial video. */
     if (frames) {

@@ -3,7 +3,8 @@
  * the order of hand-overs (`seq`). The main thread refills an idle slot's
  * world (spn_world_copy_into: no new memory once the sizes are reached; a
  * fresh clone of a 1M-particle web took about a second, most of it on new
- * pages) and marks it busy; the slot's thread draws and encodes, then waits
+ * pages), or hands over no world, and marks it busy; the slot's thread
+ * draws and encodes, then waits
  * until `turn` reaches its `seq` to add the frame, so frames go out in the
  * order they came in. Every slot takes its turn even after a failure (it
  * then adds nothing), so the turns never stall. Errors are per thread
@@ -16,6 +17,10 @@
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <unistd.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 enum { MAX_SLOTS = 8 };
 
@@ -23,7 +28,8 @@ typedef struct pipe_slot {
     frame_pipe *p;
     int index;
     pthread_t thread;
-    spn_world *world;
+    spn_world *world; /* this slot's copy */
+    const spn_world *drawn; /* the frame's world: the copy, or NULL */
     uint8_t *rgba;
     int frame;
     long seq;
@@ -39,6 +45,8 @@ struct frame_pipe {
     pipe_slot slot[MAX_SLOTS];
     int nslots;
     long pushed, turn;
+    int added, total;
+    spn_progress *bar;
     bool quit;
     spn_status failed;
     char message[1024];
@@ -58,7 +66,7 @@ static spn_status draw(pipe_slot *s, bool skip, uint8_t **bytes, size_t *size)
     frame_pipe *p = s->p;
     *bytes = NULL, *size = 0;
     if (skip) return SPN_OK;
-    spn_status st = p->fn(p->user, s->index, s->frame, s->world, s->rgba);
+    spn_status st = p->fn(p->user, s->index, s->frame, s->drawn, s->rgba);
     return st == SPN_OK ? spn_frames_encode(p->frames, s->rgba, bytes, size) : st;
 }
 
@@ -81,6 +89,11 @@ static void *worker(void *arg)
             pthread_mutex_unlock(&p->lock); /* only the turn's holder touches the sequence */
             st = spn_frames_add_encoded(p->frames, bytes, size);
             pthread_mutex_lock(&p->lock);
+            if (st == SPN_OK) {
+                p->added++;
+                spn_progress_update(p->bar, (uint64_t)p->added);
+                if (p->total > 0) spn_interrupt_progress((uint64_t)p->added, (uint64_t)p->total);
+            }
         }
         if (st != SPN_OK) fail(p, st);
         free(bytes);
@@ -90,6 +103,19 @@ static void *worker(void *arg)
     }
     pthread_mutex_unlock(&p->lock);
     return NULL;
+}
+
+int frame_pipe_threads(int count)
+{
+#ifdef _OPENMP
+    int n = omp_get_max_threads();
+#else
+    long online = sysconf(_SC_NPROCESSORS_ONLN);
+    int n = online > 0 && online < 64 ? (int)online : 1;
+#endif
+    if (n > MAX_SLOTS) n = MAX_SLOTS;
+    if (n > count) n = count;
+    return n > 1 ? n : 1;
 }
 
 spn_status frame_pipe_open(frame_pipe **pipe, spn_frames *frames, int threads, frame_pipe_fn fn, void *user)
@@ -116,11 +142,16 @@ spn_status frame_pipe_open(frame_pipe **pipe, spn_frames *frames, int threads, f
         }
     }
     if (p->nslots == 0) {
-        frame_pipe_close(p);
+        frame_pipe_close(p, NULL);
         return spn_error(SPN_ERR_NOMEM, "cannot start a frame-drawing thread");
     }
     *pipe = p;
     return SPN_OK;
+}
+
+void frame_pipe_report(frame_pipe *p, spn_progress *bar, int total)
+{
+    p->bar = bar, p->total = total;
 }
 
 spn_status frame_pipe_push(frame_pipe *p, int frame, const spn_world *w)
@@ -136,9 +167,11 @@ spn_status frame_pipe_push(frame_pipe *p, int frame, const spn_world *w)
     pthread_mutex_unlock(&p->lock);
     if (st != SPN_OK) return spn_error(st, "%s", p->message);
     /* an idle slot's world is the main thread's alone */
-    if (s->world) st = spn_world_copy_into(s->world, w);
-    else if (!(s->world = spn_world_clone(w))) st = spn_error(SPN_ERR_NOMEM, "out of memory copying the world for frame %d", frame);
+    if (w && s->world) st = spn_world_copy_into(s->world, w);
+    else if (w && !(s->world = spn_world_clone(w)))
+        st = spn_error(SPN_ERR_NOMEM, "out of memory copying the world for frame %d", frame);
     if (st != SPN_OK) return st;
+    s->drawn = w ? s->world : NULL;
     pthread_mutex_lock(&p->lock);
     s->frame = frame, s->seq = p->pushed++, s->busy = true;
     pthread_cond_broadcast(&p->changed);
@@ -146,8 +179,9 @@ spn_status frame_pipe_push(frame_pipe *p, int frame, const spn_world *w)
     return SPN_OK;
 }
 
-spn_status frame_pipe_close(frame_pipe *p)
+spn_status frame_pipe_close(frame_pipe *p, int *added)
 {
+    if (added) *added = 0;
     if (!p) return SPN_OK;
     pthread_mutex_lock(&p->lock);
     while (p->turn != p->pushed) pthread_cond_wait(&p->changed, &p->lock);
@@ -161,8 +195,22 @@ spn_status frame_pipe_close(frame_pipe *p)
         free(p->slot[i].rgba);
     }
     if (st != SPN_OK) spn_error(st, "%s", p->message);
+    if (added) *added = p->added;
     pthread_cond_destroy(&p->changed);
     pthread_mutex_destroy(&p->lock);
     free(p);
     return st;
+}
+
+spn_status frame_pipe_run(spn_frames *frames, int count, frame_pipe_fn fn, void *user, spn_progress *bar,
+                          int *added)
+{
+    *added = 0;
+    frame_pipe *pipe;
+    spn_status st = frame_pipe_open(&pipe, frames, frame_pipe_threads(count), fn, user);
+    if (st != SPN_OK) return st;
+    frame_pipe_report(pipe, bar, count);
+    for (int i = 0; i < count && st == SPN_OK && !spn_interrupted(); i++) st = frame_pipe_push(pipe, i, NULL);
+    spn_status closed = frame_pipe_close(pipe, added);
+    return st == SPN_OK ? closed : st;
 }
