@@ -188,7 +188,7 @@ typedef struct renderer {
     const recording *r;
     spn_render_def d;
     double radius; /* the view's */
-    render_slot slot[8];
+    render_slot slot[FRAME_PIPE_MAX_THREADS];
     int slots;
 } renderer;
 

@@ -22,8 +22,6 @@
 #include <omp.h>
 #endif
 
-enum { MAX_SLOTS = 8 };
-
 typedef struct pipe_slot {
     frame_pipe *p;
     int index;
@@ -42,7 +40,7 @@ struct frame_pipe {
     void *user;
     pthread_mutex_t lock;
     pthread_cond_t changed;
-    pipe_slot slot[MAX_SLOTS];
+    pipe_slot slot[FRAME_PIPE_MAX_THREADS];
     int nslots;
     long pushed, turn;
     int added, total;
@@ -113,7 +111,7 @@ int frame_pipe_threads(int count)
     long online = sysconf(_SC_NPROCESSORS_ONLN);
     int n = online > 0 && online < 64 ? (int)online : 1;
 #endif
-    if (n > MAX_SLOTS) n = MAX_SLOTS;
+    if (n > FRAME_PIPE_MAX_THREADS) n = FRAME_PIPE_MAX_THREADS;
     if (n > count) n = count;
     return n > 1 ? n : 1;
 }
@@ -129,7 +127,7 @@ spn_status frame_pipe_open(frame_pipe **pipe, spn_frames *frames, int threads, f
     int width, height;
     spn_frames_size(frames, &width, &height);
     if (threads < 1) threads = 1;
-    if (threads > MAX_SLOTS) threads = MAX_SLOTS;
+    if (threads > FRAME_PIPE_MAX_THREADS) threads = FRAME_PIPE_MAX_THREADS;
     for (; p->nslots < threads; p->nslots++) {
         pipe_slot *s = &p->slot[p->nslots];
         s->p = p, s->index = p->nslots;

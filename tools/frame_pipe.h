@@ -20,6 +20,9 @@
 
 #include <spinneret/spinneret.h>
 
+/* The most drawing threads a pipe has. */
+#define FRAME_PIPE_MAX_THREADS 8
+
 typedef struct frame_pipe frame_pipe;
 /* Draws frame `frame` into `rgba` (the sequence's width x height x 4 bytes)
  * on drawing thread `slot` (0 .. threads - 1, for state a drawer keeps per
@@ -27,11 +30,12 @@ typedef struct frame_pipe frame_pipe;
 typedef spn_status (*frame_pipe_fn)(void *user, int slot, int frame, const spn_world *w, uint8_t *rgba);
 
 /* The drawing threads for `count` frames: OpenMP's thread count
- * (OMP_NUM_THREADS), else the processors online, at most 8 and at most
- * `count`, at least 1. A drawer that keeps state per slot sizes it by this. */
+ * (OMP_NUM_THREADS), else the processors online, at most
+ * FRAME_PIPE_MAX_THREADS and at most `count`, at least 1. A drawer that
+ * keeps state per slot sizes it by this. */
 int frame_pipe_threads(int count);
 
-/* A pipe into `frames` with `threads` drawing threads (1..8). */
+/* A pipe into `frames` with `threads` drawing threads (1..FRAME_PIPE_MAX_THREADS). */
 spn_status frame_pipe_open(frame_pipe **pipe, spn_frames *frames, int threads, frame_pipe_fn fn, void *user);
 /* Follow the frames added with `bar` (may be NULL) and spn_interrupt_progress
  * (of `total`). */
