@@ -188,6 +188,9 @@ static spn_status write_all(int fd, const uint8_t *p, size_t n)
     return SPN_OK;
 }
 
+/* Bytes of one RGBA frame of the sequence. */
+static size_t frame_bytes(const spn_frames *f) { return (size_t)f->width * f->height * 4; }
+
 /* Frame `index`'s PNG file in the folder; NULL when out of memory. */
 static char *png_path(const spn_frames *f, int index)
 {
@@ -200,7 +203,7 @@ static char *png_path(const spn_frames *f, int index)
 spn_status spn_frames_encode(const spn_frames *frames, const uint8_t *rgba, uint8_t **bytes, size_t *size)
 {
     *bytes = NULL, *size = 0;
-    const size_t raw = (size_t)frames->width * frames->height * 4;
+    const size_t raw = frame_bytes(frames);
     if (frames->kind != FRAMES_PNG) {
         if (!(*bytes = malloc(raw))) return spn_error(SPN_ERR_NOMEM, "frames: out of memory");
         memcpy(*bytes, rgba, raw);
@@ -232,7 +235,7 @@ static spn_status add_png(spn_frames *f, const uint8_t *bytes, size_t size)
 
 spn_status spn_frames_add_encoded(spn_frames *frames, const uint8_t *bytes, size_t size)
 {
-    const size_t raw = (size_t)frames->width * frames->height * 4;
+    const size_t raw = frame_bytes(frames);
     if (frames->kind != FRAMES_PNG && size != raw)
         return spn_error(SPN_ERR_INVALID, "frames: an encoded video frame is %zu bytes, not %zu", size, raw);
     spn_status st = frames->kind == FRAMES_PNG ? add_png(frames, bytes, size) : write_all(frames->pipe_fd, bytes, size);
@@ -242,7 +245,7 @@ spn_status spn_frames_add_encoded(spn_frames *frames, const uint8_t *bytes, size
 
 spn_status spn_frames_add(spn_frames *frames, const uint8_t *rgba)
 {
-    if (frames->kind != FRAMES_PNG) return spn_frames_add_encoded(frames, rgba, (size_t)frames->width * frames->height * 4);
+    if (frames->kind != FRAMES_PNG) return spn_frames_add_encoded(frames, rgba, frame_bytes(frames));
     uint8_t *bytes;
     size_t size;
     spn_status st = spn_frames_encode(frames, rgba, &bytes, &size);
@@ -256,7 +259,7 @@ spn_status spn_frames_add_world(spn_frames *frames, const spn_world *w, const sp
     if (def->width != frames->width || def->height != frames->height)
         return spn_error(SPN_ERR_INVALID, "frames: picture is %dx%d but the sequence is %dx%d", def->width,
                          def->height, frames->width, frames->height);
-    if (!frames->scratch) frames->scratch = malloc((size_t)frames->width * frames->height * 4);
+    if (!frames->scratch) frames->scratch = malloc(frame_bytes(frames));
     if (!frames->scratch) return spn_error(SPN_ERR_NOMEM, "frames: out of memory");
     spn_status st = spn_render_rgba(w, def, frames->scratch);
     return st == SPN_OK ? spn_frames_add(frames, frames->scratch) : st;
