@@ -8,9 +8,12 @@
  * 4. preconditioners the step does not have are refused, naming the choices;
  * 5. auto at short steps on a big web: the cyclic preconditioner on a rings
  *    x radials web; on one that is no lattice block Jacobi (bit for bit)
- *    until a step takes it over a hundred iterations, then the multigrid;
+ *    until a step takes it over a hundred iterations, then (up to
+ *    SPN__IMPLICIT_DIRECT_MAX particles) the factor of a step's matrix;
  *    the same on a small web (1,201 particles);
- * 6. a change of preconditioner mid-run takes effect at the next step. */
+ * 6. that factor: kept while solves stay short, made again at a change of
+ *    step, the same bits on one thread and two;
+ * 7. a change of preconditioner mid-run takes effect at the next step. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -115,7 +118,8 @@ static void test_cyclic_matches_block_jacobi(void **state)
  * lattice: at dt 1e-5 s, where block Jacobi needs a few tens of iterations,
  * it keeps block Jacobi, bit for bit; at 1e-4 s its first step is block
  * Jacobi's, bit for bit, and from the second on, since that one took more
- * than a hundred, the multigrid's (SPN__IMPLICIT_BJ_MAX). `broken`: break
+ * than a hundred (SPN__IMPLICIT_BJ_MAX), the factor's (a web this small is
+ * factorised instead of given the V-cycle). `broken`: break
  * spring 1200 first; `steps` steps of dt. */
 /* web_steps below; `held`: a 0.2 g body pressing on spring 600 by a contact. */
 static spn_vec3 *web_steps_held(int rings, int radials, spn_precond pc, bool broken, bool held, double dt, int steps,
@@ -172,7 +176,7 @@ static void test_auto_at_short_steps(void **state)
     assert_memory_equal(a, b, 2 * n * sizeof *a);
     free(a), free(b);
     /* no lattice, a step that takes block Jacobi over a hundred: its first
-     * step block Jacobi's, then the multigrid */
+     * step block Jacobi's, then the factor */
     a = short_steps(SPN_PRECOND_AUTO, true, 1e-4, 1, &cg_auto), b = short_steps(SPN_PRECOND_BLOCK_JACOBI, true, 1e-4, 1, &cg_bj);
     assert_true(cg_bj > SPN__IMPLICIT_BJ_MAX);
     assert_int_equal(cg_auto, cg_bj);
@@ -190,10 +194,10 @@ static void test_auto_at_short_steps(void **state)
 
 /* The same rule on a web under SPN__IMPLICIT_MG_MIN particles, which auto
  * otherwise leaves to block Jacobi: a species web in wind took 646
- * iterations a step there, against 23 with the multigrid (bench/bench_air.c).
- * Here 20 x 60 with a spring broken at dt 1e-4 s: block Jacobi 133-142 a
- * step; auto's first step is block Jacobi's, bit for bit, the others the
- * multigrid's (12-13). */
+ * iterations a step there, against 23 with the multigrid (bench/bench_air.c)
+ * and 4-6 with the factor. Here 20 x 60 with a spring broken at dt 1e-4 s:
+ * block Jacobi 133-142 a step; auto's first step is block Jacobi's, bit for
+ * bit, the others the factor's (3 each; the multigrid took 12-13). */
 static void test_auto_on_a_small_web(void **state)
 {
     (void)state;
@@ -246,6 +250,79 @@ static void test_threads_bit_identical(void **state)
  * of it (which builds its hierarchy afresh); both take the same two steps,
  * bit for bit. Kept, the multigrid's hierarchy went on serving the cyclic
  * choice (79 CG iterations over the two steps against 10). */
+/* auto on a web that is no lattice and small enough to factorise
+ * (SPN__IMPLICIT_DIRECT_MAX): from the step after block Jacobi took over a
+ * hundred iterations, CG is preconditioned by the factor of a step's own
+ * matrix (sparse_chol.c), kept for the steps after it until a solve takes
+ * more than SPN__IMPLICIT_REFACTOR iterations (the next step factorises) or
+ * reaches SPN__IMPLICIT_RESTART (this one does, and goes on), or the step
+ * length changes. The 20 x 60 web with a spring broken, falling from flat:
+ * 24 steps of 1e-4 s, then 3 of 2e-4 s. The states agree with block
+ * Jacobi's to what the tolerance allows; no step takes more than the
+ * restart and a little (block Jacobi 137 a step, the multigrid 12-13); the
+ * factor serves two steps or more on average; the change of step
+ * factorises at once; one thread and two give the same bits and counts. */
+typedef struct factor_run {
+    spn_vec3 *state;
+    long cg_first, cg_rest, cg_max, cg_after_change;
+    uint32_t factorisations, factorisations_before_change;
+} factor_run;
+
+enum { FACTOR_STEPS = 24, FACTOR_AFTER = 3 };
+
+static factor_run factor_steps(spn_precond pc, int threads)
+{
+    spn_world_def wd = spn_world_def_default();
+    wd.integrator = SPN_INTEGRATOR_IMPLICIT;
+    wd.threads = threads;
+    spn_orb_scene_def od = spn_orb_scene_def_default();
+    od.rings = 20, od.radials = 60;
+    spn_world *w = NULL;
+    assert_int_equal(spn_scene_orb(&wd, &od, &w), SPN_OK);
+    assert_int_equal(spn_world_set_implicit_preconditioner(w, pc), SPN_OK);
+    assert_int_equal(spn_world_set_solver_tolerance(w, 1e-10, 1000), SPN_OK);
+    spn_world_break_spring(w, 1200);
+    factor_run r = {0};
+    for (int i = 0; i < FACTOR_STEPS + FACTOR_AFTER; i++) {
+        if (i == FACTOR_STEPS) r.factorisations_before_change = spn__imp_mg_factorisations(w);
+        assert_int_equal(spn_world_step(w, i < FACTOR_STEPS ? 1e-4 : 2e-4), SPN_OK);
+        const long cg = spn_world_last_step(w).cg_iterations;
+        if (i == 0) r.cg_first = cg;
+        else if (i < FACTOR_STEPS) r.cg_rest += cg, r.cg_max = cg > r.cg_max ? cg : r.cg_max;
+        else if (i == FACTOR_STEPS) r.cg_after_change = cg;
+    }
+    r.factorisations = spn__imp_mg_factorisations(w);
+    r.state = util_take_state(w); /* (destroys w) */
+    return r;
+}
+
+static void test_factor_on_a_small_web(void **state)
+{
+    (void)state;
+    const uint32_t n = spn_orb_scene_particles(20, 60);
+    factor_run a = factor_steps(SPN_PRECOND_AUTO, 1), b = factor_steps(SPN_PRECOND_BLOCK_JACOBI, 1);
+    double vmax;
+    const double dv = velocity_gap(a.state, b.state, n, &vmax);
+    print_message("factor: first step %ld CG (block Jacobi's %ld), steps 2-%d %ld, at most %ld (block Jacobi %ld), "
+                  "the step after the change %ld; %u factorisations (%u before the change); max |dv| %.2e of %.2e\n",
+                  a.cg_first, b.cg_first, FACTOR_STEPS, a.cg_rest, a.cg_max, b.cg_rest, a.cg_after_change,
+                  a.factorisations, a.factorisations_before_change, dv, vmax);
+    assert_int_equal(a.cg_first, b.cg_first);
+    assert_true(b.cg_first > SPN__IMPLICIT_BJ_MAX);
+    assert_true(vmax > 0);
+    assert_true(dv <= 1e-6 * vmax);
+    assert_true(a.cg_max <= SPN__IMPLICIT_RESTART + 2);
+    assert_true(a.factorisations_before_change >= 1 && 2 * a.factorisations_before_change <= FACTOR_STEPS - 1);
+    assert_true(a.factorisations > a.factorisations_before_change);
+    assert_true(a.cg_after_change <= 2);
+    assert_int_equal(b.factorisations, 0);
+    factor_run c = factor_steps(SPN_PRECOND_AUTO, 2);
+    assert_int_equal(c.cg_first + c.cg_rest + c.cg_after_change, a.cg_first + a.cg_rest + a.cg_after_change);
+    assert_int_equal(c.factorisations, a.factorisations);
+    assert_memory_equal(c.state, a.state, 2 * n * sizeof *a.state);
+    free(a.state), free(b.state), free(c.state);
+}
+
 static void test_change_takes_effect(void **state)
 {
     (void)state;
@@ -290,6 +367,7 @@ int main(void)
         cmocka_unit_test(test_cyclic_matches_block_jacobi),
         cmocka_unit_test(test_auto_at_short_steps),
         cmocka_unit_test(test_auto_on_a_small_web),
+        cmocka_unit_test(test_factor_on_a_small_web),
         cmocka_unit_test(test_change_takes_effect),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

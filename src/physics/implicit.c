@@ -307,9 +307,15 @@ static int solve(spn_world *w, double h, double scale, bool *unfinished)
         cg_update(w, rz / pap, mg, &rz, &rr);
         it++;
         if (rr <= stop) break;
+        if (mg && it == SPN__IMPLICIT_RESTART && spn__imp_mg_refactor(w)) {
+            cg_update(w, 0, mg, &rz, &rr); /* z from the new factor; dv and r as they are */
+            memcpy(p, z, np * sizeof *p);
+            continue;
+        }
         cg_direction(w, rz / rz_old);
     }
     *unfinished = rr > stop;
+    if (mg) spn__imp_mg_solved(w, it);
     /* auto, on any web: block Jacobi that took this many iterations sends
      * this step length and longer ones to the multigrid (spn__imp_mg_prepare) */
     if (!mg && w->implicit_pc == 0 && it > SPN__IMPLICIT_BJ_MAX &&

@@ -25,11 +25,22 @@
  * SPN__IMPLICIT_MG_MIN particles at any step, take the cyclic preconditioner (equilibrium_cyclic.c)
  * on the same level 0 instead of the V-cycle: the 20k web in a breeze at
  * 1/60 s, 15.2 -> 1.9 CG and 79 -> 13 ms a step (docs/physics-implicit-mg.md).
- * The preconditioner is a fixed linear map within a solve, so CG's result
+ * Where auto would take the V-cycle, a web of up to SPN__IMPLICIT_DIRECT_MAX
+ * free particles gets a sparse Cholesky factor of level 0 instead
+ * (sparse_chol.c; ordered and analysed once with the hierarchy's signature):
+ * a factor of one step's matrix preconditions the next steps too, until a
+ * solve takes more than SPN__IMPLICIT_REFACTOR iterations (the next step
+ * factorises) or reaches SPN__IMPLICIT_RESTART (the solve factorises this
+ * step's matrix and goes on), or the step length changes. The Araneus web in
+ * air: 15.8 -> 3.7 CG and 6.3 -> 1.6 ms a step (docs/physics-implicit-mg.md,
+ * "A factorised preconditioner").
+ * The preconditioner is a fixed linear map within a solve (a restart begins
+ * CG again from where it is), so CG's result
  * differs from block Jacobi's only within the solver tolerance; every product
  * is summed in a fixed order, so the bits do not depend on the thread count. */
 #include "core/big_alloc.h"
 #include "equilibrium_internal.h"
+#include "sparse_chol.h"
 #include "world_internal.h"
 
 #include <stdlib.h>
@@ -39,6 +50,12 @@ struct spn__imp_mg {
     spn__eq e;
     spn__mg *mg;
     spn__cyc *cyc;     /* a rings x radials web: the cyclic preconditioner instead of the V-cycle */
+    spn__chol *chol;   /* a small web under auto: a factor of an earlier step's matrix instead */
+    bool chol_ready;   /* chol holds a factor */
+    bool chol_stale;   /* the last solve took more than SPN__IMPLICIT_REFACTOR iterations */
+    bool chol_fresh;   /* the factor is of this step's matrix */
+    double chol_h;     /* the step the factor's matrix was assembled for */
+    uint32_t factorisations;
     uint32_t *espring; /* eq spring -> internal spring id */
     double *inv0;      /* 6 n: inverted diagonal blocks in eq order */
     double *r, *z;     /* 3 n */
@@ -85,6 +102,7 @@ void spn__imp_mg_free(spn__imp_mg *m)
     if (!m) return;
     spn__mg_free(m->mg);
     spn__cyc_free(m->cyc);
+    spn__chol_free(m->chol);
     spn__eq_free(&m->e);
     free(m->espring), free(m->inv0), free(m->r), free(m->z);
     free(m);
@@ -159,6 +177,10 @@ static spn__imp_mg *create(const spn_world *w)
         const char *why;
         m->cyc = spn__cyc_build(&m->e, &why);
     }
+    /* auto on a small web that is no lattice: the factor (NULL if it would
+     * hold more than 200 numbers a particle: the V-cycle then) */
+    if (w->implicit_pc == 0 && !m->cyc && m->e.n <= SPN__IMPLICIT_DIRECT_MAX)
+        m->chol = spn__chol_analyze(m->e.n, m->e.adj_start, m->e.adj_other, 200 * (size_t)m->e.n);
     return m;
 }
 
@@ -230,6 +252,18 @@ bool spn__imp_mg_prepare(spn_world *w, double h)
     if (m->failed || m->e.n == 0) return false;
     if (w->implicit_pc == 0 && !auto_mg && !m->cyc) return false; /* a short step without the cyclic one */
     assemble(m, w, h);
+    if (m->chol) {
+        m->chol_fresh = !m->chol_ready || m->chol_stale || h != m->chol_h;
+        if (m->chol_fresh) {
+            m->chol_ready = spn__chol_factor(m->chol, m->e.diag, m->e.offd);
+            m->chol_h = h;
+            m->factorisations++;
+        }
+        m->chol_stale = false;
+        if (m->chol_ready) return true;
+        spn__chol_free(m->chol); /* not definite: the multigrid from here on */
+        m->chol = NULL;
+    }
     if (m->cyc) {
         if (spn__cyc_factor(m->cyc, &m->e)) return true;
         spn__cyc_free(m->cyc); /* not definite: the multigrid from here on */
@@ -258,7 +292,33 @@ void spn__imp_mg_apply(const spn_world *w, const spn_vec3 *r, spn_vec3 *z)
                       q[4] * ri.x + q[5] * ri.y + q[2] * ri.z);
     }
     for (uint32_t i = 0; i < n; i++) memcpy(m->r + 3 * (size_t)i, &r[e->world_id[i]], 3 * sizeof(double));
-    if (m->cyc) spn__cyc_apply(m->cyc, e, m->r, m->z);
+    if (m->chol) spn__chol_solve(m->chol, m->r, m->z);
+    else if (m->cyc) spn__cyc_apply(m->cyc, e, m->r, m->z);
     else spn__mg_apply(m->mg, e, m->r, m->z);
     for (uint32_t i = 0; i < n; i++) memcpy(&z[e->world_id[i]], m->z + 3 * (size_t)i, 3 * sizeof(double));
+}
+
+bool spn__imp_mg_refactor(spn_world *w)
+{
+    spn__imp_mg *m = w->imp_mg;
+    if (!m || !m->chol || m->chol_fresh) return false;
+    /* level 0 still holds this step's matrix (assemble) */
+    m->chol_ready = spn__chol_factor(m->chol, m->e.diag, m->e.offd);
+    m->chol_fresh = true;
+    m->factorisations++;
+    if (m->chol_ready) return true;
+    m->chol_fresh = false; /* not definite: the next step's prepare drops it */
+    m->chol_stale = true;
+    return false;
+}
+
+void spn__imp_mg_solved(spn_world *w, int iterations)
+{
+    spn__imp_mg *m = w->imp_mg;
+    if (m && m->chol && !m->chol_fresh && iterations > SPN__IMPLICIT_REFACTOR) m->chol_stale = true;
+}
+
+uint32_t spn__imp_mg_factorisations(const spn_world *w)
+{
+    return w->imp_mg && w->imp_mg->chol ? w->imp_mg->factorisations : 0;
 }

@@ -417,6 +417,18 @@ void spn__invert_sym3(const double a[6], double out[6]);
  * whatever the tolerance and the web's size (docs/physics-implicit-mg.md,
  * "Stiff webs"), but for a small web's steps with contacts. */
 #define SPN__IMPLICIT_BJ_MAX 100
+/* Where auto takes the multigrid on a web that is no lattice, a web of at
+ * most this many free particles is factorised instead (sparse_chol.c): the
+ * factor of one step's matrix preconditions the steps after it, and a step
+ * whose solve took more than SPN__IMPLICIT_REFACTOR CG iterations has the
+ * next one factorise its own (docs/physics-implicit-mg.md, "A factorised
+ * preconditioner"). */
+#define SPN__IMPLICIT_DIRECT_MAX 65536u
+#define SPN__IMPLICIT_REFACTOR 4
+/* A solve with a factor of an earlier step that reaches this many
+ * iterations factorises this step's matrix and goes on from where it is
+ * (CG restarted with the new preconditioner). */
+#define SPN__IMPLICIT_RESTART 8
 typedef struct spn__imp_mg spn__imp_mg;
 void spn__imp_mg_free(spn__imp_mg *m);
 /* After w->jac and w->pinv are built for step h: (re)build or refresh the
@@ -424,6 +436,13 @@ void spn__imp_mg_free(spn__imp_mg *m);
 bool spn__imp_mg_prepare(spn_world *w, double h);
 /* z = M^-1 r over all particles (fixed rows 0). */
 void spn__imp_mg_apply(const spn_world *w, const spn_vec3 *r, spn_vec3 *z);
+/* A solve with the preconditioner took `iterations` CG iterations. */
+void spn__imp_mg_solved(spn_world *w, int iterations);
+/* Mid-solve: the factor of an earlier step replaced by this step's; false
+ * when there is none to replace (or the new one failed). */
+bool spn__imp_mg_refactor(spn_world *w);
+/* The factorisations made for the implicit step so far (0 without a factor). */
+uint32_t spn__imp_mg_factorisations(const spn_world *w);
 /* Every contact active, before a step's first solve. */
 void spn__contact_begin(spn_world *w);
 /* The active contacts' part of the implicit system: their forces and

@@ -1,0 +1,439 @@
+/* Sparse Cholesky factorisation for the implicit step's preconditioner
+ * (sparse_chol.h).
+ *
+ * Ordering: minimum degree on the particle graph (order() below). A web is
+ * made of threads, long chains of particles of two neighbours that cost no
+ * fill when eliminated first, crossing at particles of four; minimum degree
+ * takes the chains first and the crossings as they become cheap. On the
+ * Araneus web of `spinneret build --species araneus` (1,918 free particles)
+ * L holds 126k numbers, as many as CHOLMOD's approximate minimum degree
+ * gives (124k); a nested dissection on the positions, tried first, gave
+ * 288k, since its separators cut every thread they cross.
+ *
+ * Factorisation: the up-looking method on the scalar matrix (3 unknowns a
+ * particle, each particle's three consecutive): row k of L is the solution
+ * of a triangular system whose pattern is the reach of row k of A in the
+ * elimination tree (Liu's algorithm for the tree). See T. A. Davis, "Direct
+ * Methods for Sparse Linear Systems" (SIAM 2006), chapter 4, for the method.
+ * The pattern of L is counted once at analysis; every factorisation walks
+ * the same reaches in the same order, so its bits depend on the values only. */
+#include "sparse_chol.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct spn__chol {
+    uint32_t n;     /* particles */
+    uint32_t N;     /* unknowns, 3 n */
+    uint32_t *perm; /* n: new particle -> old */
+    /* A's upper triangle in the new order, by scalar column (rows ascending) */
+    size_t *ap;       /* N + 1 */
+    uint32_t *ai;     /* ap[N] */
+    double *ax;       /* ap[N] */
+    size_t *dst_diag; /* 6 n: the entry of A each diagonal-block number adds into */
+    size_t *dst_offd; /* 9 per neighbour entry: each number of the block's (a, b), or SIZE_MAX */
+    uint32_t nadj;
+    /* the elimination tree and L by column, its diagonal first */
+    int32_t *parent; /* N */
+    size_t *lp;      /* N + 1 */
+    uint32_t *li;    /* lp[N] */
+    double *lx;      /* lp[N] */
+    /* scratch: a reach's stack and marks, the dense row, the solve's vector */
+    uint32_t *stack, *mark, *next;
+    double *x;
+    bool factored;
+};
+
+static int cmp_u32(const void *pa, const void *pb)
+{
+    const uint32_t a = *(const uint32_t *)pa, b = *(const uint32_t *)pb;
+    return (a > b) - (a < b);
+}
+
+/* ---- ordering --------------------------------------------------------------- */
+
+/* Minimum degree on the particle graph: the particle with the fewest
+ * neighbours in the elimination graph goes next, and its neighbours become
+ * one another's (the fill its elimination makes). Each particle's
+ * neighbours are kept as a sorted list, merged on elimination; particles of
+ * equal degree sit in a bucket, a list in which the latest arrival comes
+ * first, so the order is a function of the graph alone. */
+typedef struct md_graph {
+    uint32_t n;
+    uint32_t **nb; /* each particle's neighbours, sorted */
+    uint32_t *len, *cap;
+    uint32_t *head; /* n: the first particle of each degree, UINT32_MAX none */
+    uint32_t *next, *prev;
+    uint32_t *merged; /* scratch for a merge */
+} md_graph;
+
+static void md_link(md_graph *g, uint32_t i)
+{
+    const uint32_t d = g->len[i];
+    g->prev[i] = UINT32_MAX, g->next[i] = g->head[d];
+    if (g->head[d] != UINT32_MAX) g->prev[g->head[d]] = i;
+    g->head[d] = i;
+}
+
+static void md_unlink(md_graph *g, uint32_t i)
+{
+    if (g->prev[i] != UINT32_MAX)
+        g->next[g->prev[i]] = g->next[i];
+    else
+        g->head[g->len[i]] = g->next[i];
+    if (g->next[i] != UINT32_MAX) g->prev[g->next[i]] = g->prev[i];
+}
+
+/* u's neighbours become (theirs and v's) less u and v; false when out of memory. */
+static bool md_merge(md_graph *g, uint32_t u, uint32_t v)
+{
+    const uint32_t *a = g->nb[u], *b = g->nb[v], la = g->len[u], lb = g->len[v];
+    uint32_t i = 0, j = 0, k = 0, *m = g->merged;
+    while (i < la || j < lb) {
+        uint32_t x;
+        if (j >= lb || (i < la && a[i] < b[j]))
+            x = a[i++];
+        else if (i >= la || b[j] < a[i])
+            x = b[j++];
+        else
+            x = a[i++], j++;
+        if (x != u && x != v) m[k++] = x;
+    }
+    if (k > g->cap[u]) {
+        uint32_t c = g->cap[u] * 2 > k ? g->cap[u] * 2 : k;
+        uint32_t *p = realloc(g->nb[u], c * sizeof *p);
+        if (!p) return false;
+        g->nb[u] = p, g->cap[u] = c;
+    }
+    memcpy(g->nb[u], m, k * sizeof *m);
+    g->len[u] = k;
+    return true;
+}
+
+static bool order(spn__chol *c, const uint32_t *start, const int32_t *adj)
+{
+    const uint32_t n = c->n;
+    md_graph g = {n,
+                  calloc(n, sizeof(uint32_t *)),
+                  calloc(n, sizeof(uint32_t)),
+                  calloc(n, sizeof(uint32_t)),
+                  malloc((size_t)(n + 1) * sizeof(uint32_t)),
+                  malloc(n * sizeof(uint32_t)),
+                  malloc(n * sizeof(uint32_t)),
+                  malloc(n * sizeof(uint32_t))};
+    bool ok = g.nb && g.len && g.cap && g.head && g.next && g.prev && g.merged;
+    for (uint32_t i = 0; ok && i < n; i++) {
+        const uint32_t deg = start[i + 1] - start[i];
+        ok = (g.nb[i] = malloc((deg ? deg : 1) * sizeof(uint32_t))) != NULL;
+        if (!ok) break;
+        g.cap[i] = deg ? deg : 1;
+        uint32_t k = 0;
+        for (uint32_t j = start[i]; j < start[i + 1]; j++)
+            if (adj[j] >= 0 && (uint32_t)adj[j] != i) g.nb[i][k++] = (uint32_t)adj[j];
+        qsort(g.nb[i], k, sizeof(uint32_t), cmp_u32);
+        uint32_t u = 0;
+        for (uint32_t t = 0; t < k; t++)
+            if (u == 0 || g.nb[i][u - 1] != g.nb[i][t]) g.nb[i][u++] = g.nb[i][t];
+        g.len[i] = u;
+    }
+    if (ok) {
+        for (uint32_t d = 0; d <= n; d++)
+            g.head[d] = UINT32_MAX;
+        for (uint32_t i = n; i-- > 0;)
+            md_link(&g, i);
+    }
+    uint32_t low = 0;
+    for (uint32_t k = 0; ok && k < n; k++) {
+        while (g.head[low] == UINT32_MAX)
+            low++;
+        const uint32_t v = g.head[low];
+        md_unlink(&g, v);
+        c->perm[k] = v;
+        for (uint32_t t = 0; ok && t < g.len[v]; t++) {
+            const uint32_t u = g.nb[v][t];
+            md_unlink(&g, u);
+            ok = md_merge(&g, u, v);
+            md_link(&g, u);
+            if (g.len[u] < low) low = g.len[u];
+        }
+        g.len[v] = 0;
+    }
+    for (uint32_t i = 0; g.nb && i < n; i++)
+        free(g.nb[i]);
+    free(g.nb), free(g.len), free(g.cap), free(g.head), free(g.next), free(g.prev), free(g.merged);
+    return ok;
+}
+
+/* ---- pattern ------------------------------------------------------------------- */
+
+/* The position of v in the sorted list l[0 .. len). */
+static uint32_t find(const uint32_t *l, uint32_t len, uint32_t v)
+{
+    uint32_t a = 0, b = len;
+    while (b - a > 1) {
+        const uint32_t m = a + (b - a) / 2;
+        if (l[m] <= v)
+            a = m;
+        else
+            b = m;
+    }
+    return a;
+}
+
+/* A's upper pattern in the new order and where each input number adds. */
+static bool upper_pattern(spn__chol *c, const uint32_t *start, const int32_t *adj)
+{
+    const uint32_t n = c->n, N = c->N;
+    uint32_t *iperm = malloc((n ? n : 1) * sizeof *iperm);
+    uint32_t *bstart = calloc((size_t)n + 1, sizeof *bstart); /* per new particle: its earlier neighbours */
+    uint32_t *bnbr = malloc((c->nadj ? c->nadj : 1) * sizeof *bnbr);
+    c->ap = malloc(((size_t)N + 1) * sizeof *c->ap);
+    c->dst_diag = malloc(6 * (size_t)(n ? n : 1) * sizeof *c->dst_diag);
+    c->dst_offd = malloc(9 * (size_t)(c->nadj ? c->nadj : 1) * sizeof *c->dst_offd);
+    bool ok = iperm && bstart && bnbr && c->ap && c->dst_diag && c->dst_offd;
+    if (ok) {
+        for (uint32_t k = 0; k < n; k++)
+            iperm[c->perm[k]] = k;
+        /* each new particle k: its neighbours numbered before it, sorted, once each */
+        for (uint32_t k = 0; k < n; k++) {
+            const uint32_t p = c->perm[k];
+            uint32_t len = 0, *l = bnbr + bstart[k];
+            for (uint32_t j = start[p]; j < start[p + 1]; j++)
+                if (adj[j] >= 0 && iperm[adj[j]] < k) l[len++] = iperm[adj[j]];
+            qsort(l, len, sizeof *l, cmp_u32);
+            uint32_t u = 0;
+            for (uint32_t t = 0; t < len; t++)
+                if (u == 0 || l[u - 1] != l[t]) l[u++] = l[t];
+            bstart[k + 1] = bstart[k] + u;
+        }
+        /* column 3k + b: rows 3q + a of each earlier neighbour q, then 3k + a, a <= b */
+        c->ap[0] = 0;
+        for (uint32_t k = 0; k < n; k++)
+            for (uint32_t b = 0; b < 3; b++)
+                c->ap[3 * k + b + 1] = c->ap[3 * k + b] + 3 * (size_t)(bstart[k + 1] - bstart[k]) + b + 1;
+        c->ai = malloc((c->ap[N] ? c->ap[N] : 1) * sizeof *c->ai);
+        c->ax = malloc((c->ap[N] ? c->ap[N] : 1) * sizeof *c->ax);
+        ok = c->ai && c->ax;
+    }
+    for (uint32_t k = 0; ok && k < n; k++) {
+        const uint32_t nb = bstart[k + 1] - bstart[k];
+        for (uint32_t b = 0; b < 3; b++) {
+            size_t e = c->ap[3 * k + b];
+            for (uint32_t t = 0; t < nb; t++)
+                for (uint32_t a = 0; a < 3; a++)
+                    c->ai[e++] = 3 * bnbr[bstart[k] + t] + a;
+            for (uint32_t a = 0; a <= b; a++)
+                c->ai[e++] = 3 * k + a;
+        }
+        /* diagonal numbers xx, yy, zz, xy, xz, yz: row a <= column b */
+        static const uint8_t ra[6] = {0, 1, 2, 0, 0, 1}, cb[6] = {0, 1, 2, 1, 2, 2};
+        const uint32_t p = c->perm[k];
+        for (int m = 0; m < 6; m++)
+            c->dst_diag[6 * (size_t)p + m] = c->ap[3 * k + cb[m]] + 3 * (size_t)nb + ra[m];
+        /* a neighbour entry of p numbered before it: all nine numbers, in its
+         * block of rows in the columns of k (the pair's other entry adds nothing) */
+        for (uint32_t j = start[p]; j < start[p + 1]; j++) {
+            size_t *d = c->dst_offd + 9 * (size_t)j;
+            if (adj[j] < 0 || iperm[adj[j]] >= k) {
+                for (int m = 0; m < 9; m++)
+                    d[m] = SIZE_MAX;
+                continue;
+            }
+            const uint32_t t = find(bnbr + bstart[k], nb, iperm[adj[j]]);
+            for (uint32_t a = 0; a < 3; a++)
+                for (uint32_t b = 0; b < 3; b++)
+                    d[3 * a + b] = c->ap[3 * k + b] + 3 * (size_t)t + a;
+        }
+    }
+    free(iperm), free(bstart), free(bnbr);
+    return ok;
+}
+
+/* Liu's elimination tree of the upper pattern. */
+static void etree(spn__chol *c, uint32_t *ancestor)
+{
+    for (uint32_t k = 0; k < c->N; k++) {
+        c->parent[k] = -1, ancestor[k] = UINT32_MAX;
+        for (size_t p = c->ap[k]; p < c->ap[k + 1]; p++) {
+            uint32_t i = c->ai[p];
+            while (i != UINT32_MAX && i < k) {
+                const uint32_t up = ancestor[i];
+                ancestor[i] = k;
+                if (up == UINT32_MAX) c->parent[i] = (int32_t)k;
+                i = up;
+            }
+        }
+    }
+}
+
+/* Row k's pattern in L (without the diagonal), children before parents, in
+ * stack[top .. N); returns top. */
+static uint32_t reach(const spn__chol *c, uint32_t k)
+{
+    uint32_t top = c->N, *s = c->stack, *len_buf = c->next;
+    c->mark[k] = k;
+    for (size_t p = c->ap[k]; p < c->ap[k + 1]; p++) {
+        uint32_t i = c->ai[p], len = 0;
+        if (i >= k) continue;
+        for (; c->mark[i] != k; i = (uint32_t)c->parent[i])
+            len_buf[len++] = i, c->mark[i] = k;
+        while (len > 0)
+            s[--top] = len_buf[--len];
+    }
+    return top;
+}
+
+spn__chol *spn__chol_analyze(uint32_t n, const uint32_t *start, const int32_t *adj_other, size_t max_entries)
+{
+    if (n == 0 || n > UINT32_MAX / 3 - 1) return NULL;
+    spn__chol *c = calloc(1, sizeof *c);
+    if (!c) return NULL;
+    c->n = n, c->N = 3 * n, c->nadj = start[n];
+    const uint32_t N = c->N;
+    c->perm = malloc(n * sizeof *c->perm);
+    c->parent = malloc(N * sizeof *c->parent);
+    c->stack = malloc(N * sizeof *c->stack);
+    c->mark = malloc(N * sizeof *c->mark);
+    c->next = malloc(N * sizeof *c->next);
+    c->x = calloc(N, sizeof *c->x);
+    c->lp = malloc(((size_t)N + 1) * sizeof *c->lp);
+    if (!c->perm || !c->parent || !c->stack || !c->mark || !c->next || !c->x || !c->lp || !order(c, start, adj_other) ||
+        !upper_pattern(c, start, adj_other)) {
+        spn__chol_free(c);
+        return NULL;
+    }
+    etree(c, c->mark);
+    /* column counts: row k's pattern adds one to each of its columns */
+    size_t *count = calloc(N, sizeof *count);
+    if (!count) {
+        spn__chol_free(c);
+        return NULL;
+    }
+    for (uint32_t k = 0; k < N; k++)
+        c->mark[k] = UINT32_MAX;
+    for (uint32_t k = 0; k < N; k++) {
+        count[k]++;
+        for (uint32_t t = reach(c, k); t < N; t++)
+            count[c->stack[t]]++;
+    }
+    c->lp[0] = 0;
+    for (uint32_t k = 0; k < N; k++)
+        c->lp[k + 1] = c->lp[k] + count[k];
+    free(count);
+    if (c->lp[N] > max_entries || !(c->li = malloc(c->lp[N] * sizeof *c->li)) ||
+        !(c->lx = malloc(c->lp[N] * sizeof *c->lx))) {
+        spn__chol_free(c);
+        return NULL;
+    }
+    return c;
+}
+
+bool spn__chol_factor(spn__chol *c, const double *diag, const double *offd)
+{
+    const uint32_t N = c->N;
+    memset(c->ax, 0, c->ap[N] * sizeof *c->ax);
+    for (size_t m = 0; m < 6 * (size_t)c->n; m++)
+        c->ax[c->dst_diag[m]] += diag[m];
+    static const uint8_t sym[9] = {0, 3, 4, 3, 1, 5, 4, 5, 2}; /* (a, b) -> xx yy zz xy xz yz */
+    for (size_t j = 0; j < c->nadj; j++)
+        for (int m = 0; m < 9; m++)
+            if (c->dst_offd[9 * j + m] != SIZE_MAX) c->ax[c->dst_offd[9 * j + m]] += offd[6 * j + sym[m]];
+    size_t *fill = malloc(((size_t)N + 1) * sizeof *fill);
+    if (!fill) return c->factored = false;
+    memcpy(fill, c->lp, ((size_t)N + 1) * sizeof *fill);
+    for (uint32_t k = 0; k < N; k++)
+        c->mark[k] = UINT32_MAX;
+    double *x = c->x;
+    bool ok = true;
+    for (uint32_t k = 0; k < N && ok; k++) {
+        uint32_t top = reach(c, k);
+        for (size_t p = c->ap[k]; p < c->ap[k + 1]; p++)
+            x[c->ai[p]] = c->ax[p];
+        double d = x[k];
+        x[k] = 0;
+        for (; top < N; top++) {
+            const uint32_t i = c->stack[top];
+            const double lki = x[i] / c->lx[c->lp[i]];
+            x[i] = 0;
+            for (size_t p = c->lp[i] + 1; p < fill[i]; p++)
+                x[c->li[p]] -= c->lx[p] * lki;
+            d -= lki * lki;
+            const size_t p = fill[i]++;
+            c->li[p] = k, c->lx[p] = lki;
+        }
+        ok = d > 0 && isfinite(d);
+        const size_t p = fill[k]++;
+        c->li[p] = k, c->lx[p] = ok ? sqrt(d) : 1;
+    }
+    for (uint32_t k = 0; k < N; k++)
+        x[k] = 0; /* a failed row leaves values behind */
+    free(fill);
+    return c->factored = ok;
+}
+
+/* L y = b, then L^T x = y, in y, a particle at a time. A particle's
+ * diagonal block enters A whole, so in the elimination tree 3k is the only
+ * child of 3k + 1 and 3k + 1 of 3k + 2, and rows of other particles come in
+ * whole triples: its three columns of L hold its 3x3 block (rows 3k + 1,
+ * 3k + 2 below the first diagonal, 3k + 2 below the second) and then the
+ * same rows S in the same order. Forward, the particle's three unknowns
+ * come from the block and each row of S is updated by its three entries;
+ * backward, the three sums over S come first, then the block. */
+static void solve_particles(const spn__chol *c, double *y)
+{
+    const double *lx = c->lx;
+    for (uint32_t k = 0; k < c->n; k++) {
+        const uint32_t j = 3 * k;
+        const size_t p0 = c->lp[j], p1 = c->lp[j + 1], p2 = c->lp[j + 2], ns = c->lp[j + 3] - p2 - 1;
+        const double y0 = y[j] / lx[p0];
+        const double y1 = (y[j + 1] - lx[p0 + 1] * y0) / lx[p1];
+        const double y2 = ((y[j + 2] - lx[p0 + 2] * y0) - lx[p1 + 1] * y1) / lx[p2];
+        y[j] = y0, y[j + 1] = y1, y[j + 2] = y2;
+        const double *a = lx + p0 + 3, *b = lx + p1 + 2, *e = lx + p2 + 1;
+        const uint32_t *rows = c->li + p2 + 1;
+        for (size_t t = 0; t < ns; t++) {
+            double *yr = y + rows[t];
+            *yr = ((*yr - a[t] * y0) - b[t] * y1) - e[t] * y2;
+        }
+    }
+    for (uint32_t k = c->n; k-- > 0;) {
+        const uint32_t j = 3 * k;
+        const size_t p0 = c->lp[j], p1 = c->lp[j + 1], p2 = c->lp[j + 2], ns = c->lp[j + 3] - p2 - 1;
+        const double *a = lx + p0 + 3, *b = lx + p1 + 2, *e = lx + p2 + 1;
+        const uint32_t *rows = c->li + p2 + 1;
+        double s0 = y[j], s1 = y[j + 1], s2 = y[j + 2];
+        for (size_t t = 0; t < ns; t++) {
+            const double xr = y[rows[t]];
+            s0 -= a[t] * xr, s1 -= b[t] * xr, s2 -= e[t] * xr;
+        }
+        const double x2 = s2 / lx[p2];
+        const double x1 = (s1 - lx[p1 + 1] * x2) / lx[p1];
+        y[j + 2] = x2, y[j + 1] = x1, y[j] = ((s0 - lx[p0 + 1] * x1) - lx[p0 + 2] * x2) / lx[p0];
+    }
+}
+
+void spn__chol_solve(const spn__chol *c, const double *b, double *out)
+{
+    const uint32_t N = c->N;
+    double *y = c->x;
+    for (uint32_t k = 0; k < c->n; k++)
+        for (int a = 0; a < 3; a++)
+            y[3 * k + a] = b[3 * (size_t)c->perm[k] + a];
+    solve_particles(c, y);
+    for (uint32_t k = 0; k < c->n; k++)
+        for (int a = 0; a < 3; a++)
+            out[3 * (size_t)c->perm[k] + a] = y[3 * k + a];
+    for (uint32_t j = 0; j < N; j++)
+        y[j] = 0; /* the factorisation's dense row starts at zero */
+}
+
+size_t spn__chol_entries(const spn__chol *c) { return c->lp[c->N]; }
+
+void spn__chol_free(spn__chol *c)
+{
+    if (!c) return;
+    free(c->perm), free(c->ap), free(c->ai), free(c->ax), free(c->dst_diag), free(c->dst_offd);
+    free(c->parent), free(c->lp), free(c->li), free(c->lx), free(c->stack), free(c->mark), free(c->next), free(c->x);
+    free(c);
+}
