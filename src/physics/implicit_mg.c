@@ -291,6 +291,7 @@ void spn__imp_mg_apply(const spn_world *w, const spn_vec3 *r, spn_vec3 *z)
         z[i] = spn_v3(q[0] * ri.x + q[3] * ri.y + q[4] * ri.z, q[3] * ri.x + q[1] * ri.y + q[5] * ri.z,
                       q[4] * ri.x + q[5] * ri.y + q[2] * ri.z);
     }
+    if (m->chol && !m->chol_ready) return; /* a factorisation failed mid-solve (spn__imp_mg_refactor) */
     for (uint32_t i = 0; i < n; i++) memcpy(m->r + 3 * (size_t)i, &r[e->world_id[i]], 3 * sizeof(double));
     if (m->chol) spn__chol_solve(m->chol, m->r, m->z);
     else if (m->cyc) spn__cyc_apply(m->cyc, e, m->r, m->z);
@@ -303,13 +304,13 @@ bool spn__imp_mg_refactor(spn_world *w)
     spn__imp_mg *m = w->imp_mg;
     if (!m || !m->chol || m->chol_fresh) return false;
     /* level 0 still holds this step's matrix (assemble) */
+    /* not definite: block Jacobi for the rest of this solve (apply), and the
+     * next step's prepare factorises again, and drops the factor if that
+     * fails too */
     m->chol_ready = spn__chol_factor(m->chol, m->e.diag, m->e.offd);
     m->chol_fresh = true;
     m->factorisations++;
-    if (m->chol_ready) return true;
-    m->chol_fresh = false; /* not definite: the next step's prepare drops it */
-    m->chol_stale = true;
-    return false;
+    return true;
 }
 
 void spn__imp_mg_solved(spn_world *w, int iterations)

@@ -438,8 +438,9 @@ bool spn__imp_mg_prepare(spn_world *w, double h);
 void spn__imp_mg_apply(const spn_world *w, const spn_vec3 *r, spn_vec3 *z);
 /* A solve with the preconditioner took `iterations` CG iterations. */
 void spn__imp_mg_solved(spn_world *w, int iterations);
-/* Mid-solve: the factor of an earlier step replaced by this step's; false
- * when there is none to replace (or the new one failed). */
+/* Mid-solve: the factor of an earlier step replaced by this step's (or,
+ * if that fails, by block Jacobi for the rest of the solve); false when
+ * there is none to replace. CG must start again from where it is. */
 bool spn__imp_mg_refactor(spn_world *w);
 /* The factorisations made for the implicit step so far (0 without a factor). */
 uint32_t spn__imp_mg_factorisations(const spn_world *w);
