@@ -45,7 +45,7 @@ struct spn__chol {
     size_t *lp;      /* N + 1 */
     uint32_t *li;    /* lp[N] */
     double *lx;      /* lp[N] */
-    /* scratch: a reach's stack and marks, the dense row, the solve's vector */
+    /* scratch: a reach's stack, marks and path, the solve's vector */
     uint32_t *stack, *mark, *next;
     double *x;
     /* the factorisation a particle at a time: the particles' elimination
