@@ -40,7 +40,9 @@ SPN_API const char *spn_precond_name(spn_precond p);
 /// SPN_PRECOND_AUTO (the default: from 4,096 particles the cyclic preconditioner on such a web at
 /// any step and the multigrid on others at steps of 5 ms and up; on any web the multigrid from the
 /// step after one that took block Jacobi over 100 CG iterations, at that step's length and longer
-/// (under 4,096 particles not in steps with contacts);
+/// (under 4,096 particles not in steps with contacts); where it would take the multigrid, a web of up
+/// to 65,536 free particles gets a sparse Cholesky factor of a step's matrix instead, kept over the
+/// steps while its solves stay short;
 /// block Jacobi otherwise). Results agree to the
 /// solver tolerance; a clone of a world mid-run continues within it, not bit for bit
 /// (the clone builds its hierarchy afresh). Changing the choice drops a kept hierarchy (the next step
