@@ -13,12 +13,12 @@
  * Factorisation: the up-looking method (T. A. Davis, "Direct Methods for
  * Sparse Linear Systems", SIAM 2006, chapter 4): row k of L is the solution
  * of a triangular system whose pattern is the reach of row k of A in the
- * elimination tree (Liu's algorithm for the tree). The pattern of L is
- * counted once at analysis, on the scalar matrix (3 unknowns a particle,
- * each particle's three consecutive). A particle's diagonal block enters A
- * whole, so its three columns of L share their rows below its 3x3 block,
- * and the factorisation and the solves go a particle at a time, on 3x3
- * blocks: one index for nine multiply-adds. A column at a time, the
+ * elimination tree (Liu's algorithm for the tree). The matrix has 3
+ * unknowns a particle, each particle's three consecutive, and a particle's
+ * diagonal block enters A whole, so its three columns of L share their rows
+ * below its 3x3 block: the tree, the reaches, the pattern of L (counted once
+ * at analysis), the factorisation and the solves all go a particle at a
+ * time, on 3x3 blocks: one index for nine multiply-adds. A column at a time, the
  * factorisation took 3.6 ms on the Araneus web, 92 and 218 ms on the Zilla
  * webs of 14k and 50k particles; a particle at a time 2.2, 30 and 82.
  * Every factorisation walks the same reaches in the same order, so its
@@ -40,21 +40,18 @@ struct spn__chol {
     size_t *dst_diag; /* 6 n: the entry of A each diagonal-block number adds into */
     size_t *dst_offd; /* 9 per neighbour entry: each number of the block's (a, b), or SIZE_MAX */
     uint32_t nadj;
-    /* the elimination tree and L by column, its diagonal first */
-    int32_t *parent; /* N */
-    size_t *lp;      /* N + 1 */
-    uint32_t *li;    /* lp[N] */
-    double *lx;      /* lp[N] */
-    /* scratch: a reach's stack, marks and path, the solve's vector */
-    uint32_t *stack, *mark, *next;
-    double *x;
-    /* the factorisation a particle at a time: the particles' elimination
-     * tree, a 3x3 block of the row being formed for each particle, and the
-     * row-particles each particle's columns hold so far */
+    /* the particles' elimination tree and L by scalar column, its diagonal first */
     int32_t *bparent; /* n */
-    double *xb;       /* 9 n, row-major (the earlier particle's row, this one's column) */
-    uint32_t *filled; /* n */
-    bool factored;
+    size_t *lp;       /* N + 1 */
+    uint32_t *li;     /* lp[N] */
+    double *lx;       /* lp[N] */
+    /* scratch: a reach's stack, marks and path (n each), the solve's vector
+     * (N), a 3x3 block of the row being formed for each particle (9 n,
+     * row-major: the earlier particle's row, this one's column) and the
+     * row-particles each particle's columns hold so far (n) */
+    uint32_t *stack, *mark, *next;
+    double *x, *xb;
+    uint32_t *filled;
 };
 
 static int cmp_u32(const void *pa, const void *pb)
@@ -262,36 +259,46 @@ static bool upper_pattern(spn__chol *c, const uint32_t *start, const int32_t *ad
     return ok;
 }
 
-/* Liu's elimination tree of the upper pattern. */
+/* Particle k's neighbours numbered before it: A's blocks above its
+ * diagonal block, every third row of column 3k from ap[3k]; their count. */
+static uint32_t earlier(const spn__chol *c, uint32_t k)
+{
+    return (uint32_t)((c->ap[3 * k + 1] - c->ap[3 * k] - 1) / 3);
+}
+
+/* Liu's elimination tree of the particles (ancestor: n of scratch). A
+ * particle's diagonal block enters A whole, so this is the scalar tree with
+ * each particle's three columns a chain, read a particle at a time. */
 static void etree(spn__chol *c, uint32_t *ancestor)
 {
-    for (uint32_t k = 0; k < c->N; k++) {
-        c->parent[k] = -1, ancestor[k] = UINT32_MAX;
-        for (size_t p = c->ap[k]; p < c->ap[k + 1]; p++) {
-            uint32_t i = c->ai[p];
+    for (uint32_t k = 0; k < c->n; k++) {
+        c->bparent[k] = -1, ancestor[k] = UINT32_MAX;
+        for (uint32_t t = 0, nb = earlier(c, k); t < nb; t++) {
+            uint32_t i = c->ai[c->ap[3 * k] + 3 * t] / 3;
             while (i != UINT32_MAX && i < k) {
                 const uint32_t up = ancestor[i];
                 ancestor[i] = k;
-                if (up == UINT32_MAX) c->parent[i] = (int32_t)k;
+                if (up == UINT32_MAX) c->bparent[i] = (int32_t)k;
                 i = up;
             }
         }
     }
 }
 
-/* Row k's pattern in L (without the diagonal), children before parents, in
- * stack[top .. N); returns top. */
-static uint32_t reach(const spn__chol *c, uint32_t k)
+/* The particles row k of L reaches in the particles' elimination tree
+ * (the particles of the blocks of row k of L), children first, in
+ * stack[top .. n); returns top. */
+static uint32_t block_reach(const spn__chol *c, uint32_t k)
 {
-    uint32_t top = c->N, *s = c->stack, *len_buf = c->next;
+    uint32_t top = c->n, *s = c->stack, *path = c->next;
+    const size_t p0 = c->ap[3 * k];
     c->mark[k] = k;
-    for (size_t p = c->ap[k]; p < c->ap[k + 1]; p++) {
-        uint32_t i = c->ai[p], len = 0;
-        if (i >= k) continue;
-        for (; c->mark[i] != k; i = (uint32_t)c->parent[i])
-            len_buf[len++] = i, c->mark[i] = k;
+    for (uint32_t t = 0, nb = earlier(c, k); t < nb; t++) {
+        uint32_t i = c->ai[p0 + 3 * t] / 3, len = 0;
+        for (; c->mark[i] != k; i = (uint32_t)c->bparent[i])
+            path[len++] = i, c->mark[i] = k;
         while (len > 0)
-            s[--top] = len_buf[--len];
+            s[--top] = path[--len];
     }
     return top;
 }
@@ -304,68 +311,38 @@ spn__chol *spn__chol_analyze(uint32_t n, const uint32_t *start, const int32_t *a
     c->n = n, c->N = 3 * n, c->nadj = start[n];
     const uint32_t N = c->N;
     c->perm = malloc(n * sizeof *c->perm);
-    c->parent = malloc(N * sizeof *c->parent);
-    c->stack = malloc(N * sizeof *c->stack);
-    c->mark = malloc(N * sizeof *c->mark);
-    c->next = malloc(N * sizeof *c->next);
-    c->x = calloc(N, sizeof *c->x);
-    c->lp = malloc(((size_t)N + 1) * sizeof *c->lp);
     c->bparent = malloc(n * sizeof *c->bparent);
+    c->stack = malloc(n * sizeof *c->stack);
+    c->mark = malloc(n * sizeof *c->mark);
+    c->next = malloc(n * sizeof *c->next);
+    c->x = calloc(N, sizeof *c->x);
     c->xb = calloc(9 * (size_t)n, sizeof *c->xb);
-    c->filled = malloc(n * sizeof *c->filled);
-    if (!c->perm || !c->parent || !c->stack || !c->mark || !c->next || !c->x || !c->lp || !c->bparent || !c->xb ||
-        !c->filled || !order(c, start, adj_other) ||
-        !upper_pattern(c, start, adj_other)) {
+    c->filled = calloc(n, sizeof *c->filled);
+    c->lp = malloc(((size_t)N + 1) * sizeof *c->lp);
+    if (!c->perm || !c->bparent || !c->stack || !c->mark || !c->next || !c->x || !c->xb || !c->filled || !c->lp ||
+        !order(c, start, adj_other) || !upper_pattern(c, start, adj_other)) {
         spn__chol_free(c);
         return NULL;
     }
     etree(c, c->mark);
-    /* a particle's parent: the particle of its last column's (whose first
-     * row below the particle's block is that particle's first) */
+    /* the row-particles of each particle's columns: each particle k reaches
+     * adds one to those it reaches; column 3i + b holds i's block's rows
+     * from 3i + b on, then three a row-particle */
     for (uint32_t k = 0; k < n; k++)
-        c->bparent[k] = c->parent[3 * k + 2] < 0 ? -1 : c->parent[3 * k + 2] / 3;
-    /* column counts: row k's pattern adds one to each of its columns */
-    size_t *count = calloc(N, sizeof *count);
-    if (!count) {
-        spn__chol_free(c);
-        return NULL;
-    }
-    for (uint32_t k = 0; k < N; k++)
         c->mark[k] = UINT32_MAX;
-    for (uint32_t k = 0; k < N; k++) {
-        count[k]++;
-        for (uint32_t t = reach(c, k); t < N; t++)
-            count[c->stack[t]]++;
-    }
+    for (uint32_t k = 0; k < n; k++)
+        for (uint32_t t = block_reach(c, k); t < n; t++)
+            c->filled[c->stack[t]]++;
     c->lp[0] = 0;
-    for (uint32_t k = 0; k < N; k++)
-        c->lp[k + 1] = c->lp[k] + count[k];
-    free(count);
+    for (uint32_t k = 0; k < n; k++)
+        for (uint32_t b = 0; b < 3; b++)
+            c->lp[3 * k + b + 1] = c->lp[3 * k + b] + (3 - b) + 3 * (size_t)c->filled[k];
     if (c->lp[N] > max_entries || !(c->li = malloc(c->lp[N] * sizeof *c->li)) ||
         !(c->lx = malloc(c->lp[N] * sizeof *c->lx))) {
         spn__chol_free(c);
         return NULL;
     }
     return c;
-}
-
-/* The particles row k of L reaches in the particles' elimination tree,
- * children first, in stack[top .. n); returns top. Its neighbours before it
- * are A's blocks above its diagonal block (every third row of column 3k). */
-static uint32_t block_reach(const spn__chol *c, uint32_t k)
-{
-    uint32_t top = c->n, *s = c->stack, *path = c->next;
-    const size_t p0 = c->ap[3 * k];
-    const uint32_t nb = (uint32_t)((c->ap[3 * k + 1] - p0 - 1) / 3);
-    c->mark[k] = k;
-    for (uint32_t t = 0; t < nb; t++) {
-        uint32_t i = c->ai[p0 + 3 * t] / 3, len = 0;
-        for (; c->mark[i] != k; i = (uint32_t)c->bparent[i])
-            path[len++] = i, c->mark[i] = k;
-        while (len > 0)
-            s[--top] = path[--len];
-    }
-    return top;
 }
 
 /* The up-looking method a particle at a time: row k of L is three rows, and
@@ -393,7 +370,7 @@ bool spn__chol_factor(spn__chol *c, const double *diag, const double *offd)
     bool ok = true;
     for (uint32_t k = 0; k < n && ok; k++) {
         const size_t q0 = c->ap[3 * k], q1 = c->ap[3 * k + 1], q2 = c->ap[3 * k + 2];
-        const uint32_t nb = (uint32_t)((q1 - q0 - 1) / 3);
+        const uint32_t nb = earlier(c, k);
         /* A's blocks above the diagonal into X, its diagonal block into d */
         for (uint32_t t = 0; t < nb; t++) {
             double *x = xb + 9 * (size_t)(c->ai[q0 + 3 * t] / 3);
@@ -452,7 +429,7 @@ bool spn__chol_factor(spn__chol *c, const double *diag, const double *offd)
         li[p2] = 3 * k + 2;
     }
     if (!ok) memset(xb, 0, 9 * (size_t)n * sizeof *xb); /* a failed row leaves values behind */
-    return c->factored = ok;
+    return ok;
 }
 
 /* L y = b, then L^T x = y, in y, a particle at a time. A particle's
@@ -517,7 +494,7 @@ void spn__chol_free(spn__chol *c)
 {
     if (!c) return;
     free(c->perm), free(c->ap), free(c->ai), free(c->ax), free(c->dst_diag), free(c->dst_offd);
-    free(c->parent), free(c->lp), free(c->li), free(c->lx), free(c->stack), free(c->mark), free(c->next), free(c->x);
-    free(c->bparent), free(c->xb), free(c->filled);
+    free(c->bparent), free(c->lp), free(c->li), free(c->lx), free(c->stack), free(c->mark), free(c->next), free(c->x);
+    free(c->xb), free(c->filled);
     free(c);
 }
