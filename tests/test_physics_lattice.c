@@ -21,7 +21,7 @@
 #include <spinneret/spinneret.h>
 
 #include "physics/lattice_rows.h"    /* lat_gov, spn__lat_gov_pick */
-#include "physics/world_internal.h" /* spn__lattice_step_bytes, spn__lattice_gov_prefer */
+#include "physics/world_internal.h" /* spn__lattice_step_bytes, _gov_prefer, _set_unblocked */
 
 /* The standard web with a disturbed state: random velocities (seeded), one
  * free particle pinned mid-web, viscous drag, so damping, slack tension-only
@@ -273,10 +273,10 @@ static spn_world *disturbed_orb32(spn_integrator integ, int threads, uint32_t pa
  * displacements (every 64 steps) inside a call, and a blow-up inside a pass
  * replayed to the same step and message. Single float32 steps come from
  * spn_world_advance only (spn_world_step takes float64 ones), so the
- * reference is the same web at parallel_min 8192 on one thread: above its
- * 2,001 particles, so no passes, with the same bands as at 256 (SPN_BLOCK
- * particles: an eighth of either parallel_min and a quarter of the web are
- * below it), which fix the order of the energy sums. */
+ * reference is the same web at parallel_min 8192 on one thread, held to
+ * single steps (spn__lattice_set_unblocked), with the same bands as at 256
+ * (SPN_BLOCK particles: an eighth of either parallel_min and a quarter of
+ * the web are below it), which fix the order of the energy sums. */
 static void test_blocked_passes_float32(void **state)
 {
     (void)state;
@@ -289,6 +289,7 @@ static void test_blocked_passes_float32(void **state)
         spn_world *one = disturbed_orb32(integs[k], 1, 256);
         spn_world *two = disturbed_orb32(integs[k], 2, 256);
         spn_world *ref = disturbed_orb32(integs[k], 1, 8192);
+        spn__lattice_set_unblocked(ref, true);
         assert_int_equal(spn_world_advance(ref, dt, 69), SPN_OK);
         assert_int_equal(spn_world_last_step(ref).blocked, 0);
         assert_passes_match(one, two, ref, dt, 69, blocked);
@@ -306,7 +307,8 @@ static void test_blocked_passes_float32(void **state)
      * and ends as the unblocked run does, at the same step, with the same
      * message, in the same state */
     spn_world *blk = disturbed_orb32(SPN_INTEGRATOR_SYMPLECTIC, 2, 256);
-    spn_world *ref = disturbed_orb32(SPN_INTEGRATOR_SYMPLECTIC, 1, 8192); /* (on two threads it may take passes) */
+    spn_world *ref = disturbed_orb32(SPN_INTEGRATOR_SYMPLECTIC, 1, 8192);
+    spn__lattice_set_unblocked(ref, true);
     const double big = 5e-5; /* (float32 overflows sooner than float64: at step 10) */
     assert_int_equal(spn_world_advance(ref, big, 400), SPN_ERR_UNSTABLE);
     const uint64_t good = spn_world_step_count(ref);
@@ -408,8 +410,8 @@ static void test_governor_choices(void **state)
 
 /* A web between parallel_min / 8 and parallel_min particles on two threads:
  * the governor's either choice, switched between calls, gives the bits of
- * one thread, in the state and the energy books; on threads the steps go
- * in blocked passes, on one thread one by one. */
+ * single steps on one thread, in the state and the energy books; either
+ * choice takes the steps in blocked passes. */
 static void test_governor_same_bits(void **state)
 {
     (void)state;
@@ -418,13 +420,12 @@ static void test_governor_same_bits(void **state)
         /* 2,001 particles, parallel_min 8,192: threads from 1,024 */
         spn_world *two = disturbed_orb(integs[k], 40, 50, 2, 8192, true);
         spn_world *one = disturbed_orb(integs[k], 40, 50, 1, 8192, true);
+        spn__lattice_set_unblocked(one, true);
         for (int call = 0; call < 6; call++) {
             const bool threads = call % 2 == 0;
             assert_true(spn__lattice_gov_prefer(two, threads));
             assert_int_equal(spn_world_advance(two, 2e-6, 8), SPN_OK);
-#ifdef _OPENMP
-            assert_int_equal(spn_world_last_step(two).blocked, threads ? 8 : 0);
-#endif
+            assert_int_equal(spn_world_last_step(two).blocked, 8);
             assert_int_equal(spn_world_advance(one, 2e-6, 8), SPN_OK);
             assert_int_equal(spn_world_last_step(one).blocked, 0);
             assert_same_state(two, one);

@@ -559,6 +559,8 @@ void spn__lat_gov_record(lat_gov *g, double ns, double now)
     g->try_sum = 0, g->try_units = 0;
 }
 
+void spn__lattice_set_unblocked(spn_world *w, bool single) { w->lattice_unblocked = single; }
+
 bool spn__lattice_gov_prefer(spn_world *w, bool threads)
 {
     if (!w->lat) return false;
@@ -692,13 +694,13 @@ bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r)
 }
 
 /* Steps as blocked passes (lattice_block_t.h), inside a replayable
- * spn_world_advance on a web too big for the caches (from def.parallel_min
- * particles, the size from which a step is spread over threads) or on a
- * smaller one stepped on threads (lattice_threads, the governor): up to k
- * Euler or symplectic steps in one pass, or one RK4 step (its four stages)
- * per pass, in float64 or (spn_world_set_precision) float32. Each step's
- * results into r[]; the count done, 0 when a blocked pass does not apply
- * (the caller then takes single steps). */
+ * spn_world_advance, on one thread or on threads (lattice_threads, the
+ * governor below parallel_min): up to k Euler or symplectic steps in one
+ * pass, or one RK4 step (its four stages) per pass, in float64 or
+ * (spn_world_set_precision) float32. Each step's results into r[]; the
+ * count done, 0 when a blocked pass does not apply (the caller then takes
+ * single steps: the bands too thin for the levels, fewer than two explicit
+ * steps left, or spn__lattice_set_unblocked). */
 int spn__lattice_block_steps(spn_world *w, double dt, int k, spn__step_result *r)
 {
     const spn_integrator in = w->def.integrator;
@@ -707,11 +709,13 @@ int spn__lattice_block_steps(spn_world *w, double dt, int k, spn__step_result *r
     if (k > LAT_LEVELS) k = LAT_LEVELS;
     const uint32_t levels = rk4 ? 4 : (uint32_t)k;
     if (levels < 2 || !w->no_backup) return 0;
+    if (w->lattice_unblocked) return 0;
+    /* on one thread too, at any size (forty-third session, Zen 5, one
+     * thread, CPU ns a spring-step: the 5k web's RK4 step 15.9 -> 11.0,
+     * symplectic 2.85 -> 2.65, webs of a few hundred particles up to twice
+     * as fast; docs/physics-lattice.md, "One thread") */
     const int threads = ready(w);
-    /* below parallel_min only on threads: on one the 5k web's pass measured
-     * no faster than single steps (docs/physics-lattice.md) */
-    if (!threads || (threads < 2 && w->np < w->def.parallel_min) || !spn__lattice_block_ready(w->lat, threads, levels))
-        return 0;
+    if (!threads || !spn__lattice_block_ready(w->lat, threads, levels)) return 0;
     const int mode = rk4 ? MODE_RK4_STAGE : in == SPN_INTEGRATOR_SYMPLECTIC ? MODE_SYMPLECTIC : MODE_EULER;
     if (float32(w)) {
         if (w->lat->live) write_back(w, threads);

@@ -170,6 +170,7 @@ struct spn_world {
     spn_vec3 *facc;                  /* per-particle spring force accumulator */
     spn__lattice *lat;               /* the stencil step of a regular orb web (NULL: none) */
     bool lattice_off;                /* spn_world_set_lattice(w, false) */
+    bool lattice_unblocked;          /* spn__lattice_set_unblocked (tests) */
     uint8_t precision;               /* spn_precision: float32 lattice steps when set */
     spn_vec3 *tmp[SPN_TMP_COUNT]; /* per-particle scratch, allocated on demand */
     spn_vec3 *fair;       /* per-spring air force (on demand) */
@@ -359,7 +360,7 @@ void spn__lattice_spring_changed(spn_world *w, uint32_t s);
  * of memory for its buffers. */
 bool spn__lattice_explicit(spn_world *w, double dt, bool symplectic, spn__step_result *r);
 bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r);
-/* Steps of a replayable advance on a big lattice web as passes over memory
+/* Steps of a replayable advance on a lattice web as passes over memory
  * that each take several levels (up to k, at most SPN__LAT_BLOCK_MAX,
  * explicit steps, or the four stages of one RK4 step); the count of steps
  * done (0: take single steps), results in r[]. */
@@ -370,6 +371,10 @@ int spn__lattice_block_steps(spn_world *w, double dt, int k, spn__step_result *r
  * blocked passes (spn_step_report.blocked); a model (lattice.c). 0 when the
  * world's steps do not take the lattice. */
 double spn__lattice_step_bytes(const spn_world *w, int steps, int blocked);
+/* For tests: every lattice step of an spn_world_advance call taken alone
+ * (`single`), not in blocked passes, for a reference to hold the passes'
+ * bits against; false again lets them run. */
+void spn__lattice_set_unblocked(spn_world *w, bool single);
 /* For tests: the lattice's thread governor (lattice.c) set to keep choosing
  * threads (or one thread) below parallel_min, as if it had measured them
  * faster; false when the world has no lattice. */
