@@ -57,8 +57,8 @@
 static void lattice_free(spn__lattice *L)
 {
     if (!L) return;
-    free(L->rk), free(L->rkd), free(L->rrest), free(L->gk), free(L->gkd), free(L->grest);
-    free(L->cut), free(L->partial), free(L->rk4), free(L->state), free(L->partial_k);
+    free(L->slots);
+    free(L->cut), free(L->partial), free(L->rk4), free(L->state), free(L->masses), free(L->partial_k);
     for (int t = 0; t < L->nbws; t++) free(L->bws[t]);
     free(L->bws);
     spn__lat32_free(L->f32);
@@ -95,6 +95,7 @@ static bool slot_of(uint32_t n, uint32_t a, uint32_t b, uint32_t rings, bool *ra
 static void store(spn__lattice *L, bool radial, size_t slot, spn__spring h)
 {
     double *k = radial ? L->rk : L->gk, *kd = radial ? L->rkd : L->gkd, *rest = radial ? L->rrest : L->grest;
+    slot = slot / L->radials * L->pitch + slot % L->radials; /* (rows of pitch) */
     k[slot] = h.k, kd[slot] = h.kd;
     rest[slot] = spn__tension_only(h) ? -h.rest : h.rest;
     spn__lat32_params_changed(L->f32);
@@ -113,12 +114,19 @@ void spn__lattice_build(spn_world *w)
     spn__lattice *L = calloc(1, sizeof *L);
     if (!L) return;
     L->gov.t0 = -1;
-    const size_t m = (size_t)rings * n;
     L->rings = rings, L->radials = n;
-    L->rk = malloc(m * sizeof *L->rk), L->rkd = malloc(m * sizeof *L->rkd), L->rrest = malloc(m * sizeof *L->rrest);
-    L->gk = malloc(m * sizeof *L->gk), L->gkd = malloc(m * sizeof *L->gkd), L->grest = malloc(m * sizeof *L->grest);
+    L->pitch = (n + 7) & ~(uint32_t)7;
+    L->nlat = 1 + (size_t)rings * L->pitch;
+    void *first;
+    size_t pitch;
+    const size_t m = (size_t)rings * n;
+    L->slots = spn__lattice_arrays(6, (size_t)rings * L->pitch, sizeof(double), 0, &first, &pitch);
+    if (L->slots) {
+        double **par[6] = {&L->rk, &L->rkd, &L->rrest, &L->gk, &L->gkd, &L->grest};
+        for (int k = 0; k < 6; k++) *par[k] = (double *)first + k * pitch;
+    }
     uint8_t *seen = calloc(2 * m, 1);
-    bool ok = L->rk && L->rkd && L->rrest && L->gk && L->gkd && L->grest && seen;
+    bool ok = L->slots && seen;
     for (uint32_t s = 0; ok && s < w->ns; s++) {
         bool radial;
         size_t slot;
@@ -168,7 +176,7 @@ static bool prepare(spn_world *w, int threads)
         free(L->cut), free(L->partial);
         L->band_rows = rows;
         L->nbands = (L->rings + rows - 1) / rows;
-        L->cut = malloc((size_t)L->nbands * 3 * n * sizeof *L->cut);
+        L->cut = spn__lattice_arrays((size_t)L->nbands * 3, L->pitch, sizeof *L->cut, 0, NULL, NULL);
         L->partial = malloc((size_t)L->nbands * L_NSUMS * sizeof *L->partial);
         if (!L->cut || !L->partial) {
             L->band_rows = 0;
@@ -249,10 +257,11 @@ LAT_INLINE void radials64(const lat_args *a, double *const *Xa, double *const *V
 {
     (void)hold; /* float64 adds its terms into the columns in the spring loop */
     const spn__lattice *L = a->L;
-    const size_t s0 = (size_t)j * L->radials;
-    springs_rows(L->radials, (const double *const *)Xa, (const double *const *)Va, (const double *const *)Xb,
-                 (const double *const *)Vb, 0, 0, L->rk + s0, L->rkd + s0, L->rrest + s0, f, 0, cs,
-                 wants_elastic(a->mode, a->stage));
+    const size_t s0 = (size_t)j * L->pitch;
+    const double *const *cXa = (const double *const *)Xa, *const *cVa = (const double *const *)Va;
+    const double *const *cXb = (const double *const *)Xb, *const *cVb = (const double *const *)Vb;
+    const bool el = wants_elastic(a->mode, a->stage);
+    springs_rows(L->radials, cXa, cVa, cXb, cVb, 0, 0, L->rk + s0, L->rkd + s0, L->rrest + s0, f, 0, cs, el);
 }
 
 LAT_INLINE void rings64(const lat_args *a, double *const *X, double *const *V, uint32_t j, double *const *f,
@@ -261,7 +270,7 @@ LAT_INLINE void rings64(const lat_args *a, double *const *X, double *const *V, u
     (void)held;
     const spn__lattice *L = a->L;
     const uint32_t n = L->radials;
-    const size_t s0 = (size_t)j * n;
+    const size_t s0 = (size_t)j * L->pitch;
     const double *const *cX = (const double *const *)X, *const *cV = (const double *const *)V;
     const bool el = wants_elastic(a->mode, a->stage);
     springs_rows(n - 1, cX, cV, cX, cV, 0, 1, L->gk + s0, L->gkd + s0, L->grest + s0, f, 0, cs, el);
@@ -274,7 +283,11 @@ LAT_INLINE void hub_state64(const lat_args *a, double *x, double *v)
     for (int c = 0; c < 3; c++) x[c] = a->ex[c][0], v[c] = a->ev[c][0];
 }
 
-static double *cut64(const lat_args *a) { return a->L->cut; }
+static double *cut64(const lat_args *a, uint32_t b, int c)
+{
+    return a->L->cut + ((size_t)b * 3 + (size_t)c) * a->L->pitch;
+}
+static size_t pitch64(const lat_args *a) { return a->L->pitch; }
 static double *ws64(const lat_args *a, int thread) { return a->L->ws[thread]; }
 static size_t stride64(const lat_args *a) { return a->L->stride; }
 
@@ -312,21 +325,35 @@ static bool load(spn_world *w, int threads)
 {
     (void)threads; /* (used by OpenMP pragmas only) */
     spn__lattice *L = w->lat;
-    const uint32_t np = w->np;
     if (!L->state) {
-        void *first;
-        size_t pitch;
-        if (!(L->state = spn__lattice_arrays(6, np, sizeof(double), 1, &first, &pitch))) return false;
+        void *first, *first2;
+        size_t pitch, pitch2;
+        if (!(L->state = spn__lattice_arrays(6, L->nlat, sizeof(double), 1, &first, &pitch))) return false;
+        if (!(L->masses = spn__lattice_arrays(2, L->nlat, sizeof(double), 1, &first2, &pitch2))) {
+            free(L->state), L->state = NULL;
+            return false;
+        }
+        L->mass = first2, L->inv_mass = (double *)first2 + pitch2;
         double *q = first;
         for (int c = 0; c < 3; c++)
             L->x[c] = q + c * pitch, L->v[c] = q + (3 + c) * pitch;
     }
     const spn_vec3 *x = w->x, *v = w->v;
     double *x0 = L->x[0], *x1 = L->x[1], *x2 = L->x[2], *v0 = L->v[0], *v1 = L->v[1], *v2 = L->v[2];
+    double *m = L->mass, *im = L->inv_mass;
+    const double *wm = w->mass, *wim = w->inv_mass;
+    const uint32_t n = L->radials, rows = L->rings;
+    const size_t P = L->pitch;
 #pragma omp parallel for schedule(static) num_threads(threads)
-    for (uint32_t i = 0; i < np; i++) {
-        x0[i] = x[i].x, x1[i] = x[i].y, x2[i] = x[i].z;
-        v0[i] = v[i].x, v1[i] = v[i].y, v2[i] = v[i].z;
+    for (uint32_t r = 0; r <= rows; r++) { /* the hub (r = 0), then ring r - 1 */
+        const size_t from = r ? 1 + (size_t)(r - 1) * n : 0, to = r ? 1 + (size_t)(r - 1) * P : 0;
+        const uint32_t count = r ? n : 1;
+        for (uint32_t i = 0; i < count; i++) {
+            const size_t s = from + i, d = to + i;
+            m[d] = wm[s], im[d] = wim[s];
+            x0[d] = x[s].x, x1[d] = x[s].y, x2[d] = x[s].z;
+            v0[d] = v[s].x, v1[d] = v[s].y, v2[d] = v[s].z;
+        }
     }
     L->live = true;
     L->mv2.ok = false;
@@ -337,11 +364,19 @@ static void write_back(spn_world *w, int threads)
 {
     (void)threads; /* (used by OpenMP pragmas only) */
     spn__lattice *L = w->lat;
-    const uint32_t np = w->np;
     spn_vec3 *x = w->x, *v = w->v;
     const double *x0 = L->x[0], *x1 = L->x[1], *x2 = L->x[2], *v0 = L->v[0], *v1 = L->v[1], *v2 = L->v[2];
+    const uint32_t n = L->radials, rows = L->rings;
+    const size_t P = L->pitch;
 #pragma omp parallel for schedule(static) num_threads(threads)
-    for (uint32_t i = 0; i < np; i++) x[i] = spn_v3(x0[i], x1[i], x2[i]), v[i] = spn_v3(v0[i], v1[i], v2[i]);
+    for (uint32_t r = 0; r <= rows; r++) { /* as load() */
+        const size_t to = r ? 1 + (size_t)(r - 1) * n : 0, from = r ? 1 + (size_t)(r - 1) * P : 0;
+        const uint32_t count = r ? n : 1;
+        for (uint32_t i = 0; i < count; i++) {
+            const size_t d = to + i, s = from + i;
+            x[d] = spn_v3(x0[s], x1[s], x2[s]), v[d] = spn_v3(v0[s], v1[s], v2[s]);
+        }
+    }
     L->live = false;
 }
 
@@ -373,11 +408,10 @@ static bool begin(spn_world *w, int threads, double dt, bool rk4, lat_args *a)
         }
         if (!load(w, threads)) return false;
     }
-    const size_t np = w->np;
     if (rk4 && !L->rk4) {
         void *first;
         size_t pitch;
-        if (!(L->rk4 = spn__lattice_arrays(18, np, sizeof(double), 1, &first, &pitch))) {
+        if (!(L->rk4 = spn__lattice_arrays(18, L->nlat, sizeof(double), 1, &first, &pitch))) {
             spn__lattice_sync(w);
             return false;
         }
@@ -389,7 +423,7 @@ static bool begin(spn_world *w, int threads, double dt, bool rk4, lat_args *a)
     }
     memset(a, 0, sizeof *a);
     a->L = L;
-    a->mass = w->mass, a->inv_mass = w->inv_mass;
+    a->mass = L->mass, a->inv_mass = L->inv_mass;
     a->g[0] = w->def.gravity.x, a->g[1] = w->def.gravity.y, a->g[2] = w->def.gravity.z;
     a->drag = w->def.drag, a->dt = dt;
     for (int c = 0; c < 3; c++) a->ex[c] = L->x[c], a->ev[c] = L->v[c];
@@ -406,9 +440,9 @@ static bool mv2_known(const spn_world *w)
     if (!L->mv2.ok || w->def.drag != 0) return false;
 #ifndef NDEBUG
     double mv2 = 0;
-    for (uint32_t i = 0; i < w->np; i++)
-        if (w->inv_mass[i] != 0)
-            mv2 += w->mass[i] * (L->v[0][i] * L->v[0][i] + L->v[1][i] * L->v[1][i] + L->v[2][i] * L->v[2][i]);
+    for (size_t i = 0; i < L->nlat; i++) /* (the padding between rows has no mass) */
+        if (L->inv_mass[i] != 0)
+            mv2 += L->mass[i] * (L->v[0][i] * L->v[0][i] + L->v[1][i] * L->v[1][i] + L->v[2][i] * L->v[2][i]);
     assert(fabs(mv2 - L->mv2.sum) <= 1e-9 * mv2 + 1e-300);
 #endif
     return true;

@@ -79,7 +79,7 @@ typedef struct LK(block) {
 static void LK(row_ptrs)(const LK(block) *B, uint32_t j, LK_T **X, LK_T **V)
 {
     if (j >= B->R0 && j < B->R1) {
-        const size_t p0 = 1 + (size_t)j * B->L->radials;
+        const size_t p0 = 1 + (size_t)j * LK(pitch)(B->la);
         for (int c = 0; c < 3; c++) X[c] = B->X[c] + p0, V[c] = B->V[c] + p0;
         return;
     }
@@ -161,7 +161,7 @@ LAT_INLINE void LK(block_move)(LK(block) *B, uint32_t s, uint32_t r, LK_T *const
 {
     const LK_ARGS *a = &B->la[s - 1];
     const uint32_t n = B->L->radials;
-    const size_t p0 = 1 + (size_t)r * n;
+    const size_t p0 = 1 + (size_t)r * LK(pitch)(a);
     LK_T *X[3], *V[3];
     LK(row_ptrs)(B, r, X, V);
     if (!B->rk4) {
@@ -267,7 +267,7 @@ static void LK(copy_ghosts)(LK(block) *B)
     for (uint32_t g = 0; g < 2 * B->K; g++) {
         const uint32_t j = g < B->K ? B->R0 - B->K + g : B->R1 + (g - B->K);
         if ((g < B->K && !B->R0) || (g >= B->K && j >= L->rings)) continue;
-        const size_t p0 = 1 + (size_t)j * n;
+        const size_t p0 = 1 + (size_t)j * LK(pitch)(B->la);
         for (int c = 0; c < 3; c++) {
             memcpy(B->ghost[g][c], B->X[c] + p0, n * sizeof(LK_T));
             memcpy(B->ghost[g][3 + c], B->V[c] + p0, n * sizeof(LK_T));

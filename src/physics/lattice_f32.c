@@ -173,7 +173,11 @@ LAT_INLINE void hub_state32(const a32 *a, float *x, float *v)
     for (int c = 0; c < 3; c++) x[c] = a->ed[c][0], v[c] = a->eu[c][0];
 }
 
-static float *cut32(const a32 *a) { return a->F->cut; }
+static float *cut32(const a32 *a, uint32_t b, int c)
+{
+    return a->F->cut + ((size_t)b * 3 + (size_t)c) * a->L->radials;
+}
+static size_t pitch32(const a32 *a) { return a->L->radials; }
 static float *ws32(const a32 *a, int thread) { return a->F->ws[thread]; }
 static size_t stride32(const a32 *a) { return a->F->stride; }
 
@@ -276,8 +280,9 @@ static bool load(spn_world *w, int threads)
     const uint32_t np = w->np;
     if (!F->params_ok)
         for (size_t s = 0; s < F->m; s++) {
-            F->rk[s] = (float)L->rk[s], F->rkd[s] = (float)L->rkd[s], F->rr[s] = (float)L->rrest[s];
-            F->gk[s] = (float)L->gk[s], F->gkd[s] = (float)L->gkd[s], F->gr[s] = (float)L->grest[s];
+            const size_t d = s / L->radials * L->pitch + s % L->radials; /* (float64 rows of pitch) */
+            F->rk[s] = (float)L->rk[d], F->rkd[s] = (float)L->rkd[d], F->rr[s] = (float)L->rrest[d];
+            F->gk[s] = (float)L->gk[d], F->gkd[s] = (float)L->gkd[d], F->gr[s] = (float)L->grest[d];
         }
     F->params_ok = true;
     const spn_vec3 *v = w->v;

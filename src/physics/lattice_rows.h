@@ -118,15 +118,25 @@ void spn__lat_gov_record(lat_gov *g, double ns, double now);
 
 struct spn__lattice {
     uint32_t rings, radials;
-    double *rk, *rkd, *rrest; /* radial slots: ring * N + i, (ring - 1, i) -> (ring, i) */
-    double *gk, *gkd, *grest; /* ring slots: ring * N + i, (i, i + 1); i = N - 1: (0, N - 1) */
+    /* The float64 arrays' row pitch: radials rounded up to whole 64-byte
+     * lines, so that every row starts a line (the state's, masses' and
+     * slots'; the float32 step keeps rows of `radials`). Particle
+     * 1 + j N + i of the world is 1 + j pitch + i here, slot j N + i is
+     * j pitch + i. */
+    uint32_t pitch;
+    size_t nlat; /* numbers in each float64 particle array: 1 + rings pitch */
+    double *slots;            /* the block of the six slot arrays below */
+    double *rk, *rkd, *rrest; /* radial slots: ring * pitch + i, (ring - 1, i) -> (ring, i) */
+    double *gk, *gkd, *grest; /* ring slots: ring * pitch + i, (i, i + 1); i = N - 1: (0, N - 1) */
     uint32_t band_rows, nbands;
-    double *cut;     /* per band: 3 x N radial forces into its first row (band 0 unused) */
+    double *cut;     /* per band: 3 rows of pitch, the radial forces into its first row (band 0 unused) */
     double *partial; /* per band: L_NSUMS */
     int nws;         /* workspaces allocated (one per thread) */
     double **ws;
     size_t stride;   /* doubles per workspace array (N rounded up) */
-    double *state;   /* the float64 state, structure of arrays: x, v by component, np each */
+    double *state;   /* the float64 state, structure of arrays: x, v by component, nlat each */
+    double *masses;  /* the block of mass and inv_mass: the world's, laid out as x, copied at each load */
+    double *mass, *inv_mass;
     double *x[3], *v[3];
     bool live;       /* inside spn_world_advance: x, v above are ahead of w->x, w->v */
     lat_mv2 mv2;     /* RK4 without drag: m v^2 of x, v above (lat_mv2) */

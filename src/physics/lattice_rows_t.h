@@ -114,25 +114,52 @@ LAT_INLINE void LK(row)(uint32_t n, bool sym, LK_T dt, const LK_T *g, LK_T drag,
         vx[i] = (o).v[0], vy[i] = (o).v[1], vz[i] = (o).v[2];                                                          \
         LK_ACC(t_mv2[i], (o).mf, (o).mv2), LK_ACC(t_gain[i], (o).mf, (o).gain), LK_ACC(t_mvn2[i], (o).mf, (o).mvn2);   \
     } while (0)
+    /* The loop runs over the whole row, from particle 0, where each of the
+     * float64 step's row arrays starts a cache line, so that its vector
+     * loads and stores do not straddle two (forty-third session,
+     * docs/physics-lattice.md "Rows on cache lines"); the two ends, which
+     * take the wrap spring in another order, are put back after it and moved
+     * by their own forces. For particle 0 it reads rx[-1], whose result is
+     * overwritten: a ring force row is never the first array of its
+     * workspace. */
+    const uint32_t ends[2] = {0, l};
+    LK_T keep[2][6];
+    LK_S keep_t[2][3];
+    for (int k = 0; k < 2; k++) {
+        const uint32_t i = ends[k];
+        keep[k][0] = xx[i], keep[k][1] = xy[i], keep[k][2] = xz[i];
+        keep[k][3] = vx[i], keep[k][4] = vy[i], keep[k][5] = vz[i];
+        keep_t[k][0] = t_mv2[i], keep_t[k][1] = t_gain[i], keep_t[k][2] = t_mvn2[i];
+    }
+    const LK_T *const rxm = rx - 1, *const rym = ry - 1, *const rzm = rz - 1; /* (i - 1 would wrap at 0) */
+    /* (a compiler barrier, no instruction: without it GCC 12 merges the
+     * first iteration's loads with the ends' above, and the loop, no
+     * longer if-converted, stays scalar in most of its inlined copies) */
+    __asm__ __volatile__("" ::: "memory");
     if (ox)
-        for (uint32_t i = 1; i < l; i++) {
+        for (uint32_t i = 0; i < n; i++) {
             const LK_T m = mass[i], dm = drag * m;
-            const LK_T fx = (((LK_FMA(-dm, vx[i], m * g[0]) + ox[i]) + rx[i]) - ix[i]) - rx[i - 1];
-            const LK_T fy = (((LK_FMA(-dm, vy[i], m * g[1]) + oy[i]) + ry[i]) - iy[i]) - ry[i - 1];
-            const LK_T fz = (((LK_FMA(-dm, vz[i], m * g[2]) + oz[i]) + rz[i]) - iz[i]) - rz[i - 1];
+            const LK_T fx = (((LK_FMA(-dm, vx[i], m * g[0]) + ox[i]) + rx[i]) - ix[i]) - rxm[i];
+            const LK_T fy = (((LK_FMA(-dm, vy[i], m * g[1]) + oy[i]) + ry[i]) - iy[i]) - rym[i];
+            const LK_T fz = (((LK_FMA(-dm, vz[i], m * g[2]) + oz[i]) + rz[i]) - iz[i]) - rzm[i];
             const LK(moved) o = LK(one)(fx, fy, fz, inv_mass[i], m, xx[i], xy[i], xz[i], vx[i], vy[i], vz[i], sym, dt, g);
             LK_STORE(i, o);
         }
     else
-        for (uint32_t i = 1; i < l; i++) {
+        for (uint32_t i = 0; i < n; i++) {
             const LK_T m = mass[i], dm = drag * m;
-            const LK_T fx = ((LK_FMA(-dm, vx[i], m * g[0]) + rx[i]) - ix[i]) - rx[i - 1];
-            const LK_T fy = ((LK_FMA(-dm, vy[i], m * g[1]) + ry[i]) - iy[i]) - ry[i - 1];
-            const LK_T fz = ((LK_FMA(-dm, vz[i], m * g[2]) + rz[i]) - iz[i]) - rz[i - 1];
+            const LK_T fx = ((LK_FMA(-dm, vx[i], m * g[0]) + rx[i]) - ix[i]) - rxm[i];
+            const LK_T fy = ((LK_FMA(-dm, vy[i], m * g[1]) + ry[i]) - iy[i]) - rym[i];
+            const LK_T fz = ((LK_FMA(-dm, vz[i], m * g[2]) + rz[i]) - iz[i]) - rzm[i];
             const LK(moved) o = LK(one)(fx, fy, fz, inv_mass[i], m, xx[i], xy[i], xz[i], vx[i], vy[i], vz[i], sym, dt, g);
             LK_STORE(i, o);
         }
-    const uint32_t ends[2] = {0, l};
+    for (int k = 0; k < 2; k++) {
+        const uint32_t i = ends[k];
+        xx[i] = keep[k][0], xy[i] = keep[k][1], xz[i] = keep[k][2];
+        vx[i] = keep[k][3], vy[i] = keep[k][4], vz[i] = keep[k][5];
+        t_mv2[i] = keep_t[k][0], t_gain[i] = keep_t[k][1], t_mvn2[i] = keep_t[k][2];
+    }
     for (int k = 0; k < 2; k++) {
         const uint32_t i = ends[k];
         const LK_T *f = k ? el : e0;
@@ -161,19 +188,22 @@ LAT_INLINE void LK(assemble)(uint32_t n, LK_T gc, LK_T drag, const LK_T *restric
                              LK_T *restrict f)
 {
     const LK_T wrap = ring[n - 1];
+    /* (over the whole row from particle 0, which starts a line, as in
+     * LK(row); the ends are overwritten below) */
+    const LK_T *const rm = ring - 1;
     if (drag == 0 && !(gc == 0 && signbit(gc))) {
         if (out)
-            for (uint32_t i = 1; i + 1 < n; i++)
-                f[i] = ((((mass[i] * gc) + out[i]) + ring[i]) - in[i]) - ring[i - 1];
+            for (uint32_t i = 0; i < n; i++)
+                f[i] = ((((mass[i] * gc) + out[i]) + ring[i]) - in[i]) - rm[i];
         else
-            for (uint32_t i = 1; i + 1 < n; i++)
-                f[i] = (((mass[i] * gc) + ring[i]) - in[i]) - ring[i - 1];
+            for (uint32_t i = 0; i < n; i++)
+                f[i] = (((mass[i] * gc) + ring[i]) - in[i]) - rm[i];
     } else if (out)
-        for (uint32_t i = 1; i + 1 < n; i++)
-            f[i] = ((((mass[i] * gc - (drag * mass[i]) * vc[i]) + out[i]) + ring[i]) - in[i]) - ring[i - 1];
+        for (uint32_t i = 0; i < n; i++)
+            f[i] = ((((mass[i] * gc - (drag * mass[i]) * vc[i]) + out[i]) + ring[i]) - in[i]) - rm[i];
     else
-        for (uint32_t i = 1; i + 1 < n; i++)
-            f[i] = (((mass[i] * gc - (drag * mass[i]) * vc[i]) + ring[i]) - in[i]) - ring[i - 1];
+        for (uint32_t i = 0; i < n; i++)
+            f[i] = (((mass[i] * gc - (drag * mass[i]) * vc[i]) + ring[i]) - in[i]) - rm[i];
     const uint32_t l = n - 1;
     LK_T f0 = mass[0] * gc - (drag * mass[0]) * vc[0], fl = mass[l] * gc - (drag * mass[l]) * vc[l];
     if (out) f0 += out[0], fl += out[l];

@@ -18,7 +18,10 @@
  *   LK(hub)(a, rad, cs)          the hub's force from its radials, and its update
  *   LK(finish)(a, p0, n, ri, rg, ro, F, cs)
  *                                a row whose forces are complete, moved
- *   LK(cut)(a)                   the radial forces into each band's first row
+ *   LK(cut)(a, b, c)             component c of the radial forces into band
+ *                                b's first row (a row of N)
+ *   LK(pitch)(a)                 the state's row pitch: row j starts at
+ *                                particle 1 + j pitch
  *   LK(ws)(a, thread), LK(stride)(a)
  *                                the per-thread workspaces (WS_* arrays)
  * Sums go to each thread's sum columns (L->cols), a band's reduced at its
@@ -33,10 +36,11 @@ SPN__KERNEL static void LK(cut_pass)(const LK_ARGS *a, double *cols, uint32_t b)
 {
     const spn__lattice *L = a->L;
     const uint32_t n = L->radials, j = b * L->band_rows;
+    const size_t P = LK(pitch)(a);
     LK_T *Xa[3], *Va[3], *Xb[3], *Vb[3], *f[3];
-    LK(eval)(a, 1 + (size_t)(j - 1) * n, Xa, Va);
-    LK(eval)(a, 1 + (size_t)j * n, Xb, Vb);
-    for (int c = 0; c < 3; c++) f[c] = LK(cut)(a) + ((size_t)b * 3 + c) * n;
+    LK(eval)(a, 1 + (size_t)(j - 1) * P, Xa, Va);
+    LK(eval)(a, 1 + (size_t)j * P, Xb, Vb);
+    for (int c = 0; c < 3; c++) f[c] = LK(cut)(a, b, c);
     const lat_cols cs = col_set(cols, L->col_stride, -1);
     LK(radials)(a, Xa, Va, Xb, Vb, j, f, &cs, false);
     double *p = L->partial + (size_t)b * L_NSUMS;
@@ -49,6 +53,7 @@ SPN__KERNEL static void LK(band_pass)(const LK_ARGS *a, LK_T *ws, double *cols, 
 {
     const spn__lattice *L = a->L;
     const uint32_t n = L->radials, lo = b * L->band_rows;
+    const size_t P = LK(pitch)(a);
     const uint32_t hi = lo + L->band_rows < L->rings ? lo + L->band_rows : L->rings;
     const size_t st = LK(stride)(a);
     LK_T *RAD[2][3], *RING[2][3], *H[6], *Fw[3], *cut[3], *next_cut[3];
@@ -56,15 +61,15 @@ SPN__KERNEL static void LK(band_pass)(const LK_ARGS *a, LK_T *ws, double *cols, 
         RAD[0][c] = ws + (WS_RAD + c) * st, RAD[1][c] = ws + (WS_RAD + 3 + c) * st;
         RING[0][c] = ws + (WS_RING + c) * st, RING[1][c] = ws + (WS_RING + 3 + c) * st;
         Fw[c] = ws + (WS_F + c) * st;
-        cut[c] = LK(cut)(a) + ((size_t)b * 3 + c) * n;
-        next_cut[c] = LK(cut)(a) + ((size_t)(b + 1) * 3 + c) * n;
+        cut[c] = LK(cut)(a, b, c);
+        next_cut[c] = LK(cut)(a, b + 1, c);
     }
     for (int c = 0; c < 6; c++) H[c] = ws + (WS_HUB + c) * st;
     const lat_cols cs = col_set(cols, L->col_stride, 0);
     int cur = 0;
     LK_T **rad_cur = NULL, **rad_prev = NULL;
     for (uint32_t j = lo; j < hi; j++, cur ^= 1) {
-        const size_t p0 = 1 + (size_t)j * n;
+        const size_t p0 = 1 + (size_t)j * P;
         LK_T *X[3], *V[3];
         LK(eval)(a, p0, X, V);
         if (j == lo && j > 0) {
@@ -79,15 +84,15 @@ SPN__KERNEL static void LK(band_pass)(const LK_ARGS *a, LK_T *ws, double *cols, 
             LK(hub)(a, rad_cur, &cs);
         } else {
             LK_T *Xp[3], *Vp[3];
-            LK(eval)(a, p0 - n, Xp, Vp);
+            LK(eval)(a, p0 - P, Xp, Vp);
             LK(radials)(a, Xp, Vp, X, V, j, RAD[cur], &cs, true);
             rad_cur = RAD[cur];
         }
         LK(rings)(a, X, V, j, RING[cur], &cs, j == 0 || j > lo); /* row lo's radials: the cut pass */
-        if (j > lo) LK(finish)(a, p0 - n, n, rad_prev, RING[cur ^ 1], rad_cur, Fw, &cs);
+        if (j > lo) LK(finish)(a, p0 - P, n, rad_prev, RING[cur ^ 1], rad_cur, Fw, &cs);
         rad_prev = rad_cur;
     }
-    LK(finish)(a, 1 + (size_t)(hi - 1) * n, n, rad_prev, RING[cur ^ 1], hi < L->rings ? next_cut : NULL, Fw, &cs);
+    LK(finish)(a, 1 + (size_t)(hi - 1) * P, n, rad_prev, RING[cur ^ 1], hi < L->rings ? next_cut : NULL, Fw, &cs);
     store_band_sums(L->partial + (size_t)b * L_NSUMS, b == 0, &cs, n);
 }
 
