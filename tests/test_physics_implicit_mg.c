@@ -13,7 +13,12 @@
  *    the same on a small web (1,201 particles);
  * 6. that factor: kept while solves stay short, made again at a change of
  *    step, the same bits on one thread and two;
- * 7. a change of preconditioner mid-run takes effect at the next step. */
+ * 7. a change of preconditioner mid-run takes effect at the next step;
+ * 8. that factor refused (a matrix not positive definite): in the middle of
+ *    a solve block Jacobi finishes it and the next step factorises again; at
+ *    the start of a step the factor is dropped and the V-cycle takes over
+ *    (block Jacobi where the cycle refuses the matrix too); the steps agree
+ *    with block Jacobi's. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -354,6 +359,168 @@ static void test_factor_with_a_contact(void **state)
     free(a), free(b);
 }
 
+/* The refused factor's tests: the 20 x 60 web of test_factor_on_a_small_web
+ * (a spring broken, falling from flat, steps of 1e-4 s, one thread) after
+ * `steps` steps. */
+static spn_world *refusal_web(int steps)
+{
+    spn_world_def wd = spn_world_def_default();
+    wd.integrator = SPN_INTEGRATOR_IMPLICIT;
+    wd.threads = 1;
+    spn_orb_scene_def od = spn_orb_scene_def_default();
+    od.rings = 20, od.radials = 60;
+    spn_world *w = NULL;
+    assert_int_equal(spn_scene_orb(&wd, &od, &w), SPN_OK);
+    assert_int_equal(spn_world_set_solver_tolerance(w, 1e-10, 1000), SPN_OK);
+    spn_world_break_spring(w, 1200);
+    for (int i = 0; i < steps; i++) assert_int_equal(spn_world_step(w, 1e-4), SPN_OK);
+    return w;
+}
+
+/* One step of 1e-4 s of w and of a clone of it with preconditioner pc, from
+ * the same state: w's CG iterations and its factorisations after the step,
+ * the clone's iterations, the largest velocity difference and the clone's
+ * largest speed. */
+typedef struct refusal_step {
+    long cg, cg_ref;
+    uint32_t factorisations;
+    double dv, vmax;
+} refusal_step;
+
+static refusal_step step_against(spn_world *w, spn_precond pc)
+{
+    spn_world *ref = spn_world_clone(w);
+    assert_non_null(ref);
+    assert_int_equal(spn_world_set_implicit_preconditioner(ref, pc), SPN_OK);
+    assert_int_equal(spn_world_step(w, 1e-4), SPN_OK);
+    assert_int_equal(spn_world_step(ref, 1e-4), SPN_OK);
+    const uint32_t n = spn_world_particle_count(w);
+    refusal_step r = {spn_world_last_step(w).cg_iterations, spn_world_last_step(ref).cg_iterations,
+                      spn__imp_mg_factorisations(w), 0, 0};
+    const spn_vec3 *v = spn_world_velocities(w), *vr = spn_world_velocities(ref);
+    for (uint32_t i = 0; i < n; i++) {
+        r.dv = fmax(r.dv, spn_v3_len(spn_v3_sub(v[i], vr[i])));
+        r.vmax = fmax(r.vmax, spn_v3_len(vr[i]));
+    }
+    spn_world_destroy(ref);
+    return r;
+}
+
+/* A matrix that is not positive definite, through the public API. The
+ * step's matrix is M (1 + h drag) plus damping, air, contact and spring
+ * terms that are each positive semi-definite (a compressed spring's negative
+ * transverse term is clamped to 0, a slack tension-only one is left out),
+ * so it takes a value no web has: a negative mass (spn_world_add_particle
+ * refuses one, spn_world_set_mass does not), a negative damping
+ * (spn_world_set_spring_stiffness) or drag below -1/h. Here particle 700's
+ * mass times -1: out of the web's plane its threads hold it by less than
+ * its mass, so even its own 3x3 block is indefinite; block Jacobi's CG
+ * still solves the step (at -10 times it breaks down). */
+enum { REFUSED_PARTICLE = 700 };
+
+static void set_mass_sign(spn_world *w, double sign)
+{
+    spn_world_set_mass(w, REFUSED_PARTICLE, sign * fabs(spn_world_mass(w, REFUSED_PARTICLE)));
+}
+
+/* In the middle of a solve. After 5 steps the web holds a factor made
+ * during the fifth step's solve, which the sixth keeps (prepare makes none);
+ * with the mass negative its solve reaches SPN__IMPLICIT_RESTART, the
+ * factorisation of its own matrix is refused, and block Jacobi finishes
+ * the solve (CG begun again): one factorisation in the step, the factor
+ * kept (a refusal at the start of the step would have dropped it), some
+ * hundred iterations where a factor of the step's own matrix finishes in
+ * one or two. The step after, the mass positive again, factorises at its
+ * start and takes one or two iterations. Both agree with block Jacobi's
+ * step from the same state to what the tolerance allows (as in
+ * test_matches_block_jacobi). */
+static void test_factor_refused_mid_solve(void **state)
+{
+    (void)state;
+    spn_world *w = refusal_web(5);
+    const uint32_t before = spn__imp_mg_factorisations(w);
+    assert_true(before >= 1);
+    set_mass_sign(w, -1);
+    refusal_step a = step_against(w, SPN_PRECOND_BLOCK_JACOBI);
+    set_mass_sign(w, 1);
+    refusal_step b = step_against(w, SPN_PRECOND_BLOCK_JACOBI);
+    print_message("refused mid-solve: CG %ld (block Jacobi %ld), factorisations %u -> %u, max |dv| %.2e of %.2e; "
+                  "the step after: CG %ld (block Jacobi %ld), factorisations %u, max |dv| %.2e of %.2e\n",
+                  a.cg, a.cg_ref, before, a.factorisations, a.dv, a.vmax, b.cg, b.cg_ref, b.factorisations, b.dv,
+                  b.vmax);
+    assert_true(a.cg_ref > SPN__IMPLICIT_BJ_MAX && a.cg_ref < 1000); /* the reference solved, no breakdown */
+    assert_int_equal(a.factorisations, before + 1);
+    assert_true(a.cg - SPN__IMPLICIT_RESTART > a.cg_ref / 2);
+    assert_true(a.vmax > 0);
+    assert_true(a.dv <= 1e-6 * a.vmax);
+    assert_int_equal(b.factorisations, before + 2);
+    assert_true(b.cg <= 2);
+    assert_true(b.dv <= 1e-6 * b.vmax);
+    spn_world_destroy(w);
+}
+
+/* At the start of a step. (1) Through the public API: the mass kept
+ * negative a second step after the refusal mid-solve, that step's
+ * factorisation is refused too and the factor dropped (the count reads 0),
+ * and not made again once the mass is positive; the steps agree with block
+ * Jacobi's. (The V-cycle built from the same matrix refuses it as well, in
+ * its line factors, and then block Jacobi does the steps; of particle
+ * masses times -0.3 to -2 one at a time, only narrow bands gave a matrix
+ * the factor refused and the V-cycle took.) (2) The V-cycle taking over,
+ * with a refusal forced (spn__imp_mg_refuse) on a definite matrix at the
+ * first step that factorises (the second; the first is block Jacobi's):
+ * the count reads 0, and that step and the ones after it are the steps of
+ * the V-cycle asked for (SPN_PRECOND_MULTIGRID) from the same state, bit
+ * for bit, at a fraction of block Jacobi's iterations, and the first agrees
+ * with block Jacobi's step. */
+static void test_factor_refused_at_a_step(void **state)
+{
+    (void)state;
+    spn_world *w = refusal_web(5);
+    set_mass_sign(w, -1);
+    refusal_step a = step_against(w, SPN_PRECOND_BLOCK_JACOBI);
+    assert_true(a.factorisations >= 1); /* refused mid-solve, kept */
+    refusal_step b = step_against(w, SPN_PRECOND_BLOCK_JACOBI);
+    set_mass_sign(w, 1);
+    refusal_step c = step_against(w, SPN_PRECOND_BLOCK_JACOBI);
+    print_message("refused again at the next step: CG %ld (block Jacobi %ld), factorisations %u -> %u, max |dv| "
+                  "%.2e of %.2e; the step after: CG %ld (block Jacobi %ld), factorisations %u, max |dv| %.2e of %.2e\n",
+                  b.cg, b.cg_ref, a.factorisations, b.factorisations, b.dv, b.vmax, c.cg, c.cg_ref, c.factorisations,
+                  c.dv, c.vmax);
+    assert_true(b.cg_ref > SPN__IMPLICIT_BJ_MAX && b.cg_ref < 1000);
+    assert_int_equal(b.factorisations, 0);
+    assert_true(b.vmax > 0);
+    assert_true(b.dv <= 1e-6 * b.vmax);
+    assert_int_equal(c.factorisations, 0);
+    assert_true(c.dv <= 1e-6 * c.vmax);
+    spn_world_destroy(w);
+
+    w = refusal_web(1);
+    assert_int_equal(spn__imp_mg_factorisations(w), 0);
+    spn_world *mg = spn_world_clone(w);
+    assert_non_null(mg);
+    assert_int_equal(spn_world_set_implicit_preconditioner(mg, SPN_PRECOND_MULTIGRID), SPN_OK);
+    spn__imp_mg_refuse(w, 1);
+    refusal_step d = step_against(w, SPN_PRECOND_BLOCK_JACOBI);
+    print_message("refused at the start of a step: CG %ld (block Jacobi %ld), factorisations %u, max |dv| %.2e of "
+                  "%.2e\n",
+                  d.cg, d.cg_ref, d.factorisations, d.dv, d.vmax);
+    assert_int_equal(d.factorisations, 0);
+    assert_true(d.cg * 4 < d.cg_ref);
+    assert_true(d.vmax > 0);
+    assert_true(d.dv <= 1e-6 * d.vmax);
+    const uint32_t n = spn_world_particle_count(w);
+    for (int i = 0; i < 3; i++) {
+        if (i) assert_int_equal(spn_world_step(w, 1e-4), SPN_OK);
+        assert_int_equal(spn_world_step(mg, 1e-4), SPN_OK);
+        assert_int_equal(spn_world_last_step(w).cg_iterations, spn_world_last_step(mg).cg_iterations);
+        assert_memory_equal(spn_world_positions(w), spn_world_positions(mg), n * sizeof(spn_vec3));
+        assert_memory_equal(spn_world_velocities(w), spn_world_velocities(mg), n * sizeof(spn_vec3));
+        assert_int_equal(spn__imp_mg_factorisations(w), 0);
+    }
+    spn_world_destroy(w), spn_world_destroy(mg);
+}
+
 static void test_change_takes_effect(void **state)
 {
     (void)state;
@@ -400,6 +567,8 @@ int main(void)
         cmocka_unit_test(test_auto_on_a_small_web),
         cmocka_unit_test(test_factor_on_a_small_web),
         cmocka_unit_test(test_factor_with_a_contact),
+        cmocka_unit_test(test_factor_refused_mid_solve),
+        cmocka_unit_test(test_factor_refused_at_a_step),
         cmocka_unit_test(test_change_takes_effect),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

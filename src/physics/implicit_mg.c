@@ -220,6 +220,16 @@ static void assemble(spn__imp_mg *m, const spn_world *w, double h)
     }
 }
 
+/* A factorisation of level 0 (assemble): false when the matrix is not
+ * positive definite, or refused for a test (spn__imp_mg_refuse). */
+static bool factorise(spn_world *w, spn__imp_mg *m)
+{
+    bool ok = spn__chol_factor(m->chol, m->e.diag, m->e.offd);
+    m->factorisations++;
+    if (w->imp_refuse) w->imp_refuse--, ok = false;
+    return ok;
+}
+
 bool spn__imp_mg_prepare(spn_world *w, double h)
 {
     /* auto: where the multigrid pays (the cyclic preconditioner instead on a
@@ -255,9 +265,8 @@ bool spn__imp_mg_prepare(spn_world *w, double h)
     if (m->chol) {
         m->chol_fresh = !m->chol_ready || m->chol_stale || h != m->chol_h;
         if (m->chol_fresh) {
-            m->chol_ready = spn__chol_factor(m->chol, m->e.diag, m->e.offd);
+            m->chol_ready = factorise(w, m);
             m->chol_h = h;
-            m->factorisations++;
         }
         m->chol_stale = false;
         if (m->chol_ready) return true;
@@ -307,9 +316,8 @@ bool spn__imp_mg_refactor(spn_world *w)
     /* not definite: block Jacobi for the rest of this solve (apply), and the
      * next step's prepare factorises again, and drops the factor if that
      * fails too */
-    m->chol_ready = spn__chol_factor(m->chol, m->e.diag, m->e.offd);
+    m->chol_ready = factorise(w, m);
     m->chol_fresh = true;
-    m->factorisations++;
     return true;
 }
 
@@ -323,3 +331,5 @@ uint32_t spn__imp_mg_factorisations(const spn_world *w)
 {
     return w->imp_mg && w->imp_mg->chol ? w->imp_mg->factorisations : 0;
 }
+
+void spn__imp_mg_refuse(spn_world *w, uint32_t n) { w->imp_refuse = n; }

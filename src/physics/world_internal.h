@@ -179,6 +179,7 @@ struct spn_world {
     spn__jac *jac;        /* implicit: per-spring Jacobian (on demand) */
     double *pinv;         /* implicit: per-particle inverse 3x3 block, 6 each (on demand) */
     struct spn__imp_mg *imp_mg; /* implicit: the multigrid preconditioner (implicit_mg.c, on demand) */
+    uint32_t imp_refuse;  /* spn__imp_mg_refuse (tests) */
     uint8_t implicit_pc;  /* implicit preconditioner: 0 auto, 1 block Jacobi, 2 multigrid, 3 cyclic */
     double imp_bj_long;   /* auto: the shortest step at which block Jacobi took more than
                            * SPN__IMPLICIT_BJ_MAX CG iterations (0: none yet); from it up, the multigrid */
@@ -449,6 +450,10 @@ void spn__imp_mg_solved(spn_world *w, int iterations);
 bool spn__imp_mg_refactor(spn_world *w);
 /* The factorisations made for the implicit step so far (0 without a factor). */
 uint32_t spn__imp_mg_factorisations(const spn_world *w);
+/* For tests: the next n factorisations of the implicit step's factor are
+ * refused, as of a matrix not positive definite (they are still made and
+ * counted), for the fallbacks to be driven on a matrix that is definite. */
+void spn__imp_mg_refuse(spn_world *w, uint32_t n);
 /* Every contact active, before a step's first solve. */
 void spn__contact_begin(spn_world *w);
 /* The active contacts' part of the implicit system: their forces and
