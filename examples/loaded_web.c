@@ -22,8 +22,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "example_loaded_web: %s\n", spn_last_error());
         return 1;
     }
-    spn_world_set_mass(w, 0, spn_world_mass(w, 0) + 3e-4); /* particle 0 is the hub */
-    spn_status st = SPN_OK;
+    spn_status st = spn_world_set_mass(w, 0, spn_world_mass(w, 0) + 3e-4); /* particle 0 is the hub */
     for (int i = 0; i < 15000 && st == SPN_OK; i++) st = spn_world_step(w, 1e-4);
     if (st == SPN_OK) st = spn_world_set_metadata(w, "{\"example\": \"loaded_web\", \"hub_load_kg\": 3e-4}");
     if (st == SPN_OK) st = spn_web_save(w, out);

@@ -1,5 +1,6 @@
-/* The spring world's construction: bad particles and springs are refused with
- * a message naming what is wrong (the analytic checks are in test_physics_*). */
+/* The spring world's construction and setters: bad particles, springs and
+ * settings are refused with a message naming what is wrong (the analytic
+ * checks are in test_physics_*). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -7,6 +8,7 @@
 #include <cmocka.h>
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 #include <spinneret/spinneret.h>
 
@@ -25,6 +27,83 @@ static void test_bad_additions_refused(void **state)
     s.b = 1;
     assert_int_equal(spn_world_add_spring(w, &s, NULL), SPN_ERR_INVALID);
     assert_non_null(strstr(spn_last_error(), "does not exist"));
+    spn_world_destroy(w);
+}
+
+/* The setters refuse what the constructors refuse (spn_world_add_particle,
+ * spn_world_add_spring, a web file's world settings): a negative or
+ * non-finite mass, stiffness, damping or drag, a non-finite gravity; each
+ * with SPN_ERR_INVALID and a message naming the particle or spring and the
+ * field, and nothing changed: the values read back are the old ones, and the
+ * world (compiled, so its stepping copy of the springs counts too) steps as a
+ * clone made before the refusals does, bit for bit. */
+static void expect_refused(spn_status st, const char *who, const char *field)
+{
+    assert_int_equal(st, SPN_ERR_INVALID);
+    if (who) assert_non_null(strstr(spn_last_error(), who));
+    assert_non_null(strstr(spn_last_error(), field));
+}
+
+static void test_bad_settings_refused(void **state)
+{
+    (void)state;
+    spn_world_def wd = spn_world_def_default();
+    wd.drag = 0.5;
+    spn_world *w = spn_world_create(&wd);
+    assert_non_null(w);
+    spn_particle_def p = spn_particle_def_default();
+    p.mass = 2e-3;
+    for (int i = 0; i < 3; i++) {
+        p.position = spn_v3(i, 0, 0);
+        p.fixed = i == 0;
+        assert_int_equal(spn_world_add_particle(w, &p, NULL), SPN_OK);
+    }
+    spn_spring_def s = spn_spring_def_default();
+    s.k = 3.5, s.kd = 0.25;
+    for (uint32_t i = 0; i < 2; i++) {
+        s.a = i, s.b = i + 1;
+        assert_int_equal(spn_world_add_spring(w, &s, NULL), SPN_OK);
+    }
+    assert_int_equal(spn_world_step(w, 1e-3), SPN_OK);
+    spn_world *c = spn_world_clone(w);
+    assert_non_null(c);
+    const double bad[] = {-1e-9, -INFINITY, INFINITY, NAN};
+    for (size_t b = 0; b < sizeof bad / sizeof *bad; b++) {
+        for (uint32_t i = 0; i < 2; i++) { /* particle 0 is fixed: still fixed after */
+            char who[32];
+            snprintf(who, sizeof who, "particle %u:", i);
+            expect_refused(spn_world_set_mass(w, i, bad[b]), who, "mass");
+        }
+        expect_refused(spn_world_set_spring_stiffness(w, 1, bad[b], 0.25), "spring 1:", "stiffness k");
+        expect_refused(spn_world_set_spring_stiffness(w, 1, 3.5, bad[b]), "spring 1:", "damping kd");
+        expect_refused(spn_world_set_drag(w, bad[b]), NULL, "drag");
+        if (!isfinite(bad[b])) {
+            expect_refused(spn_world_set_gravity(w, spn_v3(0, bad[b], 0)), NULL, "gravity");
+            expect_refused(spn_world_set_gravity(w, spn_v3(bad[b], -9.81, 0)), NULL, "gravity");
+        }
+    }
+    assert_true(spn_world_mass(w, 0) == 2e-3 && spn_world_is_fixed(w, 0));
+    assert_true(spn_world_mass(w, 1) == 2e-3 && !spn_world_is_fixed(w, 1));
+    const spn_spring_def d = spn_world_spring_def(w, 1);
+    assert_true(d.k == 3.5 && d.kd == 0.25);
+    const spn_world_def *got = spn_world_get_def(w);
+    assert_true(got->drag == 0.5 && got->gravity.x == 0 && got->gravity.y == -9.81 && got->gravity.z == 0);
+    for (int i = 0; i < 3; i++) {
+        assert_int_equal(spn_world_step(w, 1e-3), SPN_OK);
+        assert_int_equal(spn_world_step(c, 1e-3), SPN_OK);
+    }
+    assert_memory_equal(spn_world_positions(w), spn_world_positions(c), 3 * sizeof(spn_vec3));
+    assert_memory_equal(spn_world_velocities(w), spn_world_velocities(c), 3 * sizeof(spn_vec3));
+    /* the edges are accepted: zero mass (fixed), stiffness, damping and drag */
+    assert_int_equal(spn_world_set_mass(w, 2, 0), SPN_OK);
+    assert_true(spn_world_is_fixed(w, 2));
+    assert_int_equal(spn_world_set_mass(w, 2, 3e-3), SPN_OK);
+    assert_true(spn_world_mass(w, 2) == 3e-3 && !spn_world_is_fixed(w, 2));
+    assert_int_equal(spn_world_set_spring_stiffness(w, 1, 0, 0), SPN_OK);
+    assert_int_equal(spn_world_set_drag(w, 0), SPN_OK);
+    assert_int_equal(spn_world_set_gravity(w, spn_v3(0, 0, -1)), SPN_OK);
+    assert_true(spn_world_get_def(w)->drag == 0 && spn_world_get_def(w)->gravity.z == -1);
+    spn_world_destroy(c);
     spn_world_destroy(w);
 }
 
@@ -92,6 +171,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bad_additions_refused),
+        cmocka_unit_test(test_bad_settings_refused),
         cmocka_unit_test(test_particle_def_round_trip),
         cmocka_unit_test(test_spring_def_round_trip),
     };

@@ -208,7 +208,10 @@ SPN_API void spn_world_set_position(spn_world *w, uint32_t i, spn_vec3 p);
 SPN_API void spn_world_set_velocity(spn_world *w, uint32_t i, spn_vec3 v);
 /// Pin (fixed = true) or free a particle. Freeing one with mass 0 keeps it fixed.
 SPN_API void spn_world_set_fixed(spn_world *w, uint32_t i, bool fixed);
-SPN_API void spn_world_set_mass(spn_world *w, uint32_t i, double mass);
+/// Mass of particle i [kg] (0: fixed, as in spn_particle_def). SPN_ERR_INVALID
+/// naming the particle, and nothing changed, when it is negative or not
+/// finite (as spn_world_add_particle refuses).
+SPN_API spn_status spn_world_set_mass(spn_world *w, uint32_t i, double mass);
 SPN_API void spn_world_set_particle_tag(spn_world *w, uint32_t i, uint32_t tag);
 
 SPN_API spn_spring_info spn_world_spring(const spn_world *w, uint32_t s);
@@ -219,7 +222,10 @@ SPN_API spn_spring_info spn_world_spring(const spn_world *w, uint32_t s);
 SPN_API spn_spring_def spn_world_spring_def(const spn_world *w, uint32_t s);
 SPN_API bool spn_world_spring_is_broken(const spn_world *w, uint32_t s);
 SPN_API void spn_world_set_spring_rest(spn_world *w, uint32_t s, double rest);
-SPN_API void spn_world_set_spring_stiffness(spn_world *w, uint32_t s, double k, double kd);
+/// Stiffness k [N/m] and axial damping kd [N s/m] of spring s. SPN_ERR_INVALID
+/// naming the spring and the field, and nothing changed, when either is
+/// negative or not finite (as spn_world_add_spring refuses).
+SPN_API spn_status spn_world_set_spring_stiffness(spn_world *w, uint32_t s, double k, double kd);
 SPN_API void spn_world_set_spring_tag(spn_world *w, uint32_t s, uint32_t tag);
 /// Break lengths of spring s as spn_spring_def has them (0, INFINITY: never);
 /// SPN_ERR_INVALID naming the spring when either is NaN.
@@ -229,8 +235,13 @@ SPN_API spn_status spn_world_set_spring_breaks(spn_world *w, uint32_t s, double 
 SPN_API void spn_world_break_spring(spn_world *w, uint32_t s);
 
 SPN_API void spn_world_set_integrator(spn_world *w, spn_integrator integrator);
-SPN_API void spn_world_set_gravity(spn_world *w, spn_vec3 g);
-SPN_API void spn_world_set_drag(spn_world *w, double drag);
+/// Gravity [m/s^2]; SPN_ERR_INVALID, and nothing changed, when a component
+/// is not finite (as a web file's world settings refuse it).
+SPN_API spn_status spn_world_set_gravity(spn_world *w, spn_vec3 g);
+/// Viscous drag per unit mass [1/s] (spn_world_def.drag); SPN_ERR_INVALID,
+/// and nothing changed, when it is negative or not finite (as a web file's
+/// world settings and spn_settle_def refuse it).
+SPN_API spn_status spn_world_set_drag(spn_world *w, double drag);
 SPN_API double spn_world_time(const spn_world *w);
 SPN_API void spn_world_set_time(spn_world *w, double t);
 SPN_API uint64_t spn_world_step_count(const spn_world *w);

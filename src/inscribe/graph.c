@@ -121,7 +121,7 @@ spn_status spn__add_thread(spn_world *w, const spn__material *m, uint32_t a, uin
     spn_status st = spn_world_add_spring(w, &d, NULL);
     for (int e = 0; e < 2 && st == SPN_OK; e++) {
         uint32_t p = e ? b : a;
-        if (!spn_world_is_fixed(w, p)) spn_world_set_mass(w, p, spn_world_mass(w, p) + 0.5 * mseg);
+        if (!spn_world_is_fixed(w, p)) st = spn_world_set_mass(w, p, spn_world_mass(w, p) + 0.5 * mseg);
     }
     return st;
 }

@@ -241,13 +241,18 @@ void spn_world_set_fixed(spn_world *w, uint32_t i, bool fixed)
     w->free_mass += free_mass_of(w, i);
 }
 
-void spn_world_set_mass(spn_world *w, uint32_t i, double mass)
+spn_status spn_world_set_mass(spn_world *w, uint32_t i, double mass)
 {
+    /* as spn_world_add_particle: a negative mass would leave the implicit
+     * step's matrix not positive definite */
+    if (!(mass >= 0) || !isfinite(mass))
+        return spn_error(SPN_ERR_INVALID, "particle %u: mass must be finite and not negative, not %g", i, mass);
     bool fixed = w->inv_mass[i] == 0 && w->mass[i] != 0;
     w->free_mass -= free_mass_of(w, i);
     w->mass[i] = mass;
     w->inv_mass[i] = (fixed || mass == 0) ? 0 : 1.0 / mass;
     w->free_mass += free_mass_of(w, i);
+    return SPN_OK;
 }
 
 spn_spring_def spn_world_spring_def(const spn_world *w, uint32_t s)
@@ -300,14 +305,20 @@ void spn_world_set_spring_rest(spn_world *w, uint32_t s, double rest)
     }
 }
 
-void spn_world_set_spring_stiffness(spn_world *w, uint32_t s, double k, double kd)
+spn_status spn_world_set_spring_stiffness(spn_world *w, uint32_t s, double k, double kd)
 {
+    /* as spn_world_add_spring */
+    if (!(k >= 0) || !isfinite(k))
+        return spn_error(SPN_ERR_INVALID, "spring %u: stiffness k must be finite and not negative, not %g", s, k);
+    if (!(kd >= 0) || !isfinite(kd))
+        return spn_error(SPN_ERR_INVALID, "spring %u: damping kd must be finite and not negative, not %g", s, kd);
     w->k[s] = k;
     w->kd[s] = kd;
     if (w->compiled) {
         w->hs[w->iperm[s]] = spn__hot_spring(w, s);
         spn__lattice_spring_changed(w, s);
     }
+    return SPN_OK;
 }
 void spn_world_set_spring_tag(spn_world *w, uint32_t s, uint32_t tag)
 {
@@ -348,8 +359,20 @@ spn_status spn_world_set_solver_tolerance(spn_world *w, double cg_tolerance, int
     w->def.cg_max_iterations = cg_max_iterations;
     return SPN_OK;
 }
-void spn_world_set_gravity(spn_world *w, spn_vec3 g) { w->def.gravity = g; }
-void spn_world_set_drag(spn_world *w, double drag) { w->def.drag = drag; }
+/* gravity and drag as a web file's world settings have them (web_read.c) */
+spn_status spn_world_set_gravity(spn_world *w, spn_vec3 g)
+{
+    if (!spn_v3_finite(g)) return spn_error(SPN_ERR_INVALID, "gravity must be finite, not (%g, %g, %g)", g.x, g.y, g.z);
+    w->def.gravity = g;
+    return SPN_OK;
+}
+spn_status spn_world_set_drag(spn_world *w, double drag)
+{
+    if (!(drag >= 0) || !isfinite(drag))
+        return spn_error(SPN_ERR_INVALID, "drag must be finite and not negative, not %g", drag);
+    w->def.drag = drag;
+    return SPN_OK;
+}
 spn_status spn_world_set_energy_limit(spn_world *w, spn_energy_limit limit)
 {
     if (limit != SPN_ENERGY_LIMIT_OFF && limit != SPN_ENERGY_LIMIT_UNFINISHED && limit != SPN_ENERGY_LIMIT_ALWAYS)

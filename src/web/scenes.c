@@ -97,7 +97,7 @@ spn_status spn_scene_orb(const spn_world_def *world_def, const spn_orb_scene_def
     }
     for (uint32_t i = 0; i < np && st == SPN_OK; i++) {
         bool fixed = spn_world_is_fixed(w, i);
-        spn_world_set_mass(w, i, mass[i] > 0 ? mass[i] : d.linear_density * d.radius / d.rings);
+        st = spn_world_set_mass(w, i, mass[i] > 0 ? mass[i] : d.linear_density * d.radius / d.rings);
         if (fixed) spn_world_set_fixed(w, i, true);
     }
     free(mass);

@@ -110,13 +110,14 @@ spn_status spn__weaver_finish(spn__weaver *wv, const char *metadata, spn_world *
     for (uint32_t i = 0; i < np; i++)
         if (wv->mass[i] > 0 && wv->mass[i] < smallest) smallest = wv->mass[i];
     if (!isfinite(smallest)) smallest = 1e-9;
-    for (uint32_t i = 0; i < np; i++) {
+    spn_status st = SPN_OK;
+    for (uint32_t i = 0; i < np && st == SPN_OK; i++) {
         bool fixed = spn_world_is_fixed(wv->w, i);
         /* A particle no spring reaches (none should remain) still needs a mass. */
-        spn_world_set_mass(wv->w, i, wv->mass[i] > 0 ? wv->mass[i] : smallest);
+        st = spn_world_set_mass(wv->w, i, wv->mass[i] > 0 ? wv->mass[i] : smallest);
         if (fixed) spn_world_set_fixed(wv->w, i, true);
     }
-    spn_status st = metadata ? spn_world_set_metadata(wv->w, metadata) : SPN_OK;
+    if (st == SPN_OK && metadata) st = spn_world_set_metadata(wv->w, metadata);
     if (st != SPN_OK) {
         spn__weaver_abort(wv);
         return st;
