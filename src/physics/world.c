@@ -147,12 +147,32 @@ static bool reserve_springs(spn_world *w, uint32_t need)
     return ok;
 }
 
+/* A particle's mass, and a spring's stiffness and damping, as the
+ * constructors and the setters take them: finite and not negative (a
+ * negative one would leave the implicit step's matrix not positive
+ * definite). */
+static spn_status check_mass(uint32_t i, double mass)
+{
+    if (!(mass >= 0) || !isfinite(mass))
+        return spn_error(SPN_ERR_INVALID, "particle %u: mass must be finite and not negative, not %g", i, mass);
+    return SPN_OK;
+}
+
+static spn_status check_stiffness(uint32_t s, double k, double kd)
+{
+    if (!(k >= 0) || !isfinite(k))
+        return spn_error(SPN_ERR_INVALID, "spring %u: stiffness k must be finite and not negative, not %g", s, k);
+    if (!(kd >= 0) || !isfinite(kd))
+        return spn_error(SPN_ERR_INVALID, "spring %u: damping kd must be finite and not negative, not %g", s, kd);
+    return SPN_OK;
+}
+
 spn_status spn_world_add_particle(spn_world *w, const spn_particle_def *def, uint32_t *id)
 {
     if (!spn_v3_finite(def->position) || !spn_v3_finite(def->velocity))
         return spn_error(SPN_ERR_INVALID, "particle %u: position and velocity must be finite", w->np);
-    if (!(def->mass >= 0) || !isfinite(def->mass))
-        return spn_error(SPN_ERR_INVALID, "particle %u: mass must be finite and not negative", w->np);
+    spn_status st = check_mass(w->np, def->mass);
+    if (st != SPN_OK) return st;
     if (w->np >= spn_max_particles()) return spn_check_counts("world", (uint64_t)w->np + 1, 0);
     if (!reserve_particles(w, w->np + 1)) return spn_error(SPN_ERR_NOMEM, "out of memory");
     uint32_t i = w->np++;
@@ -172,8 +192,8 @@ spn_status spn_world_add_spring(spn_world *w, const spn_spring_def *def, uint32_
     if (def->a >= w->np || def->b >= w->np)
         return spn_error(SPN_ERR_INVALID, "spring %u: particle %u does not exist", s, def->a >= w->np ? def->a : def->b);
     if (def->a == def->b) return spn_error(SPN_ERR_INVALID, "spring %u: both ends are particle %u", s, def->a);
-    if (!(def->k >= 0) || !isfinite(def->k) || !(def->kd >= 0) || !isfinite(def->kd))
-        return spn_error(SPN_ERR_INVALID, "spring %u: stiffness and damping must be finite and not negative", s);
+    spn_status st = check_stiffness(s, def->k, def->kd);
+    if (st != SPN_OK) return st;
     if (isnan(def->rest) || isinf(def->rest) || isnan(def->break_min) || isnan(def->break_max))
         return spn_error(SPN_ERR_INVALID, "spring %u: rest and break lengths must be numbers", s);
     if (s >= spn_max_springs()) return spn_check_counts("world", 0, (uint64_t)s + 1);
@@ -243,10 +263,8 @@ void spn_world_set_fixed(spn_world *w, uint32_t i, bool fixed)
 
 spn_status spn_world_set_mass(spn_world *w, uint32_t i, double mass)
 {
-    /* as spn_world_add_particle: a negative mass would leave the implicit
-     * step's matrix not positive definite */
-    if (!(mass >= 0) || !isfinite(mass))
-        return spn_error(SPN_ERR_INVALID, "particle %u: mass must be finite and not negative, not %g", i, mass);
+    spn_status st = check_mass(i, mass);
+    if (st != SPN_OK) return st;
     bool fixed = w->inv_mass[i] == 0 && w->mass[i] != 0;
     w->free_mass -= free_mass_of(w, i);
     w->mass[i] = mass;
@@ -307,11 +325,8 @@ void spn_world_set_spring_rest(spn_world *w, uint32_t s, double rest)
 
 spn_status spn_world_set_spring_stiffness(spn_world *w, uint32_t s, double k, double kd)
 {
-    /* as spn_world_add_spring */
-    if (!(k >= 0) || !isfinite(k))
-        return spn_error(SPN_ERR_INVALID, "spring %u: stiffness k must be finite and not negative, not %g", s, k);
-    if (!(kd >= 0) || !isfinite(kd))
-        return spn_error(SPN_ERR_INVALID, "spring %u: damping kd must be finite and not negative, not %g", s, kd);
+    spn_status st = check_stiffness(s, k, kd);
+    if (st != SPN_OK) return st;
     w->k[s] = k;
     w->kd[s] = kd;
     if (w->compiled) {
