@@ -95,7 +95,7 @@ static bool slot_of(uint32_t n, uint32_t a, uint32_t b, uint32_t rings, bool *ra
 static void store(spn__lattice *L, bool radial, size_t slot, spn__spring h)
 {
     double *k = radial ? L->rk : L->gk, *kd = radial ? L->rkd : L->gkd, *rest = radial ? L->rrest : L->grest;
-    slot = slot / L->radials * L->pitch + slot % L->radials; /* (rows of pitch) */
+    slot = lat_slot(L, slot);
     k[slot] = h.k, kd[slot] = h.kd;
     rest[slot] = spn__tension_only(h) ? -h.rest : h.rest;
     spn__lat32_params_changed(L->f32);
@@ -342,12 +342,11 @@ static bool load(spn_world *w, int threads)
     double *x0 = L->x[0], *x1 = L->x[1], *x2 = L->x[2], *v0 = L->v[0], *v1 = L->v[1], *v2 = L->v[2];
     double *m = L->mass, *im = L->inv_mass;
     const double *wm = w->mass, *wim = w->inv_mass;
-    const uint32_t n = L->radials, rows = L->rings;
-    const size_t P = L->pitch;
+    const uint32_t rows = L->rings;
 #pragma omp parallel for schedule(static) num_threads(threads)
-    for (uint32_t r = 0; r <= rows; r++) { /* the hub (r = 0), then ring r - 1 */
-        const size_t from = r ? 1 + (size_t)(r - 1) * n : 0, to = r ? 1 + (size_t)(r - 1) * P : 0;
-        const uint32_t count = r ? n : 1;
+    for (uint32_t r = 0; r <= rows; r++) {
+        size_t from, to;
+        const uint32_t count = lat_row(L, r, &from, &to);
         for (uint32_t i = 0; i < count; i++) {
             const size_t s = from + i, d = to + i;
             m[d] = wm[s], im[d] = wim[s];
@@ -366,12 +365,11 @@ static void write_back(spn_world *w, int threads)
     spn__lattice *L = w->lat;
     spn_vec3 *x = w->x, *v = w->v;
     const double *x0 = L->x[0], *x1 = L->x[1], *x2 = L->x[2], *v0 = L->v[0], *v1 = L->v[1], *v2 = L->v[2];
-    const uint32_t n = L->radials, rows = L->rings;
-    const size_t P = L->pitch;
+    const uint32_t rows = L->rings;
 #pragma omp parallel for schedule(static) num_threads(threads)
-    for (uint32_t r = 0; r <= rows; r++) { /* as load() */
-        const size_t to = r ? 1 + (size_t)(r - 1) * n : 0, from = r ? 1 + (size_t)(r - 1) * P : 0;
-        const uint32_t count = r ? n : 1;
+    for (uint32_t r = 0; r <= rows; r++) {
+        size_t to, from;
+        const uint32_t count = lat_row(L, r, &to, &from);
         for (uint32_t i = 0; i < count; i++) {
             const size_t d = to + i, s = from + i;
             x[d] = spn_v3(x0[s], x1[s], x2[s]), v[d] = spn_v3(v0[s], v1[s], v2[s]);

@@ -280,7 +280,7 @@ static bool load(spn_world *w, int threads)
     const uint32_t np = w->np;
     if (!F->params_ok)
         for (size_t s = 0; s < F->m; s++) {
-            const size_t d = s / L->radials * L->pitch + s % L->radials; /* (float64 rows of pitch) */
+            const size_t d = lat_slot(L, s);
             F->rk[s] = (float)L->rk[d], F->rkd[s] = (float)L->rkd[d], F->rr[s] = (float)L->rrest[d];
             F->gk[s] = (float)L->gk[d], F->gkd[s] = (float)L->gkd[d], F->gr[s] = (float)L->grest[d];
         }

@@ -154,6 +154,23 @@ struct spn__lattice {
     lat_gov gov;
 };
 
+/* Where the world's slot s (ring j, radial i: s = j N + i) sits in the
+ * float64 slot arrays: j pitch + i. */
+static inline size_t lat_slot(const spn__lattice *L, size_t s)
+{
+    return s / L->radials * L->pitch + s % L->radials;
+}
+
+/* Row r of the world's particles (0: the hub alone; r > 0: ring r - 1):
+ * its first index in the world's arrays, in the float64 lattice's, and its
+ * count. */
+static inline uint32_t lat_row(const spn__lattice *L, uint32_t r, size_t *world, size_t *lat)
+{
+    *world = r ? 1 + (size_t)(r - 1) * L->radials : 0;
+    *lat = r ? 1 + (size_t)(r - 1) * L->pitch : 0;
+    return r ? L->radials : 1;
+}
+
 /* What a sweep does with a row once its forces are complete. */
 enum { MODE_EULER, MODE_SYMPLECTIC, MODE_RK4_STAGE, MODE_RK4_LAST };
 
