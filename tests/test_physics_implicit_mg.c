@@ -276,7 +276,9 @@ typedef struct factor_run {
 
 enum { FACTOR_STEPS = 24, FACTOR_AFTER = 3 };
 
-static factor_run factor_steps(spn_precond pc, int threads)
+/* The 20 x 60 web on the implicit solver, flat, spring 1200 broken (so it
+ * is no lattice), CG to 1e-10. */
+static spn_world *broken_web(int threads)
 {
     spn_world_def wd = spn_world_def_default();
     wd.integrator = SPN_INTEGRATOR_IMPLICIT;
@@ -285,9 +287,15 @@ static factor_run factor_steps(spn_precond pc, int threads)
     od.rings = 20, od.radials = 60;
     spn_world *w = NULL;
     assert_int_equal(spn_scene_orb(&wd, &od, &w), SPN_OK);
-    assert_int_equal(spn_world_set_implicit_preconditioner(w, pc), SPN_OK);
     assert_int_equal(spn_world_set_solver_tolerance(w, 1e-10, 1000), SPN_OK);
     spn_world_break_spring(w, 1200);
+    return w;
+}
+
+static factor_run factor_steps(spn_precond pc, int threads)
+{
+    spn_world *w = broken_web(threads);
+    assert_int_equal(spn_world_set_implicit_preconditioner(w, pc), SPN_OK);
     factor_run r = {0};
     for (int i = 0; i < FACTOR_STEPS + FACTOR_AFTER; i++) {
         if (i == FACTOR_STEPS) r.factorisations_before_change = spn__imp_mg_factorisations(w);
@@ -360,20 +368,12 @@ static void test_factor_with_a_contact(void **state)
     free(a), free(b);
 }
 
-/* The refused factor's tests: the 20 x 60 web of test_factor_on_a_small_web
+/* The refused factor's tests: broken_web, as in test_factor_on_a_small_web
  * (a spring broken, falling from flat, steps of 1e-4 s, one thread) after
  * `steps` steps. */
 static spn_world *refusal_web(int steps)
 {
-    spn_world_def wd = spn_world_def_default();
-    wd.integrator = SPN_INTEGRATOR_IMPLICIT;
-    wd.threads = 1;
-    spn_orb_scene_def od = spn_orb_scene_def_default();
-    od.rings = 20, od.radials = 60;
-    spn_world *w = NULL;
-    assert_int_equal(spn_scene_orb(&wd, &od, &w), SPN_OK);
-    assert_int_equal(spn_world_set_solver_tolerance(w, 1e-10, 1000), SPN_OK);
-    spn_world_break_spring(w, 1200);
+    spn_world *w = broken_web(1);
     for (int i = 0; i < steps; i++) assert_int_equal(spn_world_step(w, 1e-4), SPN_OK);
     return w;
 }
