@@ -166,20 +166,21 @@ static bool prepare(spn_world *w, int threads)
      * of them for a static schedule to share out evenly, few enough that
      * the radials computed twice at their edges cost nothing; a web that
      * takes threads below parallel_min (lattice_threads) is cut into four
-     * (the 5k web: 13, 13, 13 and 11 rows, so two threads get 26 and 24;
-     * bands of an eighth of parallel_min gave it 41 and 9, SPN_BLOCK-sized
-     * ones 11, 11, 11, 11, 6). */
+     * (bands of an eighth of parallel_min gave the 5k web 41 and 9 rows,
+     * SPN_BLOCK-sized ones 11, 11, 11, 11, 6). The rows are then shared out
+     * evenly (lat_band_lo): the 5k web's four are 12, 13, 12 and 13 rows,
+     * 25 a thread on two (bands of 13 rows, 13, 13, 13 and 11, gave
+     * 26 and 24: docs/physics-lattice.md, "Even bands"). */
     const uint32_t n = L->radials, eighth = w->def.parallel_min / 8, quarter = w->np / 4;
     const uint32_t want = eighth < quarter ? eighth : quarter, bsize = want > SPN_BLOCK ? want : SPN_BLOCK;
-    const uint32_t rows = (bsize + n - 1) / n;
-    if (L->band_rows != rows) {
+    const uint32_t rows = (bsize + n - 1) / n, nbands = (L->rings + rows - 1) / rows;
+    if (L->nbands != nbands) {
         free(L->cut), free(L->partial);
-        L->band_rows = rows;
-        L->nbands = (L->rings + rows - 1) / rows;
+        L->nbands = nbands;
         L->cut = spn__lattice_arrays((size_t)L->nbands * 3, L->pitch, sizeof *L->cut, 0, NULL, NULL);
         L->partial = malloc((size_t)L->nbands * L_NSUMS * sizeof *L->partial);
         if (!L->cut || !L->partial) {
-            L->band_rows = 0;
+            L->nbands = 0;
             return false;
         }
     }

@@ -28,9 +28,9 @@ void *spn__lattice_arrays(size_t count, size_t n, size_t size, size_t lead, void
 bool spn__lattice_block_ready(const spn__lattice *L, int threads, uint32_t K)
 {
     /* each thread's run of bands at least 4 K rows, so the ghosts cost at
-     * most a quarter */
+     * most a quarter (the smallest band: rings / nbands rows, rounded down) */
     const uint32_t per = L->nbands / (uint32_t)threads;
-    return K >= 2 && K <= LAT_LEVELS && per >= 1 && per * L->band_rows >= 4 * K;
+    return K >= 2 && K <= LAT_LEVELS && per >= 1 && per * (L->rings / L->nbands) >= 4 * K;
 }
 
 bool spn__lattice_block_alloc(spn__lattice *L, int threads, size_t bytes)

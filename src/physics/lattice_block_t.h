@@ -196,8 +196,9 @@ LAT_INLINE void LK(op)(LK(block) *B, double *partial, uint32_t s, uint32_t j)
         LK_T *X[3], *V[3];
         LK(eval_ptrs)(B, s, j, X, V);
         const bool mine = LK(own)(B, j) && j < hi;
-        const int q = (int)((j / L->band_rows) & 1);
-        const bool cut = j > 0 && j % L->band_rows == 0;
+        const uint32_t bj = lat_band_of(L, j);
+        const int q = (int)(bj & 1);
+        const bool cut = j > 0 && j == lat_band_lo(L, bj);
         const lat_cols *own = mine ? &lv->band[q] : &B->dummy;
         const bool held = j < hi && !(mine && cut); /* the ring springs follow, into the same columns */
         if (j == 0) {
@@ -214,12 +215,11 @@ LAT_INLINE void LK(op)(LK(block) *B, double *partial, uint32_t s, uint32_t j)
         if (j < hi) LK(rings)(a, X, V, j, lv->ring[cur], own, held);
     }
     if (j > LK(low)(B, s)) {
-        const uint32_t r = j - 1, b = r / L->band_rows;
+        const uint32_t r = j - 1, b = lat_band_of(L, r);
         const bool mine = LK(own)(B, r);
         LK(block_move)(B, s, r, lv->rad_prev, lv->ring[cur ^ 1], j < rings ? lv->rad[cur] : NULL,
                        mine ? &lv->band[b & 1] : &B->dummy);
-        const uint32_t band_end = (b + 1) * L->band_rows < rings ? (b + 1) * L->band_rows : rings;
-        if (mine && r + 1 == band_end) LK(store_level)(B, partial, s, b);
+        if (mine && r + 1 == lat_band_lo(L, b + 1)) LK(store_level)(B, partial, s, b);
     }
     lv->rad_prev = lv->rad[cur];
     lv->cur ^= 1;
@@ -326,7 +326,7 @@ static bool LK(block_pass)(spn__lattice *L, const LK_ARGS *la, bool rk4, int thr
         const int t = spn__thread_num();
         const uint32_t b0 = (uint32_t)((uint64_t)nb * (uint32_t)t / (uint32_t)threads);
         const uint32_t b1 = (uint32_t)((uint64_t)nb * (uint32_t)(t + 1) / (uint32_t)threads);
-        const uint32_t R0 = b0 * L->band_rows, R1 = b1 * L->band_rows < L->rings ? b1 * L->band_rows : L->rings;
+        const uint32_t R0 = lat_band_lo(L, b0), R1 = lat_band_lo(L, b1);
         LK(block) B;
         LK(block_init)(&B, la, rk4, (LK_T *)L->bws[t], L->cols[t], R0, R1, K);
         LK(copy_ghosts)(&B);

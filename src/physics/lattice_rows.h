@@ -128,7 +128,7 @@ struct spn__lattice {
     double *slots;            /* the block of the six slot arrays below */
     double *rk, *rkd, *rrest; /* radial slots: ring * pitch + i, (ring - 1, i) -> (ring, i) */
     double *gk, *gkd, *grest; /* ring slots: ring * pitch + i, (i, i + 1); i = N - 1: (0, N - 1) */
-    uint32_t band_rows, nbands;
+    uint32_t nbands; /* bands of rows, lat_band_lo */
     double *cut;     /* per band: 3 rows of pitch, the radial forces into its first row (band 0 unused) */
     double *partial; /* per band: L_NSUMS */
     int nws;         /* workspaces allocated (one per thread) */
@@ -164,6 +164,21 @@ static inline size_t lat_slot(const spn__lattice *L, size_t s)
 /* Row r of the world's particles (0: the hub alone; r > 0: ring r - 1):
  * its first index in the world's arrays, in the float64 lattice's, and its
  * count. */
+/* Band b's first row (b = nbands: the rings): the rings shared out as
+ * evenly as whole rows go, the bands' sizes differing by one at most, so
+ * that two threads taking half the bands each take half the rows (the 5k
+ * web's 50 rings: 12, 13, 12 and 13). */
+static inline uint32_t lat_band_lo(const spn__lattice *L, uint32_t b)
+{
+    return (uint32_t)((uint64_t)b * L->rings / L->nbands);
+}
+
+/* The band row j belongs to: the last b with lat_band_lo(b) <= j. */
+static inline uint32_t lat_band_of(const spn__lattice *L, uint32_t j)
+{
+    return (uint32_t)((((uint64_t)j + 1) * L->nbands - 1) / L->rings);
+}
+
 static inline uint32_t lat_row(const spn__lattice *L, uint32_t r, size_t *world, size_t *lat)
 {
     *world = r ? 1 + (size_t)(r - 1) * L->radials : 0;

@@ -35,7 +35,7 @@
 SPN__KERNEL static void LK(cut_pass)(const LK_ARGS *a, double *cols, uint32_t b)
 {
     const spn__lattice *L = a->L;
-    const uint32_t n = L->radials, j = b * L->band_rows;
+    const uint32_t n = L->radials, j = lat_band_lo(L, b);
     const size_t P = LK(pitch)(a);
     LK_T *Xa[3], *Va[3], *Xb[3], *Vb[3], *f[3];
     LK(eval)(a, 1 + (size_t)(j - 1) * P, Xa, Va);
@@ -52,9 +52,8 @@ SPN__KERNEL static void LK(cut_pass)(const LK_ARGS *a, double *cols, uint32_t b)
 SPN__KERNEL static void LK(band_pass)(const LK_ARGS *a, LK_T *ws, double *cols, uint32_t b)
 {
     const spn__lattice *L = a->L;
-    const uint32_t n = L->radials, lo = b * L->band_rows;
+    const uint32_t n = L->radials, lo = lat_band_lo(L, b), hi = lat_band_lo(L, b + 1);
     const size_t P = LK(pitch)(a);
-    const uint32_t hi = lo + L->band_rows < L->rings ? lo + L->band_rows : L->rings;
     const size_t st = LK(stride)(a);
     LK_T *RAD[2][3], *RING[2][3], *H[6], *Fw[3], *cut[3], *next_cut[3];
     for (int c = 0; c < 3; c++) {
