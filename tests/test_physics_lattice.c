@@ -236,6 +236,64 @@ static void test_blocked_passes(void **state)
     spn_world_destroy(ref);
 }
 
+/* A replayable advance on two threads keeps them as a team for the call
+ * (lattice_team.c). With no patience its workers sleep on the condition
+ * variable after every job and are woken for the next: the bits are still
+ * those of single steps on one thread, explicit, RK4 and float32, through a
+ * governor that switches between one thread and two, and a blow-up's
+ * replay. (A lost wake-up would hang here.) */
+static void test_team_asleep_between_jobs(void **state)
+{
+    (void)state;
+    spn__lat_team_set_patience(0, 0);
+    const spn_integrator integs[] = {SPN_INTEGRATOR_SYMPLECTIC, SPN_INTEGRATOR_RK4};
+    for (int k = 0; k < 2; k++)
+        for (int f32 = 0; f32 < 2; f32++) {
+            spn_world *one = disturbed_orb(integs[k], 40, 50, 1, 256, true);
+            spn_world *two = disturbed_orb(integs[k], 40, 50, 2, 256, true);
+            spn_world *ref = disturbed_orb(integs[k], 40, 50, 1, 256, true);
+            if (f32) {
+                spn_world_set_precision(one, SPN_PRECISION_FLOAT32);
+                spn_world_set_precision(two, SPN_PRECISION_FLOAT32);
+                spn_world_set_precision(ref, SPN_PRECISION_FLOAT32);
+            }
+            spn__lattice_set_unblocked(ref, true);
+            const int blocked = integs[k] == SPN_INTEGRATOR_RK4 ? 29 : 28;
+            assert_int_equal(spn_world_advance(ref, 2e-6, 29), SPN_OK);
+            assert_passes_match(one, two, ref, 2e-6, 29, blocked);
+            spn_world_destroy(one);
+            spn_world_destroy(two);
+            spn_world_destroy(ref);
+        }
+    /* the governor's choices, one thread and two, inside one team's calls */
+    spn_world *two = disturbed_orb(SPN_INTEGRATOR_SYMPLECTIC, 40, 50, 2, 8192, true);
+    spn_world *one = disturbed_orb(SPN_INTEGRATOR_SYMPLECTIC, 40, 50, 1, 8192, true);
+    spn__lattice_set_unblocked(one, true);
+    for (int call = 0; call < 4; call++) {
+        assert_true(spn__lattice_gov_prefer(two, call % 2 == 0));
+        assert_int_equal(spn_world_advance(two, 2e-6, 9), SPN_OK);
+        assert_int_equal(spn_world_advance(one, 2e-6, 9), SPN_OK);
+        assert_same_state(two, one);
+    }
+    spn_world_destroy(two);
+    spn_world_destroy(one);
+    /* a blow-up inside the team: replayed, the same step named */
+    spn_world *blk = disturbed_orb(SPN_INTEGRATOR_SYMPLECTIC, 40, 50, 2, 256, true);
+    spn_world *ref = disturbed_orb(SPN_INTEGRATOR_SYMPLECTIC, 40, 50, 2, 256, true);
+    int failed_at = -1;
+    for (int i = 0; i < 400 && failed_at < 0; i++)
+        if (spn_world_step(ref, 6e-5) != SPN_OK) failed_at = i;
+    assert_true(failed_at > 0);
+    char want[512];
+    snprintf(want, sizeof want, "%s", spn_last_error());
+    assert_int_equal(spn_world_advance(blk, 6e-5, 400), SPN_ERR_UNSTABLE);
+    assert_string_equal(spn_last_error(), want);
+    assert_same_state(blk, ref);
+    spn_world_destroy(blk);
+    spn_world_destroy(ref);
+    spn__lat_team_set_patience(-1, -1);
+}
+
 /* The float64 RK4 pass in each of its versions (SPN_RK4_AVX2=0: the one
  * target_clones picks, AVX-512 where the processor has it; 1: AVX2 code,
  * where it has that; lattice_block.c): the bits of single steps, on 1 and
@@ -615,6 +673,7 @@ int main(void)
         cmocka_unit_test(test_same_gravity_and_drag),
         cmocka_unit_test(test_bands_and_threads),
         cmocka_unit_test(test_blocked_passes),
+        cmocka_unit_test(test_team_asleep_between_jobs),
         cmocka_unit_test(test_rk4_pass_versions),
         cmocka_unit_test(test_blocked_passes_float32),
         cmocka_unit_test(test_governor_choices),

@@ -321,10 +321,31 @@ static const double *inv_mass64(const lat_args *a) { return a->inv_mass; }
 
 /* ---- state: load and write-back ---- */
 
+/* Rows [lo, hi) of the world's state and masses into the lattice's arrays
+ * (row 0: the hub). */
+static void load_rows(void *ctx, size_t lo, size_t hi)
+{
+    const spn_world *w = ctx;
+    spn__lattice *L = w->lat;
+    const spn_vec3 *x = w->x, *v = w->v;
+    double *x0 = L->x[0], *x1 = L->x[1], *x2 = L->x[2], *v0 = L->v[0], *v1 = L->v[1], *v2 = L->v[2];
+    double *m = L->mass, *im = L->inv_mass;
+    const double *wm = w->mass, *wim = w->inv_mass;
+    for (uint32_t r = (uint32_t)lo; r < hi; r++) {
+        size_t from, to;
+        const uint32_t count = lat_row(L, r, &from, &to);
+        for (uint32_t i = 0; i < count; i++) {
+            const size_t s = from + i, d = to + i;
+            m[d] = wm[s], im[d] = wim[s];
+            x0[d] = x[s].x, x1[d] = x[s].y, x2[d] = x[s].z;
+            v0[d] = v[s].x, v1[d] = v[s].y, v2[d] = v[s].z;
+        }
+    }
+}
+
 /* The world's state into the lattice's arrays; false when out of memory. */
 static bool load(spn_world *w, int threads)
 {
-    (void)threads; /* (used by OpenMP pragmas only) */
     spn__lattice *L = w->lat;
     if (!L->state) {
         void *first, *first2;
@@ -339,36 +360,20 @@ static bool load(spn_world *w, int threads)
         for (int c = 0; c < 3; c++)
             L->x[c] = q + c * pitch, L->v[c] = q + (3 + c) * pitch;
     }
-    const spn_vec3 *x = w->x, *v = w->v;
-    double *x0 = L->x[0], *x1 = L->x[1], *x2 = L->x[2], *v0 = L->v[0], *v1 = L->v[1], *v2 = L->v[2];
-    double *m = L->mass, *im = L->inv_mass;
-    const double *wm = w->mass, *wim = w->inv_mass;
-    const uint32_t rows = L->rings;
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (uint32_t r = 0; r <= rows; r++) {
-        size_t from, to;
-        const uint32_t count = lat_row(L, r, &from, &to);
-        for (uint32_t i = 0; i < count; i++) {
-            const size_t s = from + i, d = to + i;
-            m[d] = wm[s], im[d] = wim[s];
-            x0[d] = x[s].x, x1[d] = x[s].y, x2[d] = x[s].z;
-            v0[d] = v[s].x, v1[d] = v[s].y, v2[d] = v[s].z;
-        }
-    }
+    spn__lat_for(L, threads, (size_t)L->rings + 1, load_rows, w);
     L->live = true;
     L->mv2.ok = false;
     return true;
 }
 
-static void write_back(spn_world *w, int threads)
+/* Rows [lo, hi) of the lattice's state back into the world's. */
+static void write_rows(void *ctx, size_t lo, size_t hi)
 {
-    (void)threads; /* (used by OpenMP pragmas only) */
-    spn__lattice *L = w->lat;
+    spn_world *w = ctx;
+    const spn__lattice *L = w->lat;
     spn_vec3 *x = w->x, *v = w->v;
     const double *x0 = L->x[0], *x1 = L->x[1], *x2 = L->x[2], *v0 = L->v[0], *v1 = L->v[1], *v2 = L->v[2];
-    const uint32_t rows = L->rings;
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (uint32_t r = 0; r <= rows; r++) {
+    for (uint32_t r = (uint32_t)lo; r < hi; r++) {
         size_t to, from;
         const uint32_t count = lat_row(L, r, &to, &from);
         for (uint32_t i = 0; i < count; i++) {
@@ -376,7 +381,12 @@ static void write_back(spn_world *w, int threads)
             x[d] = spn_v3(x0[s], x1[s], x2[s]), v[d] = spn_v3(v0[s], v1[s], v2[s]);
         }
     }
-    L->live = false;
+}
+
+static void write_back(spn_world *w, int threads)
+{
+    spn__lat_for(w->lat, threads, (size_t)w->lat->rings + 1, write_rows, w);
+    w->lat->live = false;
 }
 
 void spn__lattice_sync(spn_world *w)
@@ -519,8 +529,18 @@ static int lattice_threads(const spn_world *w)
      * step copies the state in and out around its sweep, and on two threads
      * took as long as on one (5.5 against 5.3 ns a spring-step, 5k web)
      * with twice the CPU. */
+    if (w->lat->team) return spn__lattice_team_size(w); /* (the team's threads, lattice_team.c) */
     if (w->np < w->def.parallel_min && !w->no_backup) return 1;
     return spn__threads(w, w->np >= w->def.parallel_min / 8 ? w->def.parallel_min : 0);
+}
+
+int spn__lattice_team_threads(spn_world *w)
+{
+    const spn_integrator in = w->def.integrator;
+    if (in != SPN_INTEGRATOR_EULER && in != SPN_INTEGRATOR_SYMPLECTIC && in != SPN_INTEGRATOR_RK4) return 1;
+    if (!applies(w)) return 1;
+    const int threads = lattice_threads(w);
+    return threads > 1 ? threads : 1;
 }
 
 /* ---- threads below parallel_min: the governor ----

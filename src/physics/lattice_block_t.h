@@ -309,6 +309,43 @@ static void (*LK(runner)(bool rk4))(LK(block) *, double *)
     return LK(run_block);
 }
 
+/* A pass as a job of spn__lat_run, a share a thread's run of bands: the
+ * ghost copies, then the fronts. */
+typedef struct LK(pass) {
+    const spn__lattice *L;
+    const LK_ARGS *la;
+    bool rk4;
+    uint32_t K;
+    int threads;
+    void (*run)(LK(block) *, double *);
+} LK(pass);
+
+/* Share t's block: its run of bands, on its workspace and sum columns. */
+static void LK(share_block)(const LK(pass) *P, int t, LK(block) *B)
+{
+    const spn__lattice *L = P->L;
+    const uint64_t nb = L->nbands, T = (uint64_t)P->threads;
+    const uint32_t b0 = (uint32_t)(nb * (uint64_t)t / T), b1 = (uint32_t)(nb * ((uint64_t)t + 1) / T);
+    LK(block_init)(B, P->la, P->rk4, (LK_T *)L->bws[t], L->cols[t], lat_band_lo(L, b0), lat_band_lo(L, b1), P->K);
+}
+
+static void LK(ghost_share)(void *ctx, int t, int thread)
+{
+    (void)thread;
+    LK(block) B;
+    LK(share_block)(ctx, t, &B);
+    LK(copy_ghosts)(&B);
+}
+
+static void LK(front_share)(void *ctx, int t, int thread)
+{
+    (void)thread;
+    const LK(pass) *P = ctx;
+    LK(block) B;
+    LK(share_block)(P, t, &B);
+    P->run(&B, P->L->partial_k);
+}
+
 /* K levels (2 .. LAT_LEVELS, spn__lattice_block_ready) in one pass over the
  * state on `threads` threads: K explicit steps, or (rk4) the four stages of
  * one RK4 step; la[s] the arguments of level s + 1, the sums of each into
@@ -319,20 +356,8 @@ static bool LK(block_pass)(spn__lattice *L, const LK_ARGS *la, bool rk4, int thr
     if (!spn__lattice_block_alloc(L, threads, LK(block_numbers)(LK(stride)(la)) * sizeof(LK_T)) ||
         !spn__lattice_cols_alloc(L, threads))
         return false;
-    const uint32_t nb = L->nbands;
-    void (*const run)(LK(block) *, double *) = LK(runner)(rk4);
-#pragma omp parallel num_threads(threads)
-    {
-        const int t = spn__thread_num();
-        const uint32_t b0 = (uint32_t)((uint64_t)nb * (uint32_t)t / (uint32_t)threads);
-        const uint32_t b1 = (uint32_t)((uint64_t)nb * (uint32_t)(t + 1) / (uint32_t)threads);
-        const uint32_t R0 = lat_band_lo(L, b0), R1 = lat_band_lo(L, b1);
-        LK(block) B;
-        LK(block_init)(&B, la, rk4, (LK_T *)L->bws[t], L->cols[t], R0, R1, K);
-        LK(copy_ghosts)(&B);
-#pragma omp barrier
-        run(&B, L->partial_k);
-    }
+    LK(pass) P = {L, la, rk4, K, threads, LK(runner)(rk4)};
+    spn__lat_run(L, threads, threads, LK(ghost_share), LK(front_share), &P);
     spn__lattice_block_sums(L, K, sums);
     return true;
 }

@@ -205,15 +205,14 @@ static const float *inv_mass32(const a32 *a) { return a->F->inv_mass; }
 /* ---- state: load, reference differences, write-back ---- */
 
 /* The reference differences x_a - x_b of every slot, from w->x. */
-static void references(spn_world *w, int threads)
+static void reference_rows(void *ctx, size_t lo, size_t hi)
 {
-    (void)threads; /* (used by OpenMP pragmas only) */
+    const spn_world *w = ctx;
     const spn__lattice *L = w->lat;
     spn__lat32 *F = L->f32;
-    const uint32_t n = L->radials, rings = L->rings;
+    const uint32_t n = L->radials;
     const spn_vec3 *x = w->x;
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (uint32_t j = 0; j < rings; j++) {
+    for (uint32_t j = (uint32_t)lo; j < hi; j++) {
         const size_t s0 = (size_t)j * n, p0 = 1 + s0;
         for (uint32_t i = 0; i < n; i++) {
             const spn_vec3 in = j ? x[p0 - n + i] : x[0], me = x[p0 + i];
@@ -227,19 +226,32 @@ static void references(spn_world *w, int threads)
     }
 }
 
+static void references(spn_world *w, int threads) { spn__lat_for(w->lat, threads, w->lat->rings, reference_rows, w); }
+
 /* d into w->x (in float64), u into w->v; with `rebase`, d starts again from
  * zero and the references follow w->x. */
+typedef struct {
+    spn_world *w;
+    bool rebase;
+} write_job;
+
+static void write_particles(void *ctx, size_t lo, size_t hi)
+{
+    const write_job *j = ctx;
+    spn__lat32 *F = j->w->lat->f32;
+    spn_vec3 *x = j->w->x, *v = j->w->v;
+    for (size_t i = lo; i < hi; i++) {
+        x[i].x += (double)F->d[0][i], x[i].y += (double)F->d[1][i], x[i].z += (double)F->d[2][i];
+        v[i] = spn_v3(F->u[0][i], F->u[1][i], F->u[2][i]);
+        if (j->rebase) F->d[0][i] = F->d[1][i] = F->d[2][i] = 0;
+    }
+}
+
 static void write_back(spn_world *w, int threads, bool rebase)
 {
     spn__lat32 *F = w->lat->f32;
-    const uint32_t np = (uint32_t)F->np;
-    spn_vec3 *x = w->x, *v = w->v;
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (uint32_t i = 0; i < np; i++) {
-        x[i].x += (double)F->d[0][i], x[i].y += (double)F->d[1][i], x[i].z += (double)F->d[2][i];
-        v[i] = spn_v3(F->u[0][i], F->u[1][i], F->u[2][i]);
-        if (rebase) F->d[0][i] = F->d[1][i] = F->d[2][i] = 0;
-    }
+    write_job job = {w, rebase};
+    spn__lat_for(w->lat, threads, F->np, write_particles, &job);
     if (rebase) references(w, threads);
     F->since = 0;
     F->live = rebase;
@@ -270,6 +282,19 @@ static bool alloc_state(spn__lattice *L, size_t np)
     return true;
 }
 
+static void load_particles(void *ctx, size_t lo, size_t hi)
+{
+    const spn_world *w = ctx;
+    spn__lat32 *F = w->lat->f32;
+    const spn_vec3 *v = w->v;
+    const double *mass = w->mass, *inv_mass = w->inv_mass;
+    for (size_t i = lo; i < hi; i++) {
+        F->mass[i] = (float)mass[i], F->inv_mass[i] = (float)inv_mass[i];
+        F->d[0][i] = F->d[1][i] = F->d[2][i] = 0;
+        F->u[0][i] = (float)v[i].x, F->u[1][i] = (float)v[i].y, F->u[2][i] = (float)v[i].z;
+    }
+}
+
 /* The float32 state from the world's: d = 0, u = v, the spring constants
  * and masses rounded, the references. */
 static bool load(spn_world *w, int threads)
@@ -277,7 +302,6 @@ static bool load(spn_world *w, int threads)
     spn__lattice *L = w->lat;
     if (!alloc_state(L, w->np)) return false;
     spn__lat32 *F = L->f32;
-    const uint32_t np = w->np;
     if (!F->params_ok)
         for (size_t s = 0; s < F->m; s++) {
             const size_t d = lat_slot(L, s);
@@ -285,14 +309,7 @@ static bool load(spn_world *w, int threads)
             F->gk[s] = (float)L->gk[d], F->gkd[s] = (float)L->gkd[d], F->gr[s] = (float)L->grest[d];
         }
     F->params_ok = true;
-    const spn_vec3 *v = w->v;
-    const double *mass = w->mass, *inv_mass = w->inv_mass;
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (uint32_t i = 0; i < np; i++) {
-        F->mass[i] = (float)mass[i], F->inv_mass[i] = (float)inv_mass[i];
-        F->d[0][i] = F->d[1][i] = F->d[2][i] = 0;
-        F->u[0][i] = (float)v[i].x, F->u[1][i] = (float)v[i].y, F->u[2][i] = (float)v[i].z;
-    }
+    spn__lat_for(L, threads, w->np, load_particles, w);
     references(w, threads);
     F->since = 0;
     F->live = true;

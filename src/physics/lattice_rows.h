@@ -152,6 +152,7 @@ struct spn__lattice {
     int ncols;
     size_t col_stride;
     lat_gov gov;
+    struct spn__lat_team *team; /* open for a spn_world_advance call (lattice_team.c), or NULL */
 };
 
 /* Where the world's slot s (ring j, radial i: s = j N + i) sits in the
@@ -380,6 +381,20 @@ static inline void lat_rk4_result(double sums[4][L_NSUMS], double dt, double dra
  * of memory. With lead 0 array 0 is the block itself, and first and pitch
  * may be NULL. */
 void *spn__lattice_arrays(size_t count, size_t n, size_t size, size_t lead, void **first, size_t *pitch);
+
+/* Parallel work (lattice_team.c). A job is two phases run in `shares`
+ * shares, first(ctx, share, thread) for every share, then (unless NULL)
+ * then(ctx, share, thread) for every share; `thread` is the running
+ * thread's number, below the thread count, for per-thread workspaces. */
+typedef void (*spn__lat_job)(void *ctx, int share, int thread);
+/* A job on up to `threads` threads: on L's team when one is open with that
+ * many, else in an OpenMP region of its own (or in order on this thread,
+ * for one). */
+void spn__lat_run(const spn__lattice *L, int threads, int shares, spn__lat_job first, spn__lat_job then, void *ctx);
+/* body(ctx, lo, hi) over [0, count) cut into `threads` contiguous chunks,
+ * as a job of spn__lat_run. */
+void spn__lat_for(const spn__lattice *L, int threads, size_t count, void (*body)(void *ctx, size_t lo, size_t hi),
+                  void *ctx);
 
 /* Temporal blocking (lattice_block_t.h, helpers in lattice_block.c). */
 /* Whether K levels can go as one blocked pass on `threads` threads (each

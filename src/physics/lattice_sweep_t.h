@@ -95,22 +95,26 @@ SPN__KERNEL static void LK(band_pass)(const LK_ARGS *a, LK_T *ws, double *cols, 
     store_band_sums(L->partial + (size_t)b * L_NSUMS, b == 0, &cs, n);
 }
 
+/* The sweep as a job of spn__lat_run, a share a band: the cut passes,
+ * then the bands. */
+static void LK(cut_share)(void *ctx, int b, int t)
+{
+    const LK_ARGS *a = ctx;
+    if (b) LK(cut_pass)(a, a->L->cols[t], (uint32_t)b);
+}
+
+static void LK(band_share)(void *ctx, int b, int t)
+{
+    const LK_ARGS *a = ctx;
+    LK(band_pass)(a, LK(ws)(a, t), a->L->cols[t], (uint32_t)b);
+}
+
 /* One force evaluation and update over the whole lattice; sums into sum[]. */
 static void LK(sweep)(const LK_ARGS *a, int threads, double *sum)
 {
-    (void)threads; /* (used by OpenMP pragmas only) */
     const spn__lattice *L = a->L;
     const uint32_t nb = L->nbands;
-#pragma omp parallel num_threads(threads)
-    {
-        const int t = spn__thread_num();
-        LK_T *ws = LK(ws)(a, t);
-        double *cols = L->cols[t];
-#pragma omp for schedule(static)
-        for (uint32_t b = 1; b < nb; b++) LK(cut_pass)(a, cols, b);
-#pragma omp for schedule(static)
-        for (uint32_t b = 0; b < nb; b++) LK(band_pass)(a, ws, cols, b);
-    }
+    spn__lat_run(L, threads, (int)nb, LK(cut_share), LK(band_share), (void *)a);
     for (int k = 0; k < L_NSUMS; k++) sum[k] = 0;
     for (uint32_t b = 0; b < nb; b++)
         for (int k = 0; k < L_NSUMS; k++) sum[k] += L->partial[(size_t)b * L_NSUMS + k];

@@ -180,34 +180,30 @@ static void add_step(spn_step_report *total, const spn_step_report *last)
     total->breaks += last->breaks;
 }
 
-/* Replayable runs keep one copy of the state per call, in x0 and v0, instead
- * of one per step. On a blow-up at step j the world goes back to that copy,
- * replays the j good steps (bit-identical: same world, same calls) and takes
- * step j again with a backup, which fails as before and restores the state
- * from before it, with the usual message. */
-spn_status spn_world_advance(spn_world *w, double dt, int n)
+/* An spn_world_advance call's steps (advance_steps). */
+typedef struct {
+    double dt;
+    int n;
+    bool replay;
+    spn_step_report total;
+} advance_run;
+
+/* The steps of an advance call, the state at its start in x0 and v0 when
+ * replayable (spn_world_advance). */
+static spn_status advance_steps(spn_world *w, void *ctx)
 {
-    spn_status st = check_dt(dt);
-    if (st != SPN_OK) return st;
-    if (n < 1) return spn_error(SPN_ERR_INVALID, "spn_world_advance: step count must be at least 1, not %d", n);
-    st = spn_world_compile(w);
-    if (st != SPN_OK) return st;
-    spn_step_report total = {.dt = dt};
-    const bool replay = n > 1 && replayable(w);
-    const double t0 = w->t, work0 = w->external_work, diss0 = w->dissipated;
+    advance_run *a = ctx;
+    const double dt = a->dt, t0 = w->t, work0 = w->external_work, diss0 = w->dissipated;
     const uint64_t steps0 = w->steps;
-    if (replay) {
-        memcpy(w->x0, w->x, w->np * sizeof *w->x);
-        memcpy(w->v0, w->v, w->np * sizeof *w->v);
-        w->no_backup = true;
-    }
-    for (int j = 0; j < n;) {
+    spn_step_report *total = &a->total;
+    spn_status st = SPN_OK;
+    for (int j = 0; j < a->n;) {
         int done = 0;
-        st = replay ? block_steps(w, dt, n - j, &done) : SPN_OK;
-        j += done, total.substeps += done, total.blocked += done; /* (one sub-step each, no breaks) */
+        st = a->replay ? block_steps(w, dt, a->n - j, &done) : SPN_OK;
+        j += done, total->substeps += done, total->blocked += done; /* (one sub-step each, no breaks) */
         if (st == SPN_OK && done == 0) {
             st = step_once(w, dt);
-            if (st == SPN_OK) j++, add_step(&total, &w->last);
+            if (st == SPN_OK) j++, add_step(total, &w->last);
         }
         if (st == SPN_ERR_UNSTABLE && w->no_backup) {
             spn__lattice_discard(w);
@@ -217,13 +213,38 @@ spn_status spn_world_advance(spn_world *w, double dt, int n)
             for (int q = 0; q < j; q++) step_once(w, dt);
             w->no_backup = false;
             st = step_once(w, dt);
-            if (st == SPN_OK) j++, add_step(&total, &w->last);
+            if (st == SPN_OK) j++, add_step(total, &w->last);
         }
         if (st != SPN_OK) break;
     }
+    return st;
+}
+
+/* Replayable runs keep one copy of the state per call, in x0 and v0, instead
+ * of one per step. On a blow-up at step j the world goes back to that copy,
+ * replays the j good steps (bit-identical: same world, same calls) and takes
+ * step j again with a backup, which fails as before and restores the state
+ * from before it, with the usual message. A replayable run on the lattice
+ * with threads keeps them as a team for the whole call (lattice_team.c). */
+spn_status spn_world_advance(spn_world *w, double dt, int n)
+{
+    spn_status st = check_dt(dt);
+    if (st != SPN_OK) return st;
+    if (n < 1) return spn_error(SPN_ERR_INVALID, "spn_world_advance: step count must be at least 1, not %d", n);
+    st = spn_world_compile(w);
+    if (st != SPN_OK) return st;
+    advance_run a = {.dt = dt, .n = n, .replay = n > 1 && replayable(w), .total = {.dt = dt}};
+    if (a.replay) {
+        memcpy(w->x0, w->x, w->np * sizeof *w->x);
+        memcpy(w->v0, w->v, w->np * sizeof *w->v);
+        w->no_backup = true;
+        st = spn__lattice_team_call(w, spn__lattice_team_threads(w), advance_steps, &a);
+    } else {
+        st = advance_steps(w, &a);
+    }
     spn__lattice_sync(w);
     w->no_backup = false;
-    w->last = total;
+    w->last = a.total;
     return st;
 }
 

@@ -367,6 +367,18 @@ bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r);
  * done (0: take single steps), results in r[]. */
 #define SPN__LAT_BLOCK_MAX 4
 int spn__lattice_block_steps(spn_world *w, double dt, int k, spn__step_result *r);
+/* The threads a replayable advance's lattice steps would take (the team
+ * worth opening for it), 1 when none or when the lattice does not apply. */
+int spn__lattice_team_threads(spn_world *w);
+/* body(w, ctx) on this thread with a team of `threads` open for the
+ * lattice's parallel work (lattice_team.c); its status. */
+spn_status spn__lattice_team_call(spn_world *w, int threads, spn_status (*body)(spn_world *, void *), void *ctx);
+/* The open team's size, 0 when none. */
+int spn__lattice_team_size(const spn_world *w);
+/* Tests: how long a team's waiting threads spin (pause-spins) and yield
+ * before a worker sleeps; negative restores the default. Set between
+ * calls only. */
+void spn__lat_team_set_patience(int spins, int yields);
 /* The memory traffic a lattice step cannot avoid, in bytes per step, over
  * an spn_world_advance call of `steps` steps of which `blocked` were taken in
  * blocked passes (spn_step_report.blocked); a model (lattice.c). 0 when the
