@@ -534,14 +534,6 @@ static int lattice_threads(const spn_world *w)
     return spn__threads(w, w->np >= w->def.parallel_min / 8 ? w->def.parallel_min : 0);
 }
 
-int spn__lattice_team_threads(spn_world *w)
-{
-    const spn_integrator in = w->def.integrator;
-    if (in != SPN_INTEGRATOR_EULER && in != SPN_INTEGRATOR_SYMPLECTIC && in != SPN_INTEGRATOR_RK4) return 1;
-    if (!applies(w)) return 1;
-    const int threads = lattice_threads(w);
-    return threads > 1 ? threads : 1;
-}
 
 /* ---- threads below parallel_min: the governor ----
  *
@@ -656,6 +648,28 @@ static void gov_end(spn_world *w, uint32_t levels)
     const double now = seconds_now();
     spn__lat_gov_record(g, (now - g->t0) * 1e9 / ((double)w->np * levels), now);
     g->t0 = -1;
+}
+
+/* A team for a replayable advance call (lattice_team.c) when its steps
+ * would go on threads: on a web the governor rules, only when its pick now
+ * is threads. A team's threads must all get a core to start and to end
+ * it, so on a busy machine, where the governor keeps one thread, opening
+ * one each call would wait for the scheduler each call (5k web, one other
+ * program spinning: 2.8-3.0 ns a spring-step against one thread's 2.3);
+ * the passes then go as before, a try of threads in a region of its own. */
+int spn__lattice_team_threads(spn_world *w)
+{
+    const spn_integrator in = w->def.integrator;
+    if (in != SPN_INTEGRATOR_EULER && in != SPN_INTEGRATOR_SYMPLECTIC && in != SPN_INTEGRATOR_RK4) return 1;
+    if (!applies(w)) return 1;
+    const int threads = lattice_threads(w);
+    if (threads < 2) return 1;
+    if (w->np < w->def.parallel_min) {
+        lat_gov *g = &w->lat->gov;
+        const int mode = g->t0 >= 0 ? g->mode : spn__lat_gov_pick(g, seconds_now());
+        if (!mode) return 1;
+    }
+    return threads;
 }
 
 /* Threads for this world's bands, and the bands ready; 0 when the lattice

@@ -232,9 +232,9 @@ spn_status spn__lattice_team_call(spn_world *w, int threads, spn_status (*body)(
 #pragma omp parallel num_threads(threads)
     {
         const int t = spn__thread_num();
-        if (t == 0) T.size = spn__thread_count();
-#pragma omp barrier
+        /* (no barrier here: a worker reads size only after a post) */
         if (t == 0) {
+            T.size = spn__thread_count();
             if (T.size > 1) L->team = &T;
             st = body(w, ctx);
             L->team = NULL;
