@@ -14,13 +14,14 @@
 #include <cmocka.h>
 
 #include <math.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include <spinneret/spinneret.h>
 
-#include "physics/lattice_rows.h"    /* lat_gov, spn__lat_gov_pick */
+#include "physics/lattice_rows.h"    /* lat_gov, spn__lat_gov_pick, spn__lat_run */
 #include "physics/world_internal.h" /* spn__lattice_step_bytes, _gov_prefer, _set_unblocked */
 
 /* The standard web with a disturbed state: random velocities (seeded), one
@@ -292,6 +293,96 @@ static void test_team_asleep_between_jobs(void **state)
     spn_world_destroy(blk);
     spn_world_destroy(ref);
     spn__lat_team_set_patience(-1, -1);
+}
+
+/* What the jobs of spn__lat_run did: each share's runs of each phase, any
+ * second-phase share that began before every first-phase share was done,
+ * any thread number out of range. */
+typedef struct {
+    int shares, threads;
+    atomic_int first_done, bad;
+    atomic_int first[40], then[40];
+    atomic_int covered[1000];
+} job_log;
+
+static void log_first(void *p, int s, int t)
+{
+    job_log *j = p;
+    if (t < 0 || t >= j->threads) atomic_store(&j->bad, 1);
+    atomic_fetch_add(&j->first[s], 1);
+    atomic_fetch_add(&j->first_done, 1);
+}
+
+static void log_then(void *p, int s, int t)
+{
+    job_log *j = p;
+    if (t < 0 || t >= j->threads || atomic_load(&j->first_done) != j->shares) atomic_store(&j->bad, 1);
+    atomic_fetch_add(&j->then[s], 1);
+}
+
+static void log_range(void *p, size_t lo, size_t hi)
+{
+    job_log *j = p;
+    for (size_t i = lo; i < hi; i++) atomic_fetch_add(&j->covered[i], 1);
+}
+
+/* Jobs of every shape on threads (the team's size, fewer, one) and loops of
+ * spn__lat_for: each share of each phase once, the second phase after the
+ * whole first, every index once. */
+static void check_jobs(const spn_world *w, int threads)
+{
+    const int shares[] = {1, 2, 3, 5, 40};
+    for (int k = 0; k < 5; k++)
+        for (int with_then = 0; with_then < 2; with_then++) {
+            job_log *j = calloc(1, sizeof *j);
+            assert_non_null(j);
+            j->shares = shares[k], j->threads = threads;
+            spn__lat_run(w->lat, threads, shares[k], log_first, with_then ? log_then : NULL, j);
+            assert_int_equal(atomic_load(&j->bad), 0);
+            for (int s = 0; s < shares[k]; s++) {
+                assert_int_equal(atomic_load(&j->first[s]), 1);
+                assert_int_equal(atomic_load(&j->then[s]), with_then);
+            }
+            free(j);
+        }
+    const size_t counts[] = {0, 1, 7, 1000};
+    for (int k = 0; k < 4; k++) {
+        job_log *j = calloc(1, sizeof *j);
+        assert_non_null(j);
+        spn__lat_for(w->lat, threads, counts[k], log_range, j);
+        for (size_t i = 0; i < 1000; i++) assert_int_equal(atomic_load(&j->covered[i]), i < counts[k]);
+        free(j);
+    }
+}
+
+static spn_status team_body(spn_world *w, void *ctx)
+{
+    (void)ctx;
+    assert_int_equal(spn__lattice_team_size(w), 2);
+    check_jobs(w, 2);
+    check_jobs(w, 1);
+    return SPN_ERR_INVALID; /* passed back */
+}
+
+/* spn__lat_run and spn__lat_for outside a team (an OpenMP region each, or
+ * in order on one thread) and inside one, with the workers spinning and
+ * with them asleep between jobs. */
+static void test_team_jobs(void **state)
+{
+    (void)state;
+    spn_world *w = disturbed_orb(SPN_INTEGRATOR_SYMPLECTIC, 9, 13, 2, 0, true);
+    assert_int_equal(spn_world_advance(w, 2e-6, 2), SPN_OK); /* the lattice built */
+    assert_non_null(w->lat);
+    check_jobs(w, 2);
+    check_jobs(w, 1);
+    assert_int_equal(spn__lattice_team_size(w), 0);
+    for (int patience = 0; patience < 2; patience++) {
+        if (!patience) spn__lat_team_set_patience(0, 0);
+        assert_int_equal(spn__lattice_team_call(w, 2, team_body, NULL), SPN_ERR_INVALID);
+        spn__lat_team_set_patience(-1, -1);
+    }
+    assert_int_equal(spn__lattice_team_size(w), 0);
+    spn_world_destroy(w);
 }
 
 /* The float64 RK4 pass in each of its versions (SPN_RK4_AVX2=0: the one
@@ -673,6 +764,7 @@ int main(void)
         cmocka_unit_test(test_same_gravity_and_drag),
         cmocka_unit_test(test_bands_and_threads),
         cmocka_unit_test(test_blocked_passes),
+        cmocka_unit_test(test_team_jobs),
         cmocka_unit_test(test_team_asleep_between_jobs),
         cmocka_unit_test(test_rk4_pass_versions),
         cmocka_unit_test(test_blocked_passes_float32),
