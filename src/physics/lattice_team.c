@@ -22,12 +22,12 @@
  * thread (lattice.c, a busy machine) leaves the other core free after a
  * fraction of a millisecond.
  *
- * Outside a team (spn_world_step, or threads the team does not have) a
- * job runs in an OpenMP region of its own, as before. Either way a job is
- * two phases, `first` for every share, then `then` for every share: the
- * work between them is a barrier, and the shares of a phase may run in any
- * order on any thread, so the results cannot depend on which thread ran
- * what. */
+ * Outside a team (spn_world_step, a call the governor keeps on one thread
+ * at its start, or threads the team does not have) a job runs in an OpenMP
+ * region of its own, as before. Either way a job is two phases, `first`
+ * for every share, then `then` for every share, with a barrier between
+ * them; the shares of a phase may run in any order on any thread, so the
+ * results cannot depend on which thread ran what. */
 #include "lattice_rows.h"
 #include "world_internal.h"
 
@@ -52,9 +52,9 @@ void spn__lat_team_set_patience(int spins, int yields)
 typedef struct spn__lat_team {
     int size;                    /* threads: the master (0) and size - 1 workers */
     _Atomic unsigned posted;     /* jobs posted (a worker runs each once) */
-    _Atomic int left;            /* workers not yet done with the current phase */
-    _Atomic unsigned phase_gen;  /* the current job's phases released */
-    _Atomic int phase_left;      /* shares of the current phase not yet done */
+    _Atomic int left;            /* workers not yet done with the current job */
+    _Atomic unsigned phase_gen;  /* the current job's barrier passed (its count) */
+    _Atomic int phase_left;      /* threads not yet at the current job's barrier */
     _Atomic int sleepers;        /* workers asleep on `wake` or about to be */
     spn__lat_job first, then;    /* the job (NULL first: leave the team) */
     void *ctx;
@@ -237,7 +237,7 @@ spn_status spn__lattice_team_call(spn_world *w, int threads, spn_status (*body)(
             T.size = spn__thread_count();
             if (T.size > 1) L->team = &T;
             st = body(w, ctx);
-            L->team = NULL;
+            if (w->lat) w->lat->team = NULL; /* (w->lat again: a replayable run keeps its lattice, but in case) */
             if (T.size > 1) post(&T, NULL, NULL, NULL, 0);
         } else {
             serve(&T, t);
