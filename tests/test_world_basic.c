@@ -44,6 +44,54 @@ static void expect_refused(spn_status st, const char *who, const char *field)
     assert_non_null(strstr(spn_last_error(), field));
 }
 
+/* A world made from settings out of range is made (spn_world_create keeps
+ * what it is given) but will not step: the step names the field, and the
+ * state is as it was. An integrator set out of range later is caught the
+ * same way. */
+static void test_bad_world_def_refused(void **state)
+{
+    (void)state;
+    for (int field = 0; field < 13; field++) {
+        spn_world_def wd = spn_world_def_default();
+        const char *name = NULL;
+        switch (field) {
+        case 0: wd.gravity.y = NAN, name = "gravity"; break;
+        case 1: wd.drag = -0.5, name = "drag"; break;
+        case 2: wd.drag = INFINITY, name = "drag"; break;
+        case 3: wd.integrator = (spn_integrator)SPN_INTEGRATOR_COUNT, name = "integrator"; break;
+        case 4: wd.threads = -2, name = "threads"; break;
+        case 5: wd.dt_min = 0, name = "dt_min"; break;
+        case 6: wd.dt_factor = 1, name = "dt_factor"; break;
+        case 7: wd.energy_jump = NAN, name = "energy_jump"; break;
+        case 8: wd.cg_tolerance = 0, name = "cg_tolerance"; break;
+        case 9: wd.cg_max_iterations = 0, name = "cg_max_iterations"; break;
+        case 10: wd.provot_max_strain = -0.1, name = "provot_max_strain"; break;
+        case 11: wd.provot_iterations = -1, name = "provot_iterations"; break;
+        default: name = "integrator"; break; /* set after, below */
+        }
+        spn_world *w = spn_world_create(&wd);
+        assert_non_null(w);
+        spn_particle_def p = spn_particle_def_default();
+        p.fixed = true;
+        assert_int_equal(spn_world_add_particle(w, &p, NULL), SPN_OK);
+        p.fixed = false, p.position = spn_v3(1, 0, 0), p.velocity = spn_v3(0, 1, 0);
+        assert_int_equal(spn_world_add_particle(w, &p, NULL), SPN_OK);
+        spn_spring_def s = spn_spring_def_default();
+        s.a = 0, s.b = 1;
+        assert_int_equal(spn_world_add_spring(w, &s, NULL), SPN_OK);
+        if (field == 12) {
+            assert_int_equal(spn_world_step(w, 1e-3), SPN_OK);
+            spn_world_set_integrator(w, (spn_integrator)-1);
+        }
+        const spn_vec3 x = spn_world_positions(w)[1];
+        expect_refused(spn_world_step(w, 1e-3), "world settings", name);
+        expect_refused(spn_world_advance(w, 1e-3, 10), "world settings", name);
+        const spn_vec3 y = spn_world_positions(w)[1];
+        assert_memory_equal(&x, &y, sizeof x);
+        spn_world_destroy(w);
+    }
+}
+
 static void test_bad_settings_refused(void **state)
 {
     (void)state;
@@ -171,6 +219,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bad_additions_refused),
+        cmocka_unit_test(test_bad_world_def_refused),
         cmocka_unit_test(test_bad_settings_refused),
         cmocka_unit_test(test_particle_def_round_trip),
         cmocka_unit_test(test_spring_def_round_trip),

@@ -94,6 +94,9 @@ typedef struct spn_spring_info {
     double tension;  ///< current elastic force k(|l| - r), 0 if broken or slack [N]
 } spn_spring_info;
 
+/// A world with these settings (NULL: spn_world_def_default()); NULL only when
+/// out of memory. Settings out of range are kept: spn_world_compile, and so
+/// the first step, refuses them with SPN_ERR_INVALID naming the field.
 SPN_API spn_world *spn_world_create(const spn_world_def *def);
 SPN_API void spn_world_destroy(spn_world *w);
 /// A deep copy (particles, springs, state, settings; callbacks too).

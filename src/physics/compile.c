@@ -160,6 +160,10 @@ static void build_adjacency(spn_world *w, uint32_t *fill)
 
 spn_status spn_world_compile(spn_world *w)
 {
+    /* (every step, not only the first: spn_world_set_integrator takes any
+     * value) */
+    spn_status st = spn__check_settings(&w->def);
+    if (st != SPN_OK) return st;
     if (w->compiled) return SPN_OK;
     spn__free_compiled(w);
     if (w->np > SPN__END_MASK)

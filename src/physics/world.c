@@ -374,6 +374,38 @@ spn_status spn_world_set_solver_tolerance(spn_world *w, double cg_tolerance, int
     w->def.cg_max_iterations = cg_max_iterations;
     return SPN_OK;
 }
+spn_status spn__check_settings(const spn_world_def *d)
+{
+    const char *const what = "world settings (spn_world_def)";
+    if (!spn_v3_finite(d->gravity))
+        return spn_error(SPN_ERR_INVALID, "%s: gravity must be finite, not (%g, %g, %g)", what, d->gravity.x,
+                         d->gravity.y, d->gravity.z);
+    if (!(d->drag >= 0) || !isfinite(d->drag))
+        return spn_error(SPN_ERR_INVALID, "%s: drag must be finite and not negative, not %g", what, d->drag);
+    if ((unsigned)d->integrator >= SPN_INTEGRATOR_COUNT)
+        return spn_error(SPN_ERR_INVALID, "%s: integrator %d is none of the %d there are", what, (int)d->integrator,
+                         SPN_INTEGRATOR_COUNT);
+    if (d->threads < 0) return spn_error(SPN_ERR_INVALID, "%s: threads must not be negative, not %d", what, d->threads);
+    if (!(d->dt_min > 0) || !isfinite(d->dt_min))
+        return spn_error(SPN_ERR_INVALID, "%s: dt_min must be finite and positive, not %g", what, d->dt_min);
+    if (!(d->dt_factor > 1) || !isfinite(d->dt_factor))
+        return spn_error(SPN_ERR_INVALID, "%s: dt_factor must be finite and above 1, not %g", what, d->dt_factor);
+    if (!(d->energy_jump > 0))
+        return spn_error(SPN_ERR_INVALID, "%s: energy_jump must be positive, not %g", what, d->energy_jump);
+    if (!(d->cg_tolerance > 0 && d->cg_tolerance < 1))
+        return spn_error(SPN_ERR_INVALID, "%s: cg_tolerance must be in (0, 1), not %g", what, d->cg_tolerance);
+    if (d->cg_max_iterations < 1)
+        return spn_error(SPN_ERR_INVALID, "%s: cg_max_iterations must be at least 1, not %d", what,
+                         d->cg_max_iterations);
+    if (!(d->provot_max_strain >= 0) || !isfinite(d->provot_max_strain))
+        return spn_error(SPN_ERR_INVALID, "%s: provot_max_strain must be finite and not negative, not %g", what,
+                         d->provot_max_strain);
+    if (d->provot_iterations < 0)
+        return spn_error(SPN_ERR_INVALID, "%s: provot_iterations must not be negative, not %d", what,
+                         d->provot_iterations);
+    return SPN_OK;
+}
+
 /* gravity and drag as a web file's world settings have them (web_read.c) */
 spn_status spn_world_set_gravity(spn_world *w, spn_vec3 g)
 {

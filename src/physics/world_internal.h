@@ -236,6 +236,10 @@ spn__spring spn__hot_spring(const spn_world *w, uint32_t s);
 
 /* Threads for a loop over n items (1 below def.parallel_min). */
 int spn__threads(const spn_world *w, uint32_t n);
+/* The world's settings (spn_world_def) checked, each field in its range;
+ * SPN_ERR_INVALID naming the first that is not (spn_world_compile calls
+ * it: spn_world_create keeps whatever it is given). */
+spn_status spn__check_settings(const spn_world_def *d);
 /* Ensure the first `count` per-particle scratch buffers exist. */
 spn_status spn__scratch(spn_world *w, int count);
 /* Sum the SPN_NSUMS partials of `blocks` blocks in block order into out[]. */
