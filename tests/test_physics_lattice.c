@@ -191,6 +191,28 @@ static void assert_passes_match(spn_world *one, spn_world *two, const spn_world 
     assert_true(fastest(one) > 0.01);
 }
 
+/* A step far too long on two threads: spn_world_advance's pass blows up,
+ * the run is replayed, and the message and the state are those of single
+ * steps (spn_world_step) up to the same step. */
+static void assert_blowup_replayed(void)
+{
+    spn_world *blk = disturbed_orb(SPN_INTEGRATOR_SYMPLECTIC, 40, 50, 2, 256, true);
+    spn_world *ref = disturbed_orb(SPN_INTEGRATOR_SYMPLECTIC, 40, 50, 2, 256, true);
+    const double big = 6e-5;
+    int failed_at = -1;
+    for (int i = 0; i < 400 && failed_at < 0; i++)
+        if (spn_world_step(ref, big) != SPN_OK) failed_at = i;
+    assert_true(failed_at > 0);
+    char want[512];
+    snprintf(want, sizeof want, "%s", spn_last_error());
+    assert_int_equal(spn_world_advance(blk, big, 400), SPN_ERR_UNSTABLE);
+    assert_string_equal(spn_last_error(), want);
+    assert_same_state(blk, ref);
+    print_message("blow-up at step %d in both: %s\n", failed_at + 1, want);
+    spn_world_destroy(blk);
+    spn_world_destroy(ref);
+}
+
 /* Steps several to a pass over memory (spn_world_advance on a web of at
  * least def.parallel_min particles, lattice_block.c: four explicit steps or
  * the four stages of an RK4 step to a pass): the same bits as single steps, in the state and in the energy books, on 1 and 2 threads, and a
@@ -220,21 +242,7 @@ static void test_blocked_passes(void **state)
     }
     /* a step far too long: the pass blows up, the run is replayed and the
      * message names the same step as single steps give */
-    spn_world *blk = disturbed_orb(SPN_INTEGRATOR_SYMPLECTIC, 40, 50, 2, 256, true);
-    spn_world *ref = disturbed_orb(SPN_INTEGRATOR_SYMPLECTIC, 40, 50, 2, 256, true);
-    const double big = 6e-5;
-    int failed_at = -1;
-    for (int i = 0; i < 400 && failed_at < 0; i++)
-        if (spn_world_step(ref, big) != SPN_OK) failed_at = i;
-    assert_true(failed_at > 0);
-    char want[512];
-    snprintf(want, sizeof want, "%s", spn_last_error());
-    assert_int_equal(spn_world_advance(blk, big, 400), SPN_ERR_UNSTABLE);
-    assert_string_equal(spn_last_error(), want);
-    assert_same_state(blk, ref);
-    print_message("blow-up at step %d in both: %s\n", failed_at + 1, want);
-    spn_world_destroy(blk);
-    spn_world_destroy(ref);
+    assert_blowup_replayed();
 }
 
 /* A replayable advance on two threads keeps them as a team for the call
@@ -279,19 +287,7 @@ static void test_team_asleep_between_jobs(void **state)
     spn_world_destroy(two);
     spn_world_destroy(one);
     /* a blow-up inside the team: replayed, the same step named */
-    spn_world *blk = disturbed_orb(SPN_INTEGRATOR_SYMPLECTIC, 40, 50, 2, 256, true);
-    spn_world *ref = disturbed_orb(SPN_INTEGRATOR_SYMPLECTIC, 40, 50, 2, 256, true);
-    int failed_at = -1;
-    for (int i = 0; i < 400 && failed_at < 0; i++)
-        if (spn_world_step(ref, 6e-5) != SPN_OK) failed_at = i;
-    assert_true(failed_at > 0);
-    char want[512];
-    snprintf(want, sizeof want, "%s", spn_last_error());
-    assert_int_equal(spn_world_advance(blk, 6e-5, 400), SPN_ERR_UNSTABLE);
-    assert_string_equal(spn_last_error(), want);
-    assert_same_state(blk, ref);
-    spn_world_destroy(blk);
-    spn_world_destroy(ref);
+    assert_blowup_replayed();
     spn__lat_team_set_patience(-1, -1);
 }
 
