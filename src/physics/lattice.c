@@ -471,11 +471,15 @@ static bool applies(const spn_world *w)
     return w->compiled && w->lat && !w->lattice_off && !w->force_fn && !spn__air_active(w) && !w->nhyst;
 }
 
+/* The integrators the lattice steps: Euler, symplectic Euler and RK4. */
+static bool lattice_integrator(spn_integrator in)
+{
+    return in == SPN_INTEGRATOR_EULER || in == SPN_INTEGRATOR_SYMPLECTIC || in == SPN_INTEGRATOR_RK4;
+}
+
 const char *spn_world_step_path(const spn_world *w)
 {
-    const spn_integrator in = w->def.integrator;
-    const bool explicit = in == SPN_INTEGRATOR_EULER || in == SPN_INTEGRATOR_SYMPLECTIC || in == SPN_INTEGRATOR_RK4;
-    return explicit && applies(w) ? "lattice" : "general";
+    return lattice_integrator(w->def.integrator) && applies(w) ? "lattice" : "general";
 }
 
 void spn_world_set_lattice(spn_world *w, bool allow) { w->lattice_off = !allow; }
@@ -533,7 +537,6 @@ static int lattice_threads(const spn_world *w)
     if (w->np < w->def.parallel_min && !w->no_backup) return 1;
     return spn__threads(w, w->np >= w->def.parallel_min / 8 ? w->def.parallel_min : 0);
 }
-
 
 /* ---- threads below parallel_min: the governor ----
  *
@@ -659,9 +662,7 @@ static void gov_end(spn_world *w, uint32_t levels)
  * the passes then go as before, a try of threads in a region of its own. */
 int spn__lattice_team_threads(spn_world *w)
 {
-    const spn_integrator in = w->def.integrator;
-    if (in != SPN_INTEGRATOR_EULER && in != SPN_INTEGRATOR_SYMPLECTIC && in != SPN_INTEGRATOR_RK4) return 1;
-    if (!applies(w)) return 1;
+    if (!lattice_integrator(w->def.integrator) || !applies(w)) return 1;
     const int threads = lattice_threads(w);
     if (threads < 2) return 1;
     if (w->np < w->def.parallel_min) {
@@ -772,7 +773,7 @@ int spn__lattice_block_steps(spn_world *w, double dt, int k, spn__step_result *r
 {
     const spn_integrator in = w->def.integrator;
     const bool rk4 = in == SPN_INTEGRATOR_RK4;
-    if (!rk4 && in != SPN_INTEGRATOR_EULER && in != SPN_INTEGRATOR_SYMPLECTIC) return 0;
+    if (!lattice_integrator(in)) return 0;
     if (k > LAT_LEVELS) k = LAT_LEVELS;
     const uint32_t levels = rk4 ? 4 : (uint32_t)k;
     if (levels < 2 || !w->no_backup) return 0;

@@ -228,8 +228,7 @@ static void reference_rows(void *ctx, size_t lo, size_t hi)
 
 static void references(spn_world *w, int threads) { spn__lat_for(w->lat, threads, w->lat->rings, reference_rows, w); }
 
-/* d into w->x (in float64), u into w->v; with `rebase`, d starts again from
- * zero and the references follow w->x. */
+/* write_back's arguments, for its job. */
 typedef struct {
     spn_world *w;
     bool rebase;
@@ -247,6 +246,8 @@ static void write_particles(void *ctx, size_t lo, size_t hi)
     }
 }
 
+/* d into w->x (in float64), u into w->v; with `rebase`, d starts again from
+ * zero and the references follow w->x. */
 static void write_back(spn_world *w, int threads, bool rebase)
 {
     spn__lat32 *F = w->lat->f32;
@@ -282,6 +283,7 @@ static bool alloc_state(spn__lattice *L, size_t np)
     return true;
 }
 
+/* Particles [lo, hi): masses and velocities rounded, displacements zero. */
 static void load_particles(void *ctx, size_t lo, size_t hi)
 {
     const spn_world *w = ctx;
