@@ -364,44 +364,61 @@ bool spn_world_lattice_allowed(const spn_world *w) { return !w->lattice_off; }
 
 void spn_world_set_integrator(spn_world *w, spn_integrator integrator) { w->def.integrator = integrator; }
 
-spn_status spn_world_set_solver_tolerance(spn_world *w, double cg_tolerance, int cg_max_iterations)
+/* The settings a setter and spn__check_settings both check; `where`
+ * starts the message ("" from a setter). */
+static spn_status check_solver(const char *where, double cg_tolerance, int cg_max_iterations)
 {
     if (!(cg_tolerance > 0 && cg_tolerance < 1))
-        return spn_error(SPN_ERR_INVALID, "cg_tolerance must be in (0, 1), not %g", cg_tolerance);
+        return spn_error(SPN_ERR_INVALID, "%scg_tolerance must be in (0, 1), not %g", where, cg_tolerance);
     if (cg_max_iterations < 1)
-        return spn_error(SPN_ERR_INVALID, "cg_max_iterations must be at least 1, not %d", cg_max_iterations);
+        return spn_error(SPN_ERR_INVALID, "%scg_max_iterations must be at least 1, not %d", where, cg_max_iterations);
+    return SPN_OK;
+}
+
+static spn_status check_gravity(const char *where, spn_vec3 g)
+{
+    if (!spn_v3_finite(g))
+        return spn_error(SPN_ERR_INVALID, "%sgravity must be finite, not (%g, %g, %g)", where, g.x, g.y, g.z);
+    return SPN_OK;
+}
+
+static spn_status check_drag(const char *where, double drag)
+{
+    if (!(drag >= 0) || !isfinite(drag))
+        return spn_error(SPN_ERR_INVALID, "%sdrag must be finite and not negative, not %g", where, drag);
+    return SPN_OK;
+}
+
+spn_status spn_world_set_solver_tolerance(spn_world *w, double cg_tolerance, int cg_max_iterations)
+{
+    const spn_status st = check_solver("", cg_tolerance, cg_max_iterations);
+    if (st != SPN_OK) return st;
     w->def.cg_tolerance = cg_tolerance;
     w->def.cg_max_iterations = cg_max_iterations;
     return SPN_OK;
 }
 spn_status spn__check_settings(const spn_world_def *d)
 {
-    const char *const what = "world settings (spn_world_def)";
-    if (!spn_v3_finite(d->gravity))
-        return spn_error(SPN_ERR_INVALID, "%s: gravity must be finite, not (%g, %g, %g)", what, d->gravity.x,
-                         d->gravity.y, d->gravity.z);
-    if (!(d->drag >= 0) || !isfinite(d->drag))
-        return spn_error(SPN_ERR_INVALID, "%s: drag must be finite and not negative, not %g", what, d->drag);
+    const char *const what = "world settings (spn_world_def): ";
+    spn_status st = check_gravity(what, d->gravity);
+    if (st == SPN_OK) st = check_drag(what, d->drag);
+    if (st == SPN_OK) st = check_solver(what, d->cg_tolerance, d->cg_max_iterations);
+    if (st != SPN_OK) return st;
     if ((unsigned)d->integrator >= SPN_INTEGRATOR_COUNT)
-        return spn_error(SPN_ERR_INVALID, "%s: integrator %d is none of the %d there are", what, (int)d->integrator,
+        return spn_error(SPN_ERR_INVALID, "%sintegrator %d is none of the %d there are", what, (int)d->integrator,
                          SPN_INTEGRATOR_COUNT);
-    if (d->threads < 0) return spn_error(SPN_ERR_INVALID, "%s: threads must not be negative, not %d", what, d->threads);
+    if (d->threads < 0) return spn_error(SPN_ERR_INVALID, "%sthreads must not be negative, not %d", what, d->threads);
     if (!(d->dt_min > 0) || !isfinite(d->dt_min))
-        return spn_error(SPN_ERR_INVALID, "%s: dt_min must be finite and positive, not %g", what, d->dt_min);
+        return spn_error(SPN_ERR_INVALID, "%sdt_min must be finite and positive, not %g", what, d->dt_min);
     if (!(d->dt_factor > 1) || !isfinite(d->dt_factor))
-        return spn_error(SPN_ERR_INVALID, "%s: dt_factor must be finite and above 1, not %g", what, d->dt_factor);
+        return spn_error(SPN_ERR_INVALID, "%sdt_factor must be finite and above 1, not %g", what, d->dt_factor);
     if (!(d->energy_jump > 0))
-        return spn_error(SPN_ERR_INVALID, "%s: energy_jump must be positive, not %g", what, d->energy_jump);
-    if (!(d->cg_tolerance > 0 && d->cg_tolerance < 1))
-        return spn_error(SPN_ERR_INVALID, "%s: cg_tolerance must be in (0, 1), not %g", what, d->cg_tolerance);
-    if (d->cg_max_iterations < 1)
-        return spn_error(SPN_ERR_INVALID, "%s: cg_max_iterations must be at least 1, not %d", what,
-                         d->cg_max_iterations);
+        return spn_error(SPN_ERR_INVALID, "%senergy_jump must be positive, not %g", what, d->energy_jump);
     if (!(d->provot_max_strain >= 0) || !isfinite(d->provot_max_strain))
-        return spn_error(SPN_ERR_INVALID, "%s: provot_max_strain must be finite and not negative, not %g", what,
+        return spn_error(SPN_ERR_INVALID, "%sprovot_max_strain must be finite and not negative, not %g", what,
                          d->provot_max_strain);
     if (d->provot_iterations < 0)
-        return spn_error(SPN_ERR_INVALID, "%s: provot_iterations must not be negative, not %d", what,
+        return spn_error(SPN_ERR_INVALID, "%sprovot_iterations must not be negative, not %d", what,
                          d->provot_iterations);
     return SPN_OK;
 }
@@ -409,14 +426,15 @@ spn_status spn__check_settings(const spn_world_def *d)
 /* gravity and drag as a web file's world settings have them (web_read.c) */
 spn_status spn_world_set_gravity(spn_world *w, spn_vec3 g)
 {
-    if (!spn_v3_finite(g)) return spn_error(SPN_ERR_INVALID, "gravity must be finite, not (%g, %g, %g)", g.x, g.y, g.z);
+    const spn_status st = check_gravity("", g);
+    if (st != SPN_OK) return st;
     w->def.gravity = g;
     return SPN_OK;
 }
 spn_status spn_world_set_drag(spn_world *w, double drag)
 {
-    if (!(drag >= 0) || !isfinite(drag))
-        return spn_error(SPN_ERR_INVALID, "drag must be finite and not negative, not %g", drag);
+    const spn_status st = check_drag("", drag);
+    if (st != SPN_OK) return st;
     w->def.drag = drag;
     return SPN_OK;
 }
