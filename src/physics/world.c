@@ -397,6 +397,7 @@ spn_status spn_world_set_solver_tolerance(spn_world *w, double cg_tolerance, int
     w->def.cg_max_iterations = cg_max_iterations;
     return SPN_OK;
 }
+
 spn_status spn__check_settings(const spn_world_def *d)
 {
     const char *const what = "world settings (spn_world_def): ";
