@@ -51,18 +51,24 @@
 /* A thread's workspace: lattice_rows.h's WS_* arrays, `stride` floats each. */
 
 struct spn__lat32 {
-    size_t np, m;
+    size_t np; /* the world's particles */
+    /* Rows of `pitch` floats, the radials rounded up to whole 64-byte lines,
+     * each starting a line (as the float64 state's, lattice_rows.h): world
+     * particle 1 + j N + i is 1 + j pitch + i in the per-particle arrays
+     * (nlat floats each), slot j N + i is j pitch + i (m floats each). */
+    uint32_t pitch;
+    size_t nlat, m;
     float *block, *slots; /* the per-particle and the per-slot arrays below */
     float *d[3], *u[3];   /* displacement from w->x [m] and velocity, per particle */
     float *mass, *inv_mass;
     float *rl[3], *gl[3]; /* reference differences of the radial and ring slots */
     float *rk, *rkd, *rr, *gk, *gkd, *gr;
-    float *cut;           /* per band: 3 x N radial forces into its first row */
+    float *cut; /* per band: 3 rows of pitch, the radial forces into its first row */
     uint32_t ncut;
     float **ws;
     int nws;
     size_t stride;
-    float *rk4;           /* RK4 (on first use): two trial states, 6 x np each, ax, av */
+    float *rk4;           /* RK4 (on first use): two trial states, 6 x nlat each, ax, av */
     float *trial[2][6];   /* trial displacement and velocity, by component */
     float *ax[3], *av[3]; /* weighted sums of the stages' velocities and forces */
     bool live;            /* the state above is ahead of w->x, w->v */
@@ -150,8 +156,8 @@ LAT_INLINE void radials32(const a32 *a, float *const *Da, float *const *Ua, floa
                           uint32_t j, float *const *f, const lat_cols *cs, bool hold)
 {
     const spn__lat32 *F = a->F;
-    spring_rows(a->L->radials, Da, Ua, Db, Ub, (float *const *)F->rl, (size_t)j * a->L->radials, F->rk, F->rkd, F->rr,
-                f, 0, cs, wants_elastic(a->mode, a->stage), hold ? SUMS_HOLD : SUMS_ADD);
+    spring_rows(a->L->radials, Da, Ua, Db, Ub, (float *const *)F->rl, (size_t)j * F->pitch, F->rk, F->rkd, F->rr, f, 0,
+                cs, wants_elastic(a->mode, a->stage), hold ? SUMS_HOLD : SUMS_ADD);
 }
 
 LAT_INLINE void rings32(const a32 *a, float *const *D, float *const *U, uint32_t j, float *const *f, const lat_cols *cs,
@@ -159,7 +165,7 @@ LAT_INLINE void rings32(const a32 *a, float *const *D, float *const *U, uint32_t
 {
     const spn__lat32 *F = a->F;
     const uint32_t n = a->L->radials;
-    const size_t s0 = (size_t)j * n;
+    const size_t s0 = (size_t)j * F->pitch;
     float *D1[3], *U1[3], *Dl[3], *Ul[3]; /* the row from its second and its last particle */
     for (int c = 0; c < 3; c++) D1[c] = D[c] + 1, U1[c] = U[c] + 1, Dl[c] = D[c] + n - 1, Ul[c] = U[c] + n - 1;
     const bool el = wants_elastic(a->mode, a->stage);
@@ -173,11 +179,8 @@ LAT_INLINE void hub_state32(const a32 *a, float *x, float *v)
     for (int c = 0; c < 3; c++) x[c] = a->ed[c][0], v[c] = a->eu[c][0];
 }
 
-static float *cut32(const a32 *a, uint32_t b, int c)
-{
-    return a->F->cut + ((size_t)b * 3 + (size_t)c) * a->L->radials;
-}
-static size_t pitch32(const a32 *a) { return a->L->radials; }
+static float *cut32(const a32 *a, uint32_t b, int c) { return a->F->cut + ((size_t)b * 3 + (size_t)c) * a->F->pitch; }
+static size_t pitch32(const a32 *a) { return a->F->pitch; }
 static float *ws32(const a32 *a, int thread) { return a->F->ws[thread]; }
 static size_t stride32(const a32 *a) { return a->F->stride; }
 
@@ -213,7 +216,7 @@ static void reference_rows(void *ctx, size_t lo, size_t hi)
     const uint32_t n = L->radials;
     const spn_vec3 *x = w->x;
     for (uint32_t j = (uint32_t)lo; j < hi; j++) {
-        const size_t s0 = (size_t)j * n, p0 = 1 + s0;
+        const size_t s0 = (size_t)j * F->pitch, p0 = 1 + (size_t)j * n; /* slots; the world's row */
         for (uint32_t i = 0; i < n; i++) {
             const spn_vec3 in = j ? x[p0 - n + i] : x[0], me = x[p0 + i];
             const spn_vec3 nb = i + 1 < n ? x[p0 + i + 1] : x[p0];
@@ -234,15 +237,22 @@ typedef struct {
     bool rebase;
 } write_job;
 
-static void write_particles(void *ctx, size_t lo, size_t hi)
+/* Rows [lo, hi) (lat_row_in) of the float32 state into the world's. */
+static void write_rows(void *ctx, size_t lo, size_t hi)
 {
     const write_job *j = ctx;
-    spn__lat32 *F = j->w->lat->f32;
+    const spn__lattice *L = j->w->lat;
+    spn__lat32 *F = L->f32;
     spn_vec3 *x = j->w->x, *v = j->w->v;
-    for (size_t i = lo; i < hi; i++) {
-        x[i].x += (double)F->d[0][i], x[i].y += (double)F->d[1][i], x[i].z += (double)F->d[2][i];
-        v[i] = spn_v3(F->u[0][i], F->u[1][i], F->u[2][i]);
-        if (j->rebase) F->d[0][i] = F->d[1][i] = F->d[2][i] = 0;
+    for (uint32_t r = (uint32_t)lo; r < hi; r++) {
+        size_t to, from;
+        const uint32_t count = lat_row_in(L, F->pitch, r, &to, &from);
+        for (uint32_t k = 0; k < count; k++) {
+            const size_t i = to + k, q = from + k;
+            x[i].x += (double)F->d[0][q], x[i].y += (double)F->d[1][q], x[i].z += (double)F->d[2][q];
+            v[i] = spn_v3(F->u[0][q], F->u[1][q], F->u[2][q]);
+            if (j->rebase) F->d[0][q] = F->d[1][q] = F->d[2][q] = 0;
+        }
     }
 }
 
@@ -252,7 +262,7 @@ static void write_back(spn_world *w, int threads, bool rebase)
 {
     spn__lat32 *F = w->lat->f32;
     write_job job = {w, rebase};
-    spn__lat_for(w->lat, threads, F->np, write_particles, &job);
+    spn__lat_for(w->lat, threads, (size_t)w->lat->rings + 1, write_rows, &job);
     if (rebase) references(w, threads);
     F->since = 0;
     F->live = rebase;
@@ -260,16 +270,17 @@ static void write_back(spn_world *w, int threads, bool rebase)
 
 static bool alloc_state(spn__lattice *L, size_t np)
 {
-    const size_t m = (size_t)L->rings * L->radials;
+    const uint32_t rp = (L->radials + 15) & ~(uint32_t)15;
+    const size_t m = (size_t)L->rings * rp, nlat = 1 + m;
     if (L->f32 && L->f32->np == np) return true;
     spn__lat32_free(L->f32);
     spn__lat32 *F = L->f32 = calloc(1, sizeof *F);
     void *first, *sfirst;
     size_t pitch, spitch;
-    if (!F || !(F->block = spn__lattice_arrays(8, np, sizeof(float), 1, &first, &pitch)) ||
+    if (!F || !(F->block = spn__lattice_arrays(8, nlat, sizeof(float), 1, &first, &pitch)) ||
         !(F->slots = spn__lattice_arrays(12, m, sizeof(float), 0, &sfirst, &spitch)))
         return false;
-    F->np = np, F->m = m;
+    F->np = np, F->pitch = rp, F->nlat = nlat, F->m = m;
     float *q = first;
     for (int c = 0; c < 3; c++)
         F->d[c] = q, q += pitch, F->u[c] = q, q += pitch;
@@ -283,17 +294,24 @@ static bool alloc_state(spn__lattice *L, size_t np)
     return true;
 }
 
-/* Particles [lo, hi): masses and velocities rounded, displacements zero. */
-static void load_particles(void *ctx, size_t lo, size_t hi)
+/* Rows [lo, hi) (lat_row_in): masses and velocities rounded, displacements
+ * zero. */
+static void load_rows(void *ctx, size_t lo, size_t hi)
 {
     const spn_world *w = ctx;
-    spn__lat32 *F = w->lat->f32;
+    const spn__lattice *L = w->lat;
+    spn__lat32 *F = L->f32;
     const spn_vec3 *v = w->v;
     const double *mass = w->mass, *inv_mass = w->inv_mass;
-    for (size_t i = lo; i < hi; i++) {
-        F->mass[i] = (float)mass[i], F->inv_mass[i] = (float)inv_mass[i];
-        F->d[0][i] = F->d[1][i] = F->d[2][i] = 0;
-        F->u[0][i] = (float)v[i].x, F->u[1][i] = (float)v[i].y, F->u[2][i] = (float)v[i].z;
+    for (uint32_t r = (uint32_t)lo; r < hi; r++) {
+        size_t from, to;
+        const uint32_t count = lat_row_in(L, F->pitch, r, &from, &to);
+        for (uint32_t k = 0; k < count; k++) {
+            const size_t i = from + k, q = to + k;
+            F->mass[q] = (float)mass[i], F->inv_mass[q] = (float)inv_mass[i];
+            F->d[0][q] = F->d[1][q] = F->d[2][q] = 0;
+            F->u[0][q] = (float)v[i].x, F->u[1][q] = (float)v[i].y, F->u[2][q] = (float)v[i].z;
+        }
     }
 }
 
@@ -305,13 +323,13 @@ static bool load(spn_world *w, int threads)
     if (!alloc_state(L, w->np)) return false;
     spn__lat32 *F = L->f32;
     if (!F->params_ok)
-        for (size_t s = 0; s < F->m; s++) {
-            const size_t d = lat_slot(L, s);
-            F->rk[s] = (float)L->rk[d], F->rkd[s] = (float)L->rkd[d], F->rr[s] = (float)L->rrest[d];
-            F->gk[s] = (float)L->gk[d], F->gkd[s] = (float)L->gkd[d], F->gr[s] = (float)L->grest[d];
+        for (size_t s = 0; s < (size_t)L->rings * L->radials; s++) {
+            const size_t d = lat_slot(L, s), e = lat_slot_in(L, F->pitch, s);
+            F->rk[e] = (float)L->rk[d], F->rkd[e] = (float)L->rkd[d], F->rr[e] = (float)L->rrest[d];
+            F->gk[e] = (float)L->gk[d], F->gkd[e] = (float)L->gkd[d], F->gr[e] = (float)L->grest[d];
         }
     F->params_ok = true;
-    spn__lat_for(L, threads, w->np, load_particles, w);
+    spn__lat_for(L, threads, (size_t)L->rings + 1, load_rows, w);
     references(w, threads);
     F->since = 0;
     F->live = true;
@@ -326,7 +344,8 @@ static bool prepare32(spn__lattice *L, int threads)
     if (F->ncut != L->nbands) {
         free(F->cut);
         F->ncut = 0;
-        if (!(F->cut = malloc((size_t)L->nbands * 3 * L->radials * sizeof *F->cut))) return false;
+        if (!(F->cut = spn__lattice_arrays((size_t)L->nbands * 3, F->pitch, sizeof *F->cut, 0, NULL, NULL)))
+            return false;
         F->ncut = L->nbands;
     }
     if (F->nws < threads) {
@@ -359,7 +378,7 @@ static bool begin(spn_world *w, int threads, double dt, bool rk4, a32 *a)
     if (rk4 && !F->rk4) {
         void *first;
         size_t pitch;
-        if (!(F->rk4 = spn__lattice_arrays(18, F->np, sizeof(float), 1, &first, &pitch))) {
+        if (!(F->rk4 = spn__lattice_arrays(18, F->nlat, sizeof(float), 1, &first, &pitch))) {
             spn__lattice_sync(w);
             return false;
         }
@@ -391,7 +410,7 @@ static bool mv2_known(const spn_world *w)
     if (!F->mv2.ok || w->def.drag != 0) return false;
 #ifndef NDEBUG
     double mv2 = 0;
-    for (size_t i = 0; i < F->np; i++)
+    for (size_t i = 0; i < F->nlat; i++) /* (the rows' padding: inv_mass 0) */
         if (F->inv_mass[i] != 0)
             mv2 += (double)F->mass[i] * ((double)F->u[0][i] * F->u[0][i] + (double)F->u[1][i] * F->u[1][i] +
                                          (double)F->u[2][i] * F->u[2][i]);

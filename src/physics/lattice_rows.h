@@ -155,16 +155,15 @@ struct spn__lattice {
     struct spn__lat_team *team; /* open for a spn_world_advance call (lattice_team.c), or NULL */
 };
 
-/* Where the world's slot s (ring j, radial i: s = j N + i) sits in the
- * float64 slot arrays: j pitch + i. */
-static inline size_t lat_slot(const spn__lattice *L, size_t s)
+/* Where the world's slot s (ring j, radial i: s = j N + i) sits in slot
+ * arrays of rows of `pitch`: j pitch + i (lat_slot: the float64 slots). */
+static inline size_t lat_slot_in(const spn__lattice *L, size_t pitch, size_t s)
 {
-    return s / L->radials * L->pitch + s % L->radials;
+    return s / L->radials * pitch + s % L->radials;
 }
 
-/* Row r of the world's particles (0: the hub alone; r > 0: ring r - 1):
- * its first index in the world's arrays, in the float64 lattice's, and its
- * count. */
+static inline size_t lat_slot(const spn__lattice *L, size_t s) { return lat_slot_in(L, L->pitch, s); }
+
 /* Band b's first row (b = nbands: the rings): the rings shared out as
  * evenly as whole rows go, the bands' sizes differing by one at most, so
  * that two threads taking half the bands each take half the rows (the 5k
@@ -180,11 +179,19 @@ static inline uint32_t lat_band_of(const spn__lattice *L, uint32_t j)
     return (uint32_t)((((uint64_t)j + 1) * L->nbands - 1) / L->rings);
 }
 
-static inline uint32_t lat_row(const spn__lattice *L, uint32_t r, size_t *world, size_t *lat)
+/* Row r of the world's particles (0: the hub alone; r > 0: ring r - 1):
+ * its first index in the world's arrays, in a lattice state of rows of
+ * `pitch` (lat_row: the float64 state's), and its count. */
+static inline uint32_t lat_row_in(const spn__lattice *L, size_t pitch, uint32_t r, size_t *world, size_t *lat)
 {
     *world = r ? 1 + (size_t)(r - 1) * L->radials : 0;
-    *lat = r ? 1 + (size_t)(r - 1) * L->pitch : 0;
+    *lat = r ? 1 + (size_t)(r - 1) * pitch : 0;
     return r ? L->radials : 1;
+}
+
+static inline uint32_t lat_row(const spn__lattice *L, uint32_t r, size_t *world, size_t *lat)
+{
+    return lat_row_in(L, L->pitch, r, world, lat);
 }
 
 /* What a sweep does with a row once its forces are complete. */
