@@ -262,7 +262,8 @@ LAT_INLINE void radials64(const lat_args *a, double *const *Xa, double *const *V
     const double *const *cXa = (const double *const *)Xa, *const *cVa = (const double *const *)Va;
     const double *const *cXb = (const double *const *)Xb, *const *cVb = (const double *const *)Vb;
     const bool el = wants_elastic(a->mode, a->stage);
-    springs_rows(L->radials, cXa, cVa, cXb, cVb, 0, 0, L->rk + s0, L->rkd + s0, L->rrest + s0, f, 0, cs, el);
+    /* (over the padding too: padded64, lattice_rows_t.h) */
+    springs_rows(padded64(L->radials), cXa, cVa, cXb, cVb, 0, 0, L->rk + s0, L->rkd + s0, L->rrest + s0, f, 0, cs, el);
 }
 
 LAT_INLINE void rings64(const lat_args *a, double *const *X, double *const *V, uint32_t j, double *const *f,

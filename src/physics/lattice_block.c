@@ -60,7 +60,7 @@ bool spn__lattice_cols_alloc(spn__lattice *L, int threads)
     double **cols = realloc(L->cols, (size_t)threads * sizeof *cols);
     if (!cols) return false;
     L->cols = cols;
-    L->col_stride = ((size_t)L->radials + 7) & ~(size_t)7;
+    L->col_stride = ((size_t)L->radials + 15) & ~(size_t)15; /* (float32's padded rows of scratch) */
     for (; L->ncols < threads; L->ncols++)
         if (!(L->cols[L->ncols] = spn__lattice_arrays(COL_COUNT, L->col_stride, sizeof **L->cols, 0, NULL, NULL)))
             return false;

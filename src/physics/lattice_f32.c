@@ -156,8 +156,9 @@ LAT_INLINE void radials32(const a32 *a, float *const *Da, float *const *Ua, floa
                           uint32_t j, float *const *f, const lat_cols *cs, bool hold)
 {
     const spn__lat32 *F = a->F;
-    spring_rows(a->L->radials, Da, Ua, Db, Ub, (float *const *)F->rl, (size_t)j * F->pitch, F->rk, F->rkd, F->rr, f, 0,
-                cs, wants_elastic(a->mode, a->stage), hold ? SUMS_HOLD : SUMS_ADD);
+    /* (over the padding too: padded32, lattice_rows_t.h) */
+    spring_rows(padded32(a->L->radials), Da, Ua, Db, Ub, (float *const *)F->rl, (size_t)j * F->pitch, F->rk, F->rkd,
+                F->rr, f, 0, cs, wants_elastic(a->mode, a->stage), hold ? SUMS_HOLD : SUMS_ADD);
 }
 
 LAT_INLINE void rings32(const a32 *a, float *const *D, float *const *U, uint32_t j, float *const *f, const lat_cols *cs,

@@ -18,6 +18,20 @@
 #error "define LK_T, LK_U, LK(name) and LK_SCRATCH before including lattice_rows_t.h"
 #endif
 
+/* A row of n rounded up to whole 64-byte vectors (8 doubles, 16 floats):
+ * the pitch of every row array of the lattice (the state, masses, slots and
+ * RK4 arrays, the force rows, ghost rows and sum columns), whose padding
+ * holds zeros: massless particles that no select moves, at rest, with
+ * springs of zero stiffness. The particle loops of LK(row) and
+ * LK(assemble) run over it, so that they end on a whole vector instead of
+ * a scalar remainder (docs/physics-lattice.md, "Loops over the padding");
+ * what they write there is never read. */
+LAT_INLINE uint32_t LK(padded)(uint32_t n)
+{
+    const uint32_t lanes = 64 / sizeof(LK_T);
+    return (n + lanes - 1) & ~(lanes - 1);
+}
+
 /* The per-particle sum terms m q (LK_ACC(a, m, q)): float64 adds them
  * straight into the sum columns (LK_S double, a += m q as one fused
  * multiply-add); float32 stores them in its float scratch (lat_cols.scr)
@@ -136,8 +150,9 @@ LAT_INLINE void LK(row)(uint32_t n, bool sym, LK_T dt, const LK_T *g, LK_T drag,
      * first iteration's loads with the ends' above, and the loop, no
      * longer if-converted, stays scalar in most of its inlined copies) */
     __asm__ __volatile__("" ::: "memory");
+    const uint32_t wn = LK(padded)(n);
     if (ox)
-        for (uint32_t i = 0; i < n; i++) {
+        for (uint32_t i = 0; i < wn; i++) {
             const LK_T m = mass[i], dm = drag * m;
             const LK_T fx = (((LK_FMA(-dm, vx[i], m * g[0]) + ox[i]) + rx[i]) - ix[i]) - rxm[i];
             const LK_T fy = (((LK_FMA(-dm, vy[i], m * g[1]) + oy[i]) + ry[i]) - iy[i]) - rym[i];
@@ -146,7 +161,7 @@ LAT_INLINE void LK(row)(uint32_t n, bool sym, LK_T dt, const LK_T *g, LK_T drag,
             LK_STORE(i, o);
         }
     else
-        for (uint32_t i = 0; i < n; i++) {
+        for (uint32_t i = 0; i < wn; i++) {
             const LK_T m = mass[i], dm = drag * m;
             const LK_T fx = ((LK_FMA(-dm, vx[i], m * g[0]) + rx[i]) - ix[i]) - rxm[i];
             const LK_T fy = ((LK_FMA(-dm, vy[i], m * g[1]) + ry[i]) - iy[i]) - rym[i];
@@ -191,18 +206,19 @@ LAT_INLINE void LK(assemble)(uint32_t n, LK_T gc, LK_T drag, const LK_T *restric
     /* (over the whole row from particle 0, which starts a line, as in
      * LK(row); the ends are overwritten below) */
     const LK_T *const rm = ring - 1;
+    const uint32_t wn = LK(padded)(n);
     if (drag == 0 && !(gc == 0 && signbit(gc))) {
         if (out)
-            for (uint32_t i = 0; i < n; i++)
+            for (uint32_t i = 0; i < wn; i++)
                 f[i] = ((((mass[i] * gc) + out[i]) + ring[i]) - in[i]) - rm[i];
         else
-            for (uint32_t i = 0; i < n; i++)
+            for (uint32_t i = 0; i < wn; i++)
                 f[i] = (((mass[i] * gc) + ring[i]) - in[i]) - rm[i];
     } else if (out)
-        for (uint32_t i = 0; i < n; i++)
+        for (uint32_t i = 0; i < wn; i++)
             f[i] = ((((mass[i] * gc - (drag * mass[i]) * vc[i]) + out[i]) + ring[i]) - in[i]) - rm[i];
     else
-        for (uint32_t i = 0; i < n; i++)
+        for (uint32_t i = 0; i < wn; i++)
             f[i] = (((mass[i] * gc - (drag * mass[i]) * vc[i]) + ring[i]) - in[i]) - rm[i];
     const uint32_t l = n - 1;
     LK_T f0 = mass[0] * gc - (drag * mass[0]) * vc[0], fl = mass[l] * gc - (drag * mass[l]) * vc[l];
