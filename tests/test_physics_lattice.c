@@ -587,6 +587,95 @@ static void test_governor_same_bits(void **state)
     }
 }
 
+/* Where the bands of a blocked pass on two threads go (lat_split: share 0
+ * held to 2, 3, 5 or 6 of the web's 8 bands, then left to follow the
+ * threads' speeds) changes no bit of the trajectory or of the energy
+ * books: against one thread, explicit and RK4, float64 and float32. */
+static void test_split_same_bits(void **state)
+{
+    (void)state;
+    const spn_integrator integs[] = {SPN_INTEGRATOR_SYMPLECTIC, SPN_INTEGRATOR_RK4};
+    const int holds[] = {2, 3, 5, 6, -1};
+    for (int k = 0; k < 4; k++) {
+        /* 4,001 particles, parallel_min 8,192: threads from 1,024, and
+         * eight bands of 10 rings (a share keeps 16 rows: 2 to 6 bands) */
+        spn_world *two = disturbed_orb(integs[k % 2], 80, 50, 2, 8192, true);
+        spn_world *one = disturbed_orb(integs[k % 2], 80, 50, 1, 8192, true);
+        if (k >= 2) {
+            spn_world_set_precision(two, SPN_PRECISION_FLOAT32);
+            spn_world_set_precision(one, SPN_PRECISION_FLOAT32);
+        }
+        assert_true(spn__lattice_gov_prefer(two, true));
+        for (int h = 0; h < 5; h++) {
+            spn__lattice_split_hold(two, holds[h]);
+            assert_int_equal(spn_world_advance(two, 2e-6, 24), SPN_OK);
+            assert_int_equal(spn_world_last_step(two).blocked, 24);
+            assert_int_equal(two->lat->nbands, 8);
+            if (holds[h] >= 0) assert_int_equal(two->lat->split.first[1], holds[h]);
+            assert_int_equal(spn_world_advance(one, 2e-6, 24), SPN_OK);
+            assert_same_state(two, one);
+            spn_energy e2 = spn_world_energy(two), e1 = spn_world_energy(one);
+            assert_memory_equal(&e2.dissipated, &e1.dissipated, sizeof(double));
+        }
+        assert_true(fastest(one) > 0.01);
+        spn_world_destroy(two);
+        spn_world_destroy(one);
+    }
+}
+
+/* The split's rule (spn__lattice_split_update) on made-up times: shares
+ * that run alike keep their even split, through a pass that one of them
+ * lost to a preempted core; a share whose rows take half as long again
+ * gives up bands until the two parts take about as long, and takes them
+ * back when the two run alike again. */
+static void run_split(spn__lattice *L, double per_row0, double per_row1, int passes)
+{
+    for (int p = 0; p < passes; p++) {
+        uint32_t R0, R1;
+        for (int t = 0; t < 2; t++) {
+            spn__lattice_split_rows(L, t, &R0, &R1);
+            L->split.took[t].ns = (t ? per_row1 : per_row0) * (R1 - R0);
+        }
+        spn__lattice_split_update(L);
+    }
+}
+
+static void test_split_follows_speed(void **state)
+{
+    (void)state;
+    spn__lattice L;
+    memset(&L, 0, sizeof L);
+    L.rings = 80, L.nbands = 8, L.split.hold = -1;
+    assert_true(spn__lattice_split_ready(&L, 2));
+    assert_int_equal(L.split.first[0], 0);
+    assert_int_equal(L.split.first[1], 4);
+    assert_int_equal(L.split.first[2], 8);
+    run_split(&L, 1000, 1000, 20);
+    assert_int_equal(L.split.first[1], 4);
+    run_split(&L, 1000, 10000, 1); /* one slow pass */
+    assert_int_equal(L.split.first[1], 4);
+    run_split(&L, 1000, 1000, 20);
+    assert_int_equal(L.split.first[1], 4);
+    /* share 1 half as slow again: its 40 rows take 60,000 against share
+     * 0's 40,000; at band 5 its 30 take 45,000, share 0's 50 50,000 */
+    run_split(&L, 1000, 1500, 40);
+    assert_int_equal(L.split.first[1], 5);
+    uint32_t R0, R1;
+    spn__lattice_split_rows(&L, 1, &R0, &R1);
+    assert_int_equal(R0, 50);
+    assert_int_equal(R1, 80);
+    run_split(&L, 1000, 1000, 40);
+    assert_int_equal(L.split.first[1], 4);
+    /* never below a share's 16 rows: share 0 ten times as slow keeps 2 bands */
+    run_split(&L, 10000, 1000, 60);
+    assert_int_equal(L.split.first[1], 2);
+    /* the split starts again even when the bands change */
+    L.nbands = 4;
+    assert_true(spn__lattice_split_ready(&L, 2));
+    assert_int_equal(L.split.first[1], 2);
+    free(L.split.first), free(L.split.rate), free(L.split.took);
+}
+
 /* Changing a spring keeps the lattice in step; breaking one hands over to the
  * general path, and the trajectories stay identical through both. */
 static void test_changes_and_break(void **state)
@@ -756,20 +845,14 @@ static void test_traffic_model(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_same_trajectory),
-        cmocka_unit_test(test_same_gravity_and_drag),
-        cmocka_unit_test(test_bands_and_threads),
-        cmocka_unit_test(test_blocked_passes),
-        cmocka_unit_test(test_team_jobs),
-        cmocka_unit_test(test_team_asleep_between_jobs),
-        cmocka_unit_test(test_rk4_pass_versions),
-        cmocka_unit_test(test_blocked_passes_float32),
-        cmocka_unit_test(test_governor_choices),
-        cmocka_unit_test(test_governor_same_bits),
-        cmocka_unit_test(test_changes_and_break),
-        cmocka_unit_test(test_hand_built_and_breakage),
-        cmocka_unit_test(test_not_a_lattice),
-        cmocka_unit_test(test_traffic_model),
+        cmocka_unit_test(test_same_trajectory),   cmocka_unit_test(test_same_gravity_and_drag),
+        cmocka_unit_test(test_bands_and_threads), cmocka_unit_test(test_blocked_passes),
+        cmocka_unit_test(test_team_jobs),         cmocka_unit_test(test_team_asleep_between_jobs),
+        cmocka_unit_test(test_rk4_pass_versions), cmocka_unit_test(test_blocked_passes_float32),
+        cmocka_unit_test(test_governor_choices),  cmocka_unit_test(test_governor_same_bits),
+        cmocka_unit_test(test_split_same_bits),   cmocka_unit_test(test_split_follows_speed),
+        cmocka_unit_test(test_changes_and_break), cmocka_unit_test(test_hand_built_and_breakage),
+        cmocka_unit_test(test_not_a_lattice),     cmocka_unit_test(test_traffic_model),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

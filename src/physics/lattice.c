@@ -59,6 +59,7 @@ static void lattice_free(spn__lattice *L)
     if (!L) return;
     free(L->slots);
     free(L->cut), free(L->partial), free(L->rk4), free(L->state), free(L->masses), free(L->partial_k);
+    free(L->split.first), free(L->split.rate), free(L->split.took);
     for (int t = 0; t < L->nbws; t++) free(L->bws[t]);
     free(L->bws);
     spn__lat32_free(L->f32);
@@ -114,6 +115,7 @@ void spn__lattice_build(spn_world *w)
     spn__lattice *L = calloc(1, sizeof *L);
     if (!L) return;
     L->gov.t0 = -1;
+    L->split.hold = -1;
     L->rings = rings, L->radials = n;
     L->pitch = (n + 7) & ~(uint32_t)7;
     L->nlat = 1 + (size_t)rings * L->pitch;
@@ -161,18 +163,20 @@ void spn__lattice_spring_changed(spn_world *w, uint32_t s)
 static bool prepare(spn_world *w, int threads)
 {
     spn__lattice *L = w->lat;
-    /* Bands of an eighth of parallel_min particles, or of a quarter of the
-     * web where that is less, and at least SPN_BLOCK: on a big web enough
+    /* Bands of an eighth of parallel_min particles, or of an eighth of the
+     * web where that is less, and at least SPN_BLOCK / 2: on a big web enough
      * of them for a static schedule to share out evenly, few enough that
      * the radials computed twice at their edges cost nothing; a web that
-     * takes threads below parallel_min (lattice_threads) is cut into four
-     * (bands of an eighth of parallel_min gave the 5k web 41 and 9 rows,
-     * SPN_BLOCK-sized ones 11, 11, 11, 11, 6). The rows are then shared out
-     * evenly (lat_band_lo): the 5k web's four are 12, 13, 12 and 13 rows,
-     * 25 a thread on two (bands of 13 rows, 13, 13, 13 and 11, gave
-     * 26 and 24: docs/physics-lattice.md, "Even bands"). */
-    const uint32_t n = L->radials, eighth = w->def.parallel_min / 8, quarter = w->np / 4;
-    const uint32_t want = eighth < quarter ? eighth : quarter, bsize = want > SPN_BLOCK ? want : SPN_BLOCK;
+     * takes threads below parallel_min (lattice_threads) is cut into eight,
+     * so that a blocked pass's split (lat_split) can move a band or two
+     * toward a faster core (bands of an eighth of parallel_min gave the 5k
+     * web 41 and 9 rows, SPN_BLOCK-sized ones 11, 11, 11, 11, 6). The rows
+     * are then shared out evenly (lat_band_lo): the 5k web's eight are 6,
+     * 6, 7, 6, 6, 6, 6 and 7 rows, 25 a thread on two when the cores run
+     * alike (bands of 13 rows, 13, 13, 13 and 11, gave 26 and 24:
+     * docs/physics-lattice.md, "Even bands"). */
+    const uint32_t n = L->radials, eighth = w->def.parallel_min / 8, web = (uint32_t)(w->np / 8);
+    const uint32_t want = eighth < web ? eighth : web, bsize = want > SPN_BLOCK / 2 ? want : SPN_BLOCK / 2;
     const uint32_t rows = (bsize + n - 1) / n, nbands = (L->rings + rows - 1) / rows;
     if (L->nbands != nbands) {
         free(L->cut), free(L->partial);

@@ -9,8 +9,10 @@
 #include "lattice_rows.h"
 #include "world_internal.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 void *spn__lattice_arrays(size_t count, size_t n, size_t size, size_t lead, void **first, size_t *pitch)
 {
@@ -91,6 +93,131 @@ bool spn__lattice_rk4_avx2(void)
 #else
     return false;
 #endif
+}
+
+/* ---- the split of the bands over a pass's shares (lat_split) ---- */
+
+/* Rows each share keeps: with its ghost rows costing at most a quarter of
+ * them at any level count, as spn__lattice_block_ready asks of an even
+ * split. */
+#define SPLIT_MIN_ROWS (4 * LAT_LEVELS)
+/* Weight of a pass's time per row in a share's rate, the time first held
+ * within a factor of 2 of the rate: some 20 passes (each about 50 us on
+ * the 5k web) to follow a core that slows down, while a pass that a
+ * preempted core made slow moves no band. */
+#define SPLIT_GAIN 0.05
+/* A new split is taken when it would shorten the slowest share's part by
+ * more than this: moving a band makes its rows' cache lines move to the
+ * other core, so small gains, or a pass's noise, do not move one. */
+#define SPLIT_MARGIN 0.92
+
+static void split_even(lat_split *S)
+{
+    for (int t = 0; t <= S->shares; t++)
+        S->first[t] = (uint32_t)((uint64_t)S->nbands * (uint64_t)t / (uint64_t)S->shares);
+    for (int t = 0; t < S->shares; t++)
+        S->rate[t] = 0;
+}
+
+bool spn__lattice_split_ready(spn__lattice *L, int shares)
+{
+    lat_split *S = &L->split;
+    if (S->shares == shares && S->nbands == L->nbands) return true;
+    if (S->shares != shares) {
+        free(S->first), free(S->rate), free(S->took);
+        S->shares = 0;
+        /* (first: the boundaries, then as many for a proposal) */
+        S->first = malloc(2 * ((size_t)shares + 1) * sizeof *S->first);
+        S->rate = malloc((size_t)shares * sizeof *S->rate);
+        S->took = aligned_alloc(64, (size_t)shares * sizeof *S->took);
+        if (!S->first || !S->rate || !S->took) return false;
+        memset(S->took, 0, (size_t)shares * sizeof *S->took);
+    }
+    S->shares = shares, S->nbands = L->nbands;
+    split_even(S);
+    return true;
+}
+
+void spn__lattice_split_rows(const spn__lattice *L, int t, uint32_t *R0, uint32_t *R1)
+{
+    *R0 = lat_band_lo(L, L->split.first[t]), *R1 = lat_band_lo(L, L->split.first[t + 1]);
+}
+
+/* Rows of bands [b0, b1). */
+static uint32_t band_rows(const spn__lattice *L, uint32_t b0, uint32_t b1)
+{
+    return lat_band_lo(L, b1) - lat_band_lo(L, b0);
+}
+
+void spn__lattice_split_update(spn__lattice *L)
+{
+    lat_split *S = &L->split;
+    const int T = S->shares;
+    const uint32_t nb = S->nbands;
+    if (T < 2) return;
+    if (S->moved) {
+        /* (the bands that moved were cold in their new share's caches) */
+        S->moved = false;
+        return;
+    }
+    double worst = 0, speed = 0;
+    for (int t = 0; t < T; t++) {
+        const double rows = band_rows(L, S->first[t], S->first[t + 1]), per = S->took[t].ns / rows;
+        const double r = S->rate[t];
+        if (!(per > 0)) return; /* (a share not timed) */
+        S->rate[t] = r > 0 ? r + SPLIT_GAIN * (fmin(fmax(per, 0.5 * r), 2 * r) - r) : per;
+        if (S->rate[t] * rows > worst) worst = S->rate[t] * rows;
+        speed += 1 / S->rate[t];
+    }
+    uint32_t *next = S->first + T + 1;
+    if (S->hold >= 0) {
+        if (T != 2 || S->hold < 1 || (uint32_t)S->hold >= nb || band_rows(L, 0, (uint32_t)S->hold) < SPLIT_MIN_ROWS ||
+            band_rows(L, (uint32_t)S->hold, nb) < SPLIT_MIN_ROWS)
+            return;
+        S->first[1] = (uint32_t)S->hold;
+        return;
+    }
+    /* each boundary where the shares before it would take their part of
+     * the rows at their speeds, at the nearest band boundary that leaves
+     * every share its rows */
+    next[0] = 0, next[T] = nb;
+    double ahead = 0;
+    for (int t = 1; t < T; t++) {
+        ahead += 1 / S->rate[t - 1];
+        const double row = L->rings * ahead / speed;
+        uint32_t best = 0;
+        double dist = 0;
+        for (uint32_t b = next[t - 1] + 1; b < nb; b++) {
+            if (band_rows(L, next[t - 1], b) < SPLIT_MIN_ROWS) continue;
+            if (band_rows(L, b, nb) < SPLIT_MIN_ROWS * (uint32_t)(T - t)) break;
+            const double d = fabs(lat_band_lo(L, b) - row);
+            if (!best || d < dist) best = b, dist = d;
+        }
+        if (!best) return;
+        next[t] = best;
+    }
+    double longest = 0;
+    for (int t = 0; t < T; t++) {
+        const double part = S->rate[t] * band_rows(L, next[t], next[t + 1]);
+        if (part > longest) longest = part;
+    }
+    if (longest < SPLIT_MARGIN * worst) {
+        memcpy(S->first, next, ((size_t)T + 1) * sizeof *next);
+        S->moved = true;
+        S->moves++;
+    }
+}
+
+void spn__lattice_split_hold(spn_world *w, int bands)
+{
+    if (w->lat) w->lat->split.hold = bands;
+}
+
+double spn__lattice_clock_ns(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec * 1e9 + (double)t.tv_nsec;
 }
 
 void spn__lattice_block_sums(const spn__lattice *L, uint32_t K, double sums[][L_NSUMS])

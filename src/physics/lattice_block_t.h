@@ -117,9 +117,11 @@ static void LK(store_level)(LK(block) *B, double *partial, uint32_t s, uint32_t 
     LK(level) *lv = &B->lv[s - 1];
     const int q = (int)(b & 1);
     const spn__lattice *L = B->L;
+    const LK_ARGS *a = &B->la[s - 1];
     double *out = partial + ((size_t)(s - 1) * L->nbands + b) * L_NSUMS;
     if (b) out[L_ELASTIC] = lv->cut_e[q], out[L_DAMP] = lv->cut_p[q];
-    store_band_sums(out, b == 0, &lv->band[q], L->radials);
+    store_band_sums(out, b == 0, &lv->band[q], L->radials,
+                    lat_sums_made(a->mode, a->stage, a->kin_known, a->drag != 0));
 }
 
 /* The hub at level s: its radial springs into ring 0 (forces into rad),
@@ -208,7 +210,9 @@ LAT_INLINE void LK(op)(LK(block) *B, double *partial, uint32_t s, uint32_t j)
             LK(eval_ptrs)(B, s, j - 1, Xp, Vp);
             LK(radials)(a, Xp, Vp, X, V, j, lv->rad[cur], mine && cut ? &B->cut : own, held);
             if (mine && cut) {
-                lv->cut_e[q] = col_take(B->cut.c[L_ELASTIC], L->radials);
+                const bool el = wants_elastic(a->mode, a->stage);
+                assert(el || col_zero(B->cut.c[L_ELASTIC], L->radials));
+                lv->cut_e[q] = el ? col_take(B->cut.c[L_ELASTIC], L->radials) : 0;
                 lv->cut_p[q] = col_take(B->cut.c[L_DAMP], L->radials);
             }
         }
@@ -320,13 +324,14 @@ typedef struct LK(pass) {
     void (*run)(LK(block) *, double *);
 } LK(pass);
 
-/* Share t's block: its run of bands, on its workspace and sum columns. */
+/* Share t's block: its run of bands (L->split), on its workspace and sum
+ * columns. */
 static void LK(share_block)(const LK(pass) *P, int t, LK(block) *B)
 {
     const spn__lattice *L = P->L;
-    const uint64_t nb = L->nbands, T = (uint64_t)P->threads;
-    const uint32_t b0 = (uint32_t)(nb * (uint64_t)t / T), b1 = (uint32_t)(nb * ((uint64_t)t + 1) / T);
-    LK(block_init)(B, P->la, P->rk4, (LK_T *)L->bws[t], L->cols[t], lat_band_lo(L, b0), lat_band_lo(L, b1), P->K);
+    uint32_t R0, R1;
+    spn__lattice_split_rows(L, t, &R0, &R1);
+    LK(block_init)(B, P->la, P->rk4, (LK_T *)L->bws[t], L->cols[t], R0, R1, P->K);
 }
 
 static void LK(ghost_share)(void *ctx, int t, int thread)
@@ -343,7 +348,9 @@ static void LK(front_share)(void *ctx, int t, int thread)
     const LK(pass) *P = ctx;
     LK(block) B;
     LK(share_block)(P, t, &B);
+    const double t0 = P->threads > 1 ? spn__lattice_clock_ns() : 0;
     P->run(&B, P->L->partial_k);
+    if (P->threads > 1) P->L->split.took[t].ns = spn__lattice_clock_ns() - t0;
 }
 
 /* K levels (2 .. LAT_LEVELS, spn__lattice_block_ready) in one pass over the
@@ -354,10 +361,11 @@ static bool LK(block_pass)(spn__lattice *L, const LK_ARGS *la, bool rk4, int thr
                            double sums[][L_NSUMS])
 {
     if (!spn__lattice_block_alloc(L, threads, LK(block_numbers)(LK(stride)(la)) * sizeof(LK_T)) ||
-        !spn__lattice_cols_alloc(L, threads))
+        !spn__lattice_cols_alloc(L, threads) || !spn__lattice_split_ready(L, threads))
         return false;
     LK(pass) P = {L, la, rk4, K, threads, LK(runner)(rk4)};
     spn__lat_run(L, threads, threads, LK(ghost_share), LK(front_share), &P);
+    if (threads > 1) spn__lattice_split_update(L);
     spn__lattice_block_sums(L, K, sums);
     return true;
 }

@@ -11,6 +11,7 @@
 
 #include "world_internal.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
@@ -116,6 +117,29 @@ typedef struct lat_gov {
 int spn__lat_gov_pick(lat_gov *g, double now);
 void spn__lat_gov_record(lat_gov *g, double ns, double now);
 
+/* How a blocked pass on threads shares out its bands (lattice_block.c,
+ * spn__lattice_split_*): share t takes bands [first[t], first[t + 1]). Even
+ * at first; then, from each pass's measured time per row of each share, the
+ * bands move toward the faster threads, as two cores of a virtual machine,
+ * or a big and a little core, need not run alike. Where the bands go
+ * changes no result: every band's rows get the same arithmetic and its sums
+ * the same order on any thread. */
+typedef struct lat_share_time {
+    double ns; /* the share's fronts in the last pass (its own line: each share writes its own) */
+    char pad[64 - sizeof(double)];
+} lat_share_time;
+
+typedef struct lat_split {
+    int shares; /* what first[] is for: shares and bands (0: nothing yet) */
+    uint32_t nbands;
+    uint32_t *first;      /* shares + 1 band boundaries */
+    double *rate;         /* per share: smoothed ns per row (0: not measured) */
+    lat_share_time *took; /* per share */
+    int hold;             /* tests: >= 0 holds share 0 to this many bands (two shares) */
+    bool moved;           /* the last pass ran on a new split: its times are not learnt from */
+    unsigned long moves;  /* new splits taken (for tests and measurements) */
+} lat_split;
+
 struct spn__lattice {
     uint32_t rings, radials;
     /* The float64 arrays' row pitch: radials rounded up to whole 64-byte
@@ -152,6 +176,7 @@ struct spn__lattice {
     int ncols;
     size_t col_stride;
     lat_gov gov;
+    lat_split split;            /* blocked passes on threads: the bands of each share */
     struct spn__lat_team *team; /* open for a spn_world_advance call (lattice_team.c), or NULL */
 };
 
@@ -285,14 +310,53 @@ LAT_INLINE double col_take(double *restrict c, uint32_t n)
     return lane_total(acc);
 }
 
+/* Whether column c[0 .. n) holds only zeros (asserted of the columns a
+ * level leaves alone). */
+LAT_INLINE bool col_zero(const double *c, uint32_t n)
+{
+    for (uint32_t i = 0; i < n; i++)
+        if (c[i] != 0) return false;
+    return true;
+}
+
+#define L_ALL_SUMS ((1u << L_NSUMS) - 1)
+
+/* The sums (bit k: sum k) a step or RK4 stage of `mode` adds terms to;
+ * the others' columns stay zero. An RK4 stage sums the elastic energy at
+ * its first stage only (lat_rk4_result reads it there), m v^2 at the first
+ * unless carried (kin_known), at every stage with drag, and at the last,
+ * with the gain and the new kinetic energy (LK(rk4_update)). */
+LAT_INLINE unsigned lat_sums_made(int mode, int stage, bool kin_known, bool drag)
+{
+    if (mode != MODE_RK4_STAGE && mode != MODE_RK4_LAST) return L_ALL_SUMS;
+    unsigned m = 1u << L_DAMP;
+    if (stage == 0) m |= 1u << L_ELASTIC;
+    if ((stage == 0 && !kin_known) || drag || stage == 3) m |= 1u << L_MV2;
+    if (stage == 3) m |= 1u << L_GAIN | 1u << L_MVN2;
+    return m;
+}
+
 /* A band's sums into out (its L_NSUMS partials), from its columns (n
  * wide): the spring energy terms add to what the band's cut put there (the
- * first band has none), the particle terms are the band's own. */
-LAT_INLINE void store_band_sums(double *out, bool first, const lat_cols *cs, uint32_t n)
+ * first band has none), the particle terms are the band's own. Only the
+ * sums in `made` (lat_sums_made) are taken: the others are zero, as
+ * col_take would find them (+0, whose addition changes no bit), and a
+ * column costs a pass over it, which at eight bands and four RK4 stages a
+ * pass adds up. */
+LAT_INLINE void store_band_sums(double *out, bool first, const lat_cols *cs, uint32_t n, unsigned made)
 {
     if (first) out[L_ELASTIC] = out[L_DAMP] = 0;
-    out[L_ELASTIC] += col_take(cs->c[L_ELASTIC], n), out[L_DAMP] += col_take(cs->c[L_DAMP], n);
-    for (int k = L_MV2; k <= L_MVN2; k++) out[k] = col_take(cs->c[k], n);
+    for (int k = 0; k < L_NSUMS; k++) {
+        double v = 0;
+        if (made >> k & 1)
+            v = col_take(cs->c[k], n);
+        else
+            assert(col_zero(cs->c[k], n));
+        if (k <= L_DAMP)
+            out[k] += v;
+        else
+            out[k] = v;
+    }
 }
 
 /* Springs j = 0..n-1 from (a[j]) to (b[j]), SoA: force on end a into f, the
@@ -415,6 +479,17 @@ bool spn__lattice_block_alloc(spn__lattice *L, int threads, size_t bytes);
 bool spn__lattice_cols_alloc(spn__lattice *L, int threads);
 /* Each level's sums from its band partials, in band order. */
 void spn__lattice_block_sums(const spn__lattice *L, uint32_t K, double sums[][L_NSUMS]);
+/* The split of L's bands over `shares` shares ready (even, if the shares or
+ * bands changed); false when out of memory. */
+bool spn__lattice_split_ready(spn__lattice *L, int shares);
+/* Share t's rows [*R0, *R1) under the split. */
+void spn__lattice_split_rows(const spn__lattice *L, int t, uint32_t *R0, uint32_t *R1);
+/* After a pass whose shares' fronts took split.took[t].ns: the rates, and
+ * a new split where it would shorten the slowest share's part by more than
+ * a few percent. */
+void spn__lattice_split_update(spn__lattice *L);
+/* CLOCK_MONOTONIC in ns (a share's fronts are timed by it). */
+double spn__lattice_clock_ns(void);
 /* Whether float64 RK4 passes run their AVX2 version (lattice_block_t.h,
  * LK(runner)) on this processor; see lattice_block.c. */
 bool spn__lattice_rk4_avx2(void);

@@ -92,7 +92,7 @@ SPN__KERNEL static void LK(band_pass)(const LK_ARGS *a, LK_T *ws, double *cols, 
         rad_prev = rad_cur;
     }
     LK(finish)(a, 1 + (size_t)(hi - 1) * P, n, rad_prev, RING[cur ^ 1], hi < L->rings ? next_cut : NULL, Fw, &cs);
-    store_band_sums(L->partial + (size_t)b * L_NSUMS, b == 0, &cs, n);
+    store_band_sums(L->partial + (size_t)b * L_NSUMS, b == 0, &cs, n, L_ALL_SUMS);
 }
 
 /* The sweep as a job of spn__lat_run, a share a band: the cut passes,

@@ -392,6 +392,10 @@ double spn__lattice_step_bytes(const spn_world *w, int steps, int blocked);
  * (`single`), not in blocked passes, for a reference to hold the passes'
  * bits against; false again lets them run. */
 void spn__lattice_set_unblocked(spn_world *w, bool single);
+/* Tests: blocked passes on two threads give share 0 the first `bands`
+ * bands from the next pass on (where that leaves each share its rows),
+ * instead of moving the split by the shares' speeds; -1 lets it move. */
+void spn__lattice_split_hold(spn_world *w, int bands);
 /* For tests: the lattice's thread governor (lattice.c) set to keep choosing
  * threads (or one thread) below parallel_min, as if it had measured them
  * faster; false when the world has no lattice. */
