@@ -144,9 +144,9 @@ struct spn__lattice {
     uint32_t rings, radials;
     /* The float64 arrays' row pitch: radials rounded up to whole 64-byte
      * lines, so that every row starts a line (the state's, masses' and
-     * slots'; the float32 step keeps rows of `radials`). Particle
-     * 1 + j N + i of the world is 1 + j pitch + i here, slot j N + i is
-     * j pitch + i. */
+     * slots'; the float32 step's rows have a pitch of their own,
+     * spn__lat32). Particle 1 + j N + i of the world is 1 + j pitch + i
+     * here, slot j N + i is j pitch + i. */
     uint32_t pitch;
     size_t nlat; /* numbers in each float64 particle array: 1 + rings pitch */
     double *slots;            /* the block of the six slot arrays below */
@@ -192,7 +192,7 @@ static inline size_t lat_slot(const spn__lattice *L, size_t s) { return lat_slot
 /* Band b's first row (b = nbands: the rings): the rings shared out as
  * evenly as whole rows go, the bands' sizes differing by one at most, so
  * that two threads taking half the bands each take half the rows (the 5k
- * web's 50 rings: 12, 13, 12 and 13). */
+ * web's 50 rings in eight bands: 6, 6, 7, 6, 6, 6, 6 and 7). */
 static inline uint32_t lat_band_lo(const spn__lattice *L, uint32_t b)
 {
     return (uint32_t)((uint64_t)b * L->rings / L->nbands);
