@@ -50,7 +50,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 /* ---- building ---- */
 
@@ -117,7 +116,7 @@ void spn__lattice_build(spn_world *w)
     L->gov.t0 = -1;
     L->split.hold = -1;
     L->rings = rings, L->radials = n;
-    L->pitch = (n + 7) & ~(uint32_t)7;
+    L->pitch = padded64(n);
     L->nlat = 1 + (size_t)rings * L->pitch;
     void *first;
     size_t pitch;
@@ -192,7 +191,7 @@ static bool prepare(spn_world *w, int threads)
         double **ws = realloc(L->ws, (size_t)threads * sizeof *ws);
         if (!ws) return false;
         L->ws = ws;
-        L->stride = ((size_t)n + 7) & ~(size_t)7;
+        L->stride = padded64(n);
         for (; L->nws < threads; L->nws++) {
             L->ws[L->nws] = spn__lattice_arrays(WS_COUNT, L->stride, sizeof **L->ws, 0, NULL, NULL);
             if (!L->ws[L->nws]) return false;
@@ -624,12 +623,7 @@ bool spn__lattice_gov_prefer(spn_world *w, bool threads)
     return true;
 }
 
-static double seconds_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
+static double seconds_now(void) { return 1e-9 * spn__lattice_clock_ns(); }
 
 /* The threads for a unit of work on a web that may take them (threads), as
  * the governor picks below parallel_min, its timing started. A unit begun

@@ -62,7 +62,7 @@ bool spn__lattice_cols_alloc(spn__lattice *L, int threads)
     double **cols = realloc(L->cols, (size_t)threads * sizeof *cols);
     if (!cols) return false;
     L->cols = cols;
-    L->col_stride = ((size_t)L->radials + 15) & ~(size_t)15; /* (float32's padded rows of scratch) */
+    L->col_stride = ((size_t)L->radials + 15) & ~(size_t)15; /* padded32(radials): float32's scratch rows */
     for (; L->ncols < threads; L->ncols++)
         if (!(L->cols[L->ncols] = spn__lattice_arrays(COL_COUNT, L->col_stride, sizeof **L->cols, 0, NULL, NULL)))
             return false;
@@ -204,7 +204,6 @@ void spn__lattice_split_update(spn__lattice *L)
     if (longest < SPLIT_MARGIN * worst) {
         memcpy(S->first, next, ((size_t)T + 1) * sizeof *next);
         S->moved = true;
-        S->moves++;
     }
 }
 

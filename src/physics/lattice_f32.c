@@ -271,7 +271,7 @@ static void write_back(spn_world *w, int threads, bool rebase)
 
 static bool alloc_state(spn__lattice *L, size_t np)
 {
-    const uint32_t rp = (L->radials + 15) & ~(uint32_t)15;
+    const uint32_t rp = padded32(L->radials);
     const size_t m = (size_t)L->rings * rp, nlat = 1 + m;
     if (L->f32 && L->f32->np == np) return true;
     spn__lat32_free(L->f32);
@@ -353,7 +353,7 @@ static bool prepare32(spn__lattice *L, int threads)
         float **ws = realloc(F->ws, (size_t)threads * sizeof *ws);
         if (!ws) return false;
         F->ws = ws;
-        F->stride = ((size_t)L->radials + 15) & ~(size_t)15;
+        F->stride = padded32(L->radials);
         for (; F->nws < threads; F->nws++)
             if (!(F->ws[F->nws] = spn__lattice_arrays(WS_COUNT, F->stride, sizeof **F->ws, 0, NULL, NULL)))
                 return false;

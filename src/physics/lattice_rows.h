@@ -137,7 +137,6 @@ typedef struct lat_split {
     lat_share_time *took; /* per share */
     int hold;             /* tests: >= 0 holds share 0 to this many bands (two shares) */
     bool moved;           /* the last pass ran on a new split: its times are not learnt from */
-    unsigned long moves;  /* new splits taken (for tests and measurements) */
 } lat_split;
 
 struct spn__lattice {
@@ -319,6 +318,14 @@ LAT_INLINE bool col_zero(const double *c, uint32_t n)
     return true;
 }
 
+/* Whether a sweep or a level of a blocked pass sums the springs' elastic
+ * energy: RK4 reads it from its first stage only (lat_rk4_result), so its
+ * other three stages leave it out (their L_ELASTIC sums stay 0). */
+LAT_INLINE bool wants_elastic(int mode, int stage)
+{
+    return stage == 0 || (mode != MODE_RK4_STAGE && mode != MODE_RK4_LAST);
+}
+
 #define L_ALL_SUMS ((1u << L_NSUMS) - 1)
 
 /* The sums (bit k: sum k) a step or RK4 stage of `mode` adds terms to;
@@ -330,7 +337,7 @@ LAT_INLINE unsigned lat_sums_made(int mode, int stage, bool kin_known, bool drag
 {
     if (mode != MODE_RK4_STAGE && mode != MODE_RK4_LAST) return L_ALL_SUMS;
     unsigned m = 1u << L_DAMP;
-    if (stage == 0) m |= 1u << L_ELASTIC;
+    if (wants_elastic(mode, stage)) m |= 1u << L_ELASTIC;
     if ((stage == 0 && !kin_known) || drag || stage == 3) m |= 1u << L_MV2;
     if (stage == 3) m |= 1u << L_GAIN | 1u << L_MVN2;
     return m;
@@ -390,14 +397,6 @@ LAT_INLINE void springs(bool elastic, uint32_t n, const double *restrict axp, co
         cp[j] += kd * rate * rate;
         fx[j] = s * lx, fy[j] = s * ly, fz[j] = s * lz;
     }
-}
-
-/* Whether a sweep or a level of a blocked pass sums the springs' elastic
- * energy: RK4 reads it from its first stage only (lat_rk4_result), so its
- * other three stages leave it out (their L_ELASTIC sums stay 0). */
-LAT_INLINE bool wants_elastic(int mode, int stage)
-{
-    return stage == 0 || (mode != MODE_RK4_STAGE && mode != MODE_RK4_LAST);
 }
 
 /* Springs from rows a to b of a state (3 arrays each, offsets off_a,
