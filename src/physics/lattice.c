@@ -208,7 +208,8 @@ LAT_INLINE void eval_rows(const lat_args *a, size_t p0, double **X, double **V)
     for (int c = 0; c < 3; c++) X[c] = (double *)a->ex[c] + p0, V[c] = (double *)a->ev[c] + p0;
 }
 
-/* Particles p0 .. p0+n-1 of an RK4 stage, their force F (3 arrays) known. */
+/* Particles p0 .. p0+n-1 of an RK4 stage, their force F (3 arrays) known
+ * (n: the hub's 1 or a row's padded length, LK(rk4_update)). */
 LAT_INLINE void rk4_update(const lat_args *a, size_t p0, uint32_t n, double *const *F,
                            const lat_cols *cs)
 {
@@ -230,7 +231,7 @@ LAT_INLINE void finish(const lat_args *a, size_t p0, uint32_t n, double *const *
     if (a->mode == MODE_RK4_STAGE || a->mode == MODE_RK4_LAST) {
         for (int c = 0; c < 3; c++)
             assemble64(n, a->g[c], a->drag, a->mass + p0, a->ev[c] + p0, ri[c], rg[c], ro ? ro[c] : NULL, Fw[c]);
-        rk4_update(a, p0, n, Fw, cs);
+        rk4_update(a, p0, padded64(n), Fw, cs);
         return;
     }
     double *X[3], *V[3];

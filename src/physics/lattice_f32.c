@@ -104,7 +104,8 @@ LAT_INLINE void eval_rows(const a32 *a, size_t p0, float **D, float **U)
     for (int c = 0; c < 3; c++) D[c] = (float *)a->ed[c] + p0, U[c] = (float *)a->eu[c] + p0;
 }
 
-/* Particles p0 .. p0+n-1 of an RK4 stage, their force F (3 arrays) known. */
+/* Particles p0 .. p0+n-1 of an RK4 stage, their force F (3 arrays) known
+ * (n: the hub's 1 or a row's padded length, LK(rk4_update)). */
 LAT_INLINE void rk4_update(const a32 *a, size_t p0, uint32_t n, float *const *F,
                            const lat_cols *cs)
 {
@@ -125,7 +126,7 @@ LAT_INLINE void finish32(const a32 *a, size_t p0, uint32_t n, float *const *ri, 
     if (a->mode == MODE_RK4_STAGE || a->mode == MODE_RK4_LAST) {
         for (int c = 0; c < 3; c++)
             assemble32(n, a->g[c], a->drag, F->mass + p0, a->eu[c] + p0, ri[c], rg[c], ro ? ro[c] : NULL, Fw[c]);
-        rk4_update(a, p0, n, Fw, cs);
+        rk4_update(a, p0, padded32(n), Fw, cs);
         return;
     }
     float *D[3], *U[3];

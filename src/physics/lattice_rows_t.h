@@ -22,10 +22,10 @@
  * the pitch of every row array of the lattice (the state, masses, slots and
  * RK4 arrays, the force rows, ghost rows and sum columns), whose padding
  * holds zeros: massless particles that no select moves, at rest, with
- * springs of zero stiffness. The particle loops of LK(row) and
- * LK(assemble) run over it, so that they end on a whole vector instead of
- * a scalar remainder (docs/physics-lattice.md, "Loops over the padding");
- * what they write there is never read. */
+ * springs of zero stiffness. The particle loops of LK(row), LK(assemble)
+ * and LK(rk4_update) run over it, so that they end on a whole vector
+ * instead of a scalar remainder (docs/physics-lattice.md, "Loops over the
+ * padding"); what they write there is never read. */
 LAT_INLINE uint32_t LK(padded)(uint32_t n)
 {
     const uint32_t lanes = 64 / sizeof(LK_T);
@@ -386,7 +386,9 @@ LAT_INLINE void LK(rk4_stages)(uint32_t n, int stage, LK_T h, LK_T wgt, const LK
 
 /* n particles of RK4 stage `stage` (0-3; weighted `wgt`, step fraction h,
  * or h = dt / 6 at the last), their force F known and masses from mass and
- * inv_mass; sum terms into the columns cs. kin_known: no drag, and the sum
+ * inv_mass; sum terms into the columns cs. n is the hub's 1 or a row's
+ * LK(padded)(N): the padding's massless particles stay where they are
+ * (zeros) and add nothing to the sums. kin_known: no drag, and the sum
  * of m v^2 at the first stage is known already, so it is not summed. (The
  * last stage's m v'^2 terms are those of the next step's first stage, bit
  * for bit: LK(rk4_sums) forms v' as LK(rk4_last) stores it, the masses
