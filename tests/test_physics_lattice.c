@@ -22,7 +22,7 @@
 #include <spinneret/spinneret.h>
 
 #include "physics/lattice_rows.h"    /* lat_gov, spn__lat_gov_pick, spn__lat_run */
-#include "physics/world_internal.h" /* spn__lattice_step_bytes, _gov_prefer, _set_unblocked */
+#include "physics/world_internal.h" /* spn__lattice_step_bytes, _gov_prefer, _set_unblocked, _hold_passes */
 
 /* The standard web with a disturbed state: random velocities (seeded), one
  * free particle pinned mid-web, viscous drag, so damping, slack tension-only
@@ -48,8 +48,19 @@ static spn_world *disturbed_orb(spn_integrator integ, int rings, int radials, in
                                                 0.2 * spn_rng_normal(&rng)));
     spn_world_set_fixed(w, 1 + (uint32_t)radials + 3, true);
     spn_world_set_lattice(w, lattice);
+    /* blocked passes on one thread wherever they apply, so that the tests
+     * can count them (test_pass_governor lets the governor pick) */
+    spn__lattice_hold_passes(w, true);
     assert_int_equal(spn_world_compile(w), SPN_OK);
     assert_string_equal(spn_world_step_path(w), lattice ? "lattice" : "general");
+    return w;
+}
+
+/* The 40 x 50 web of most tests below (parallel_min 256), float32 if asked. */
+static spn_world *web_2k(spn_integrator integ, int threads, bool f32)
+{
+    spn_world *w = disturbed_orb(integ, 40, 50, threads, 256, true);
+    if (f32) spn_world_set_precision(w, SPN_PRECISION_FLOAT32);
     return w;
 }
 
@@ -59,6 +70,14 @@ static void assert_same_state(const spn_world *a, const spn_world *b)
     assert_int_equal(n, spn_world_particle_count(b));
     assert_memory_equal(spn_world_positions(a), spn_world_positions(b), n * sizeof(spn_vec3));
     assert_memory_equal(spn_world_velocities(a), spn_world_velocities(b), n * sizeof(spn_vec3));
+}
+
+/* The same state and the same energy lost, bit for bit. */
+static void assert_same_run(const spn_world *a, const spn_world *b)
+{
+    assert_same_state(a, b);
+    spn_energy ea = spn_world_energy(a), eb = spn_world_energy(b);
+    assert_memory_equal(&ea.dissipated, &eb.dissipated, sizeof(double));
 }
 
 /* The same change in a and b: spring s 10% shorter at rest, spring s + 1
@@ -258,14 +277,8 @@ static void test_team_asleep_between_jobs(void **state)
     const spn_integrator integs[] = {SPN_INTEGRATOR_SYMPLECTIC, SPN_INTEGRATOR_RK4};
     for (int k = 0; k < 2; k++)
         for (int f32 = 0; f32 < 2; f32++) {
-            spn_world *one = disturbed_orb(integs[k], 40, 50, 1, 256, true);
-            spn_world *two = disturbed_orb(integs[k], 40, 50, 2, 256, true);
-            spn_world *ref = disturbed_orb(integs[k], 40, 50, 1, 256, true);
-            if (f32) {
-                spn_world_set_precision(one, SPN_PRECISION_FLOAT32);
-                spn_world_set_precision(two, SPN_PRECISION_FLOAT32);
-                spn_world_set_precision(ref, SPN_PRECISION_FLOAT32);
-            }
+            spn_world *one = web_2k(integs[k], 1, f32), *two = web_2k(integs[k], 2, f32);
+            spn_world *ref = web_2k(integs[k], 1, f32);
             spn__lattice_set_unblocked(ref, true);
             const int blocked = integs[k] == SPN_INTEGRATOR_RK4 ? 29 : 28;
             assert_int_equal(spn_world_advance(ref, 2e-6, 29), SPN_OK);
@@ -573,9 +586,7 @@ static void test_governor_same_bits(void **state)
             assert_int_equal(spn_world_last_step(two).blocked, 8);
             assert_int_equal(spn_world_advance(one, 2e-6, 8), SPN_OK);
             assert_int_equal(spn_world_last_step(one).blocked, 0);
-            assert_same_state(two, one);
-            spn_energy e2 = spn_world_energy(two), e1 = spn_world_energy(one);
-            assert_memory_equal(&e2.dissipated, &e1.dissipated, sizeof(double));
+            assert_same_run(two, one);
         }
         /* and as it chooses by itself */
         assert_int_equal(spn_world_advance(two, 2e-6, 40), SPN_OK);
@@ -585,6 +596,43 @@ static void test_governor_same_bits(void **state)
         spn_world_destroy(two);
         spn_world_destroy(one);
     }
+}
+
+/* On one thread the pass governor (lattice.c, "One thread: passes or
+ * single steps") times an explicit step's blocked passes against single
+ * steps and keeps the faster. Its first unit is a pass and its second a
+ * single step, so a first call takes some steps each way; whatever it
+ * picks in the calls after, the bits are those of single steps, in the
+ * state and the energy books, float64 and float32. RK4 takes every step it
+ * can in passes. */
+static void test_pass_governor(void **state)
+{
+    (void)state;
+    const spn_integrator integs[] = {SPN_INTEGRATOR_SYMPLECTIC, SPN_INTEGRATOR_RK4};
+    for (int k = 0; k < 2; k++)
+        for (int f32 = 0; f32 < 2; f32++) {
+            spn_world *one = web_2k(integs[k], 1, f32), *ref = web_2k(integs[k], 1, f32);
+            spn__lattice_hold_passes(one, false);
+            spn__lattice_set_unblocked(ref, true);
+            for (int call = 0; call < 4; call++) {
+                assert_int_equal(spn_world_advance(one, 2e-6, 28), SPN_OK);
+                const int blocked = spn_world_last_step(one).blocked;
+                if (integs[k] == SPN_INTEGRATOR_RK4) {
+                    assert_int_equal(blocked, 28);
+                } else if (call == 0) {
+                    /* the first pass (4 steps), then a single step: 28 in
+                     * passes only if that were skipped */
+                    assert_true(blocked >= 4);
+                    assert_true(blocked <= 27);
+                }
+                assert_int_equal(spn_world_advance(ref, 2e-6, 28), SPN_OK);
+                assert_int_equal(spn_world_last_step(ref).blocked, 0);
+                assert_same_run(one, ref);
+            }
+            assert_true(fastest(one) > 0.01);
+            spn_world_destroy(one);
+            spn_world_destroy(ref);
+        }
 }
 
 /* Where the bands of a blocked pass on two threads go (lat_split: share 0
@@ -613,9 +661,7 @@ static void test_split_same_bits(void **state)
             assert_int_equal(two->lat->nbands, 8);
             if (holds[h] >= 0) assert_int_equal(two->lat->split.first[1], holds[h]);
             assert_int_equal(spn_world_advance(one, 2e-6, 24), SPN_OK);
-            assert_same_state(two, one);
-            spn_energy e2 = spn_world_energy(two), e1 = spn_world_energy(one);
-            assert_memory_equal(&e2.dissipated, &e1.dissipated, sizeof(double));
+            assert_same_run(two, one);
         }
         assert_true(fastest(one) > 0.01);
         spn_world_destroy(two);
@@ -850,6 +896,7 @@ int main(void)
         cmocka_unit_test(test_team_jobs),         cmocka_unit_test(test_team_asleep_between_jobs),
         cmocka_unit_test(test_rk4_pass_versions), cmocka_unit_test(test_blocked_passes_float32),
         cmocka_unit_test(test_governor_choices),  cmocka_unit_test(test_governor_same_bits),
+        cmocka_unit_test(test_pass_governor),
         cmocka_unit_test(test_split_same_bits),   cmocka_unit_test(test_split_follows_speed),
         cmocka_unit_test(test_changes_and_break), cmocka_unit_test(test_hand_built_and_breakage),
         cmocka_unit_test(test_not_a_lattice),     cmocka_unit_test(test_traffic_model),

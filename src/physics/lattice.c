@@ -113,7 +113,7 @@ void spn__lattice_build(spn_world *w)
         if (w->sflags[s] & SPN_SPRING_BROKEN) return;
     spn__lattice *L = calloc(1, sizeof *L);
     if (!L) return;
-    L->gov.t0 = -1;
+    L->gov.t0 = -1, L->passes.t0 = -1;
     L->split.hold = -1;
     L->rings = rings, L->radials = n;
     L->pitch = padded64(n);
@@ -643,15 +643,53 @@ static int gov_begin(spn_world *w, int threads)
     return g->mode ? threads : 1;
 }
 
-/* The unit begun by gov_begin done: `levels` steps or RK4 stages. */
+/* The unit begun by gov_begin (and passes_pick) done: `levels` steps or
+ * RK4 stages, timed for each governor that timed it. */
 static void gov_end(spn_world *w, uint32_t levels)
 {
-    lat_gov *g = &w->lat->gov;
-    if (!(g->t0 >= 0)) return;
-    const double now = seconds_now();
-    spn__lat_gov_record(g, (now - g->t0) * 1e9 / ((double)w->np * levels), now);
-    g->t0 = -1;
+    lat_gov *const G[2] = {&w->lat->gov, &w->lat->passes};
+    double now = -1;
+    for (int i = 0; i < 2; i++) {
+        lat_gov *g = G[i];
+        if (!(g->t0 >= 0)) continue;
+        if (now < 0) now = seconds_now();
+        spn__lat_gov_record(g, (now - g->t0) * 1e9 / ((double)w->np * levels), now);
+        g->t0 = -1;
+    }
 }
+
+/* ---- one thread: passes or single steps ----
+ *
+ * A blocked pass keeps the rows in flight in the caches, but it pays for
+ * that with per-level force rows, sum columns and bookkeeping, a working
+ * set of some 100 KB a front on the 5k web. On one thread it is the faster
+ * way for tiny webs (whose single steps are mostly fixed costs) and for
+ * webs larger than the L2 cache, not always in between. Measured on the Zen
+ * 5 (forty-sixth session, one thread, minimum ns a spring-step, single
+ * steps against passes): symplectic float64 500 particles 2.35-2.46 against
+ * 2.30-2.31, 5k 2.05-2.09 against 2.17-2.26, 20k 2.13-2.14 against
+ * 1.99-2.01; float32 5k 1.58-1.66 against 1.79-1.84, 20k and 50k alike;
+ * RK4 5k float64 10.5-11.1 against 9.25-9.38, float32 6.20-6.41 against
+ * 6.50-6.66. Where the line falls for the explicit steps depends on the
+ * machine's caches, so on one thread each of their units is also timed by
+ * a second governor with the thread governor's rules (above): choice 0 a
+ * single step (the sweep), 1 a blocked pass. RK4 keeps its passes: its
+ * single stages read and write six whole-web arrays each, and its passes
+ * were the faster by a seventh or more (a governor's tries of the sweep
+ * cost it 1-4% in `make bench`'s short runs). The bits are the same either
+ * way (tests/test_physics_lattice.c). True: take a blocked pass for this
+ * unit (its timing started). */
+static bool passes_pick(spn_world *w)
+{
+    if (w->lattice_passes_held) return true;
+    lat_gov *g = &w->lat->passes;
+    const double now = seconds_now();
+    if (!(g->t0 >= 0)) spn__lat_gov_pick(g, now);
+    g->t0 = now;
+    return g->mode;
+}
+
+void spn__lattice_hold_passes(spn_world *w, bool held) { w->lattice_passes_held = held; }
 
 /* A team for a replayable advance call (lattice_team.c) when its steps
  * would go on threads: on a web the governor rules, only when its pick now
@@ -778,12 +816,14 @@ int spn__lattice_block_steps(spn_world *w, double dt, int k, spn__step_result *r
     const uint32_t levels = rk4 ? 4 : (uint32_t)k;
     if (levels < 2 || !w->no_backup) return 0;
     if (w->lattice_unblocked) return 0;
-    /* on one thread too, at any size (forty-third session, Zen 5, one
-     * thread, CPU ns a spring-step: the 5k web's RK4 step 15.9 -> 11.0,
-     * symplectic 2.85 -> 2.65, webs of a few hundred particles up to twice
-     * as fast; docs/physics-lattice.md, "One thread") */
+    /* on one thread too: RK4 always, explicit steps as the pass governor
+     * picks (above; from the forty-third session to the forty-sixth every
+     * one-thread step went in passes, measured then on the 5k web at RK4
+     * 15.9 -> 11.0 and symplectic 2.85 -> 2.65 CPU ns a spring-step;
+     * docs/physics-lattice.md, "One thread") */
     const int threads = ready(w);
     if (!threads || !spn__lattice_block_ready(w->lat, threads, levels)) return 0;
+    if (threads == 1 && !rk4 && !passes_pick(w)) return 0; /* (the single step ends the unit) */
     const int mode = rk4 ? MODE_RK4_STAGE : in == SPN_INTEGRATOR_SYMPLECTIC ? MODE_SYMPLECTIC : MODE_EULER;
     if (float32(w)) {
         if (w->lat->live) write_back(w, threads);

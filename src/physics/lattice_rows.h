@@ -94,26 +94,30 @@ static inline void lat_mv2_carry(lat_mv2 *m, bool known, double sums[][L_NSUMS])
     m->ok = true;
 }
 
-/* The thread governor of a web that may take threads below parallel_min
- * (lattice.c, "Threads below parallel_min"): what a unit of work (one step,
- * or one blocked pass) costs on one thread and on threads, ns per particle
- * and level, which is kept, and when the other is tried again. */
+/* A governor (lattice.c): what a unit of work (one step, or one blocked
+ * pass) costs with each of two choices, ns per particle and level, which is
+ * kept, and when the other is tried again. The thread governor of a web
+ * that may take threads below parallel_min ("Threads below parallel_min")
+ * chooses between one thread (0) and threads (1); the pass governor, on one
+ * thread ("One thread: passes or single steps"), between single steps (0)
+ * and blocked passes (1). */
 typedef struct lat_gov {
-    double ns[2];     /* [0] one thread, [1] threads: the kept choice's running mean
-                       * over its units, the other's from its last try; 0 until measured */
+    double ns[2];     /* choice [0] (one thread; single steps) and [1] (threads; blocked
+                       * passes): the kept choice's running mean over its units, the
+                       * other's from its last try; 0 until measured */
     double t0;        /* start of the unit being timed [s]; < 0: none */
     double next;      /* the choice not kept is tried from this time [s] */
     double wait[2];   /* ... each choice this long after it was last tried or left [s];
                        * 0 before the first two units */
     double try_sum;   /* ns of the try under way, summed over its units */
     int try_units;    /* its units so far (0: no try under way) */
-    int mode;         /* the unit being timed: 0 one thread, 1 threads */
+    int mode;         /* the unit being timed: choice 0 or 1 */
     int kept;         /* the choice kept between tries */
 } lat_gov;
 
-/* The governor's choice for the unit starting at `now` [s] (0 one thread,
- * 1 threads), and its record of the unit ending at `now` that took `ns` per
- * particle and level. */
+/* A governor's choice (0 or 1) for the unit starting at `now` [s], and its
+ * record of the unit ending at `now` that took `ns` per particle and
+ * level. */
 int spn__lat_gov_pick(lat_gov *g, double now);
 void spn__lat_gov_record(lat_gov *g, double ns, double now);
 
@@ -174,7 +178,8 @@ struct spn__lattice {
     double **cols;   /* per thread: COL_COUNT sum columns of col_stride doubles, zero between uses */
     int ncols;
     size_t col_stride;
-    lat_gov gov;
+    lat_gov gov;                /* below parallel_min: one thread or threads (lattice.c) */
+    lat_gov passes;             /* on one thread: single steps or blocked passes (lattice.c) */
     lat_split split;            /* blocked passes on threads: the bands of each share */
     struct spn__lat_team *team; /* open for a spn_world_advance call (lattice_team.c), or NULL */
 };

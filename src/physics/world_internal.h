@@ -171,6 +171,7 @@ struct spn_world {
     spn__lattice *lat;               /* the stencil step of a regular orb web (NULL: none) */
     bool lattice_off;                /* spn_world_set_lattice(w, false) */
     bool lattice_unblocked;          /* spn__lattice_set_unblocked (tests) */
+    bool lattice_passes_held;        /* spn__lattice_hold_passes (tests) */
     uint8_t precision;               /* spn_precision: float32 lattice steps when set */
     spn_vec3 *tmp[SPN_TMP_COUNT]; /* per-particle scratch, allocated on demand */
     spn_vec3 *fair;       /* per-spring air force (on demand) */
@@ -392,6 +393,10 @@ double spn__lattice_step_bytes(const spn_world *w, int steps, int blocked);
  * (`single`), not in blocked passes, for a reference to hold the passes'
  * bits against; false again lets them run. */
 void spn__lattice_set_unblocked(spn_world *w, bool single);
+/* For tests: on one thread, blocked passes taken wherever they apply
+ * (`held`), instead of as the pass governor (lattice.c) picks between them
+ * and single steps; false lets it pick again. */
+void spn__lattice_hold_passes(spn_world *w, bool held);
 /* Tests: blocked passes on two threads give share 0 the first `bands`
  * bands from the next pass on (where that leaves each share its rows),
  * instead of moving the split by the shares' speeds; -1 lets it move. */
