@@ -604,7 +604,8 @@ static void test_governor_same_bits(void **state)
  * single step, so a first call takes some steps each way; whatever it
  * picks in the calls after, the bits are those of single steps, in the
  * state and the energy books, float64 and float32. RK4 takes every step it
- * can in passes. */
+ * can in passes, and so does a web the thread governor keeps on one
+ * thread. */
 static void test_pass_governor(void **state)
 {
     (void)state;
@@ -633,6 +634,15 @@ static void test_pass_governor(void **state)
             spn_world_destroy(one);
             spn_world_destroy(ref);
         }
+    /* where the thread governor puts a unit on one thread, it stays a pass */
+    spn_world *two = disturbed_orb(SPN_INTEGRATOR_SYMPLECTIC, 40, 50, 2, 8192, true);
+    spn__lattice_hold_passes(two, false);
+    assert_true(spn__lattice_gov_prefer(two, false));
+    for (int call = 0; call < 2; call++) {
+        assert_int_equal(spn_world_advance(two, 2e-6, 28), SPN_OK);
+        assert_int_equal(spn_world_last_step(two).blocked, 28);
+    }
+    spn_world_destroy(two);
 }
 
 /* Where the bands of a blocked pass on two threads go (lat_split: share 0

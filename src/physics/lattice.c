@@ -671,9 +671,14 @@ static void gov_end(spn_world *w, uint32_t levels)
  * 1.99-2.01; float32 5k 1.58-1.66 against 1.79-1.84, 20k and 50k alike;
  * RK4 5k float64 10.5-11.1 against 9.25-9.38, float32 6.20-6.41 against
  * 6.50-6.66. Where the line falls for the explicit steps depends on the
- * machine's caches, so on one thread each of their units is also timed by
- * a second governor with the thread governor's rules (above): choice 0 a
- * single step (the sweep), 1 a blocked pass. RK4 keeps its passes: its
+ * machine's caches, so on a web that steps on one thread (def.threads 1,
+ * or too small for threads) each of their units is also timed by a second
+ * governor with the thread governor's rules (above): choice 0 a single
+ * step (the sweep), 1 a blocked pass. Not where the thread governor chose
+ * one thread: there single steps made threads lose its tries (a try
+ * outside the call's team pays a parallel region a pass), and the 5k web's
+ * symplectic step stayed on one thread (2.10 ns a spring-step in a `make
+ * bench` run, against 1.4-1.5 on two). RK4 keeps its passes: its
  * single stages read and write six whole-web arrays each, and its passes
  * were the faster by a seventh or more (a governor's tries of the sweep
  * cost it 1-4% in `make bench`'s short runs). The bits are the same either
@@ -823,7 +828,11 @@ int spn__lattice_block_steps(spn_world *w, double dt, int k, spn__step_result *r
      * docs/physics-lattice.md, "One thread") */
     const int threads = ready(w);
     if (!threads || !spn__lattice_block_ready(w->lat, threads, levels)) return 0;
-    if (threads == 1 && !rk4 && !passes_pick(w)) return 0; /* (the single step ends the unit) */
+    /* (a unit the thread governor put on one thread stays a pass: its
+     * tries of threads, outside a team, could not win against single
+     * steps, and the 5k web's symplectic step then stayed on one thread;
+     * the single step ends the unit) */
+    if (threads == 1 && !rk4 && lattice_threads(w) < 2 && !passes_pick(w)) return 0;
     const int mode = rk4 ? MODE_RK4_STAGE : in == SPN_INTEGRATOR_SYMPLECTIC ? MODE_SYMPLECTIC : MODE_EULER;
     if (float32(w)) {
         if (w->lat->live) write_back(w, threads);
