@@ -181,8 +181,8 @@ LAT_INLINE void LK(block_move)(LK(block) *B, uint32_t s, uint32_t r, LK_T *const
         R.vt[c] = s < 4 ? B->trial[s - 1][r % 4][3 + c] : NULL;
         R.ax[c] = B->sums[r % 8][c], R.av[c] = B->sums[r % 8][3 + c];
     }
-    LK(rk4_update)(LK(padded)(n), a->stage, a->h, a->weight, a->drag, a->kin_known, a->g, B->mass + p0, B->inv_mass + p0, &R,
-                   B->F, cs);
+    LK(rk4_update)(LK(padded)(n), a->stage, a->h, a->weight, a->drag, a->kin_known, a->g, B->mass + p0,
+                   B->inv_mass + p0, &R, B->F, cs);
 }
 
 /* op(s, j): see the file comment. (Inlined into run_block, so that each
