@@ -630,6 +630,15 @@ static double seconds_now(void) { return 1e-9 * spn__lattice_clock_ns(); }
  * the governor picks below parallel_min, its timing started. A unit begun
  * and not ended (a blocked pass declined on one thread, the single step
  * taken instead) passes its pick on to the next. */
+/* Governor g's choice for a unit starting now, its timing started. */
+static int gov_start(lat_gov *g)
+{
+    const double now = seconds_now();
+    if (!(g->t0 >= 0)) spn__lat_gov_pick(g, now);
+    g->t0 = now;
+    return g->mode;
+}
+
 static int gov_begin(spn_world *w, int threads)
 {
     lat_gov *g = &w->lat->gov;
@@ -637,10 +646,7 @@ static int gov_begin(spn_world *w, int threads)
         g->t0 = -1;
         return threads;
     }
-    const double now = seconds_now();
-    if (!(g->t0 >= 0)) spn__lat_gov_pick(g, now);
-    g->t0 = now;
-    return g->mode ? threads : 1;
+    return gov_start(g) ? threads : 1;
 }
 
 /* The unit begun by gov_begin (and passes_pick) done: `levels` steps or
@@ -686,12 +692,7 @@ static void gov_end(spn_world *w, uint32_t levels)
  * unit (its timing started). */
 static bool passes_pick(spn_world *w)
 {
-    if (w->lattice_passes_held) return true;
-    lat_gov *g = &w->lat->passes;
-    const double now = seconds_now();
-    if (!(g->t0 >= 0)) spn__lat_gov_pick(g, now);
-    g->t0 = now;
-    return g->mode;
+    return w->lattice_passes_held || gov_start(&w->lat->passes);
 }
 
 void spn__lattice_hold_passes(spn_world *w, bool held) { w->lattice_passes_held = held; }
@@ -828,11 +829,11 @@ int spn__lattice_block_steps(spn_world *w, double dt, int k, spn__step_result *r
      * docs/physics-lattice.md, "One thread") */
     const int threads = ready(w);
     if (!threads || !spn__lattice_block_ready(w->lat, threads, levels)) return 0;
-    /* (a unit the thread governor put on one thread stays a pass: its
-     * tries of threads, outside a team, could not win against single
-     * steps, and the 5k web's symplectic step then stayed on one thread;
-     * the single step ends the unit) */
-    if (threads == 1 && !rk4 && lattice_threads(w) < 2 && !passes_pick(w)) return 0;
+    /* (a unit the thread governor put on one thread, the one it is timing,
+     * stays a pass: its tries of threads, outside a team, could not win
+     * against single steps, and the 5k web's symplectic step then stayed on
+     * one thread; the single step ends the unit) */
+    if (threads == 1 && !rk4 && !(w->lat->gov.t0 >= 0) && !passes_pick(w)) return 0;
     const int mode = rk4 ? MODE_RK4_STAGE : in == SPN_INTEGRATOR_SYMPLECTIC ? MODE_SYMPLECTIC : MODE_EULER;
     if (float32(w)) {
         if (w->lat->live) write_back(w, threads);
