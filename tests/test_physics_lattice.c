@@ -655,6 +655,17 @@ static void test_split_same_bits(void **state)
         }
         assert_true(spn__lattice_gov_prefer(two, true));
         for (int h = 0; h < 5; h++) {
+            if (h) {
+                /* a particle of the rows the shares sent each other at the end
+                 * of the last call moved by hand: the next call's first pass
+                 * (on that split) takes its ghost rows from the state again */
+                uint32_t R0, R1;
+                spn__lattice_split_rows(two->lat, 1, &R0, &R1);
+                const uint32_t p = 1 + R0 * 50 + 7;
+                const spn_vec3 v = spn_v3_add(spn_world_velocity(one, p), spn_v3(0, 0, 0.01));
+                spn_world_set_velocity(two, p, v);
+                spn_world_set_velocity(one, p, v);
+            }
             spn__lattice_split_hold(two, holds[h]);
             assert_int_equal(spn_world_advance(two, 2e-6, 24), SPN_OK);
             assert_int_equal(spn_world_last_step(two).blocked, 24);

@@ -366,6 +366,7 @@ static bool load(spn_world *w, int threads)
             L->x[c] = q + c * pitch, L->v[c] = q + (3 + c) * pitch;
     }
     spn__lat_for(L, threads, (size_t)L->rings + 1, load_rows, w);
+    spn__lattice_state_moved(L);
     L->live = true;
     L->mv2.ok = false;
     return true;
@@ -756,6 +757,7 @@ bool spn__lattice_explicit(spn_world *w, double dt, bool symplectic, spn__step_r
     w->lat->mv2.ok = false;
     double sum[L_NSUMS];
     sweep64(&a, threads, sum);
+    spn__lattice_state_moved(w->lat);
     lat_explicit_result(sum, dt, w->def.drag, r);
     end(w, threads);
     gov_end(w, 1);
@@ -798,6 +800,7 @@ bool spn__lattice_rk4(spn_world *w, double dt, spn__step_result *r)
         a.h = stage < 3 ? frac[stage + 1] * dt : dt / 6;
         sweep64(&a, threads, sums[stage]);
     }
+    spn__lattice_state_moved(L);
     lat_mv2_carry(&L->mv2, known, sums);
     lat_rk4_result(sums, dt, w->def.drag, r);
     end(w, threads);

@@ -13,6 +13,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 void *spn__lattice_arrays(size_t count, size_t n, size_t size, size_t lead, void **first, size_t *pitch)
 {
@@ -42,6 +45,7 @@ bool spn__lattice_block_alloc(spn__lattice *L, int threads, size_t bytes)
         free(L->bws);
         L->nbws = 0;
         L->block_size = 0;
+        L->split.sent_ok = false; /* (the rows sent were in the workspaces) */
         if (!(L->bws = calloc((size_t)threads, sizeof *L->bws))) return false;
         for (; L->nbws < threads; L->nbws++)
             if (!(L->bws[L->nbws] = spn__lattice_arrays(1, bytes, 1, 0, NULL, NULL))) return false;
@@ -126,16 +130,53 @@ bool spn__lattice_split_ready(spn__lattice *L, int shares)
     if (S->shares != shares) {
         free(S->first), free(S->rate), free(S->took);
         S->shares = 0;
-        /* (first: the boundaries, then as many for a proposal) */
-        S->first = malloc(2 * ((size_t)shares + 1) * sizeof *S->first);
+        /* (first: the boundaries, then as many for a proposal, then the
+         * boundaries of the last rows sent) */
+        S->first = malloc(3 * ((size_t)shares + 1) * sizeof *S->first);
         S->rate = malloc((size_t)shares * sizeof *S->rate);
         S->took = aligned_alloc(64, (size_t)shares * sizeof *S->took);
         if (!S->first || !S->rate || !S->took) return false;
         memset(S->took, 0, (size_t)shares * sizeof *S->took);
     }
     S->shares = shares, S->nbands = L->nbands;
+    S->sent_first = S->first + 2 * ((size_t)shares + 1);
+    S->sent_ok = false;
     split_even(S);
     return true;
+}
+
+bool spn__lattice_sent_ready(const spn__lattice *L, uint32_t K, size_t size)
+{
+    const lat_split *S = &L->split;
+    return S->sent_ok && S->sent_K == K && S->sent_size == size &&
+           memcmp(S->sent_first, S->first, ((size_t)S->shares + 1) * sizeof *S->first) == 0;
+}
+
+void spn__lattice_sent(spn__lattice *L, uint32_t K, size_t size)
+{
+    lat_split *S = &L->split;
+    memcpy(S->sent_first, S->first, ((size_t)S->shares + 1) * sizeof *S->first);
+    S->sent_K = K, S->sent_size = size, S->sent_ok = true;
+}
+
+void spn__lattice_state_moved(spn__lattice *L) { L->split.sent_ok = false; }
+
+void spn__lattice_stream(void *restrict dst, const void *restrict src, size_t bytes)
+{
+#if defined(__SSE2__)
+    __m128i *d = dst;
+    const __m128i *s = src;
+    for (size_t i = 0; i < bytes / 16; i++) _mm_stream_si128(d + i, _mm_load_si128(s + i));
+#else
+    memcpy(dst, src, bytes);
+#endif
+}
+
+void spn__lattice_stream_fence(void)
+{
+#if defined(__SSE2__)
+    _mm_sfence();
+#endif
 }
 
 void spn__lattice_split_rows(const spn__lattice *L, int t, uint32_t *R0, uint32_t *R1)

@@ -22,7 +22,9 @@
  *
  * Threads. Each thread takes a contiguous run of bands. It needs the rows
  * within K of its run from its neighbours at every level before they move,
- * so it copies those ghost rows (level 0) into its own buffers first, and,
+ * so it copies those ghost rows (level 0) into its own buffers first (from
+ * the state at a call's first pass, then from the rows each neighbour sent
+ * it at the end of the pass before, LK(send)), and,
  * after a barrier, steps them along privately: the rows it may step at level
  * s shrink by one at each side per level (a trapezoid), and at level K they
  * are its own rows exactly. Ghost rows are stepped twice (by each side),
@@ -229,11 +231,18 @@ LAT_INLINE void LK(op)(LK(block) *B, double *partial, uint32_t s, uint32_t j)
     lv->cur ^= 1;
 }
 
+/* The arrays of a share's workspace before its sent rows (LK(sent)). */
+#define LK_SENT_AT (12 * LAT_LEVELS + 12 * LAT_LEVELS + 6 * 4 * (LAT_LEVELS - 1) + 6 * 8 + 9)
+
 /* The workspace of one thread, stride numbers per array. */
-static size_t LK(block_numbers)(size_t stride)
+static size_t LK(block_numbers)(size_t stride) { return (LK_SENT_AT + 12 * LAT_LEVELS) * stride; }
+
+/* Array c (x, y, z, then v) of row g of the rows a share sends its
+ * neighbours, in its workspace ws: g < K its first K rows (for the share
+ * below), g >= K its last K (for the share above). */
+static LK_T *LK(sent)(void *ws, size_t stride, uint32_t g, int c)
 {
-    const size_t levels = 12 * LAT_LEVELS, ghosts = 12 * LAT_LEVELS, rk4 = 6 * 4 * (LAT_LEVELS - 1) + 6 * 8;
-    return (levels + ghosts + rk4 + 9) * stride;
+    return (LK_T *)ws + (LK_SENT_AT + (size_t)g * 6 + (size_t)c) * stride;
 }
 
 static void LK(block_init)(LK(block) *B, const LK_ARGS *la, bool rk4, LK_T *ws, double *cols, uint32_t R0,
@@ -263,20 +272,55 @@ static void LK(block_init)(LK(block) *B, const LK_ARGS *la, bool rk4, LK_T *ws, 
         for (int r = 0; r < 2; r++) B->lv[s].band[r] = col_set(cols, cst, 2 * (int)s + r);
 }
 
-/* Level 0 of the ghost rows, from the state before anyone moves it. */
-static void LK(copy_ghosts)(LK(block) *B)
+/* Level 0 of the ghost rows: from the state before anyone moves it, or
+ * (ws non-NULL: the share's workspaces, spn__lattice_sent_ready) from the
+ * rows its neighbours sent at the end of the pass before, the same numbers
+ * (a debug build checks them against the state). */
+static void LK(copy_ghosts)(LK(block) *B, int t, void *const *ws)
 {
     const spn__lattice *L = B->L;
     const uint32_t n = L->radials;
+    const size_t st = LK(stride)(B->la);
     for (uint32_t g = 0; g < 2 * B->K; g++) {
         const uint32_t j = g < B->K ? B->R0 - B->K + g : B->R1 + (g - B->K);
         if ((g < B->K && !B->R0) || (g >= B->K && j >= L->rings)) continue;
         const size_t p0 = 1 + (size_t)j * LK(pitch)(B->la);
-        for (int c = 0; c < 3; c++) {
-            memcpy(B->ghost[g][c], B->X[c] + p0, n * sizeof(LK_T));
-            memcpy(B->ghost[g][3 + c], B->V[c] + p0, n * sizeof(LK_T));
+        for (int c = 0; c < 6; c++) {
+            const LK_T *row = (c < 3 ? B->X[c] : B->V[c - 3]) + p0;
+            if (ws) {
+                /* (the share below sent its last K rows as its rows K .. 2 K -
+                 * 1, the share above its first K as its rows 0 .. K - 1) */
+                const LK_T *from =
+                    g < B->K ? LK(sent)(ws[t - 1], st, g + B->K, c) : LK(sent)(ws[t + 1], st, g - B->K, c);
+                assert(memcmp(from, row, n * sizeof(LK_T)) == 0);
+                row = from;
+            }
+            memcpy(B->ghost[g][c], row, n * sizeof(LK_T));
         }
     }
+}
+
+/* The end of a pass on threads: this share's first and last K rows (those
+ * its neighbours step as ghost rows), the state the next pass starts from,
+ * into its workspace ws for them (LK(copy_ghosts)). Why not let them read
+ * the rows from the state, as the first pass does: their reads leave this
+ * share's lines of those rows shared between the cores, and its first
+ * writes to them in the next pass's fronts then wait for the other core
+ * to give them up (some 4 us a pass of the 5k web on the Zen 5, the
+ * forty-seventh session, docs/physics-lattice.md). Sent past the caches,
+ * the copies cost this core no such wait either. */
+static void LK(send)(const LK(block) *B, void *ws)
+{
+    const spn__lattice *L = B->L;
+    const size_t st = LK(stride)(B->la), bytes = LK(padded)(L->radials) * sizeof(LK_T);
+    for (uint32_t g = 0; g < 2 * B->K; g++) {
+        if ((g < B->K && !B->R0) || (g >= B->K && B->R1 >= L->rings)) continue;
+        const uint32_t j = g < B->K ? B->R0 + g : B->R1 - 2 * B->K + g;
+        const size_t p0 = 1 + (size_t)j * LK(pitch)(B->la);
+        for (int c = 0; c < 6; c++)
+            spn__lattice_stream(LK(sent)(ws, st, g, c), (c < 3 ? B->X[c] : B->V[c - 3]) + p0, bytes);
+    }
+    spn__lattice_stream_fence();
 }
 
 /* This block's pass, front by front. Inlined into each version of
@@ -321,6 +365,7 @@ typedef struct LK(pass) {
     bool rk4;
     uint32_t K;
     int threads;
+    bool sent; /* the ghost rows from what the shares sent (spn__lattice_sent_ready) */
     void (*run)(LK(block) *, double *);
 } LK(pass);
 
@@ -337,9 +382,10 @@ static void LK(share_block)(const LK(pass) *P, int t, LK(block) *B)
 static void LK(ghost_share)(void *ctx, int t, int thread)
 {
     (void)thread;
+    const LK(pass) *P = ctx;
     LK(block) B;
-    LK(share_block)(ctx, t, &B);
-    LK(copy_ghosts)(&B);
+    LK(share_block)(P, t, &B);
+    LK(copy_ghosts)(&B, t, P->sent ? P->L->bws : NULL);
 }
 
 static void LK(front_share)(void *ctx, int t, int thread)
@@ -350,7 +396,10 @@ static void LK(front_share)(void *ctx, int t, int thread)
     LK(share_block)(P, t, &B);
     const double t0 = P->threads > 1 ? spn__lattice_clock_ns() : 0;
     P->run(&B, P->L->partial_k);
-    if (P->threads > 1) P->L->split.took[t].ns = spn__lattice_clock_ns() - t0;
+    if (P->threads > 1) {
+        P->L->split.took[t].ns = spn__lattice_clock_ns() - t0;
+        LK(send)(&B, P->L->bws[t]);
+    }
 }
 
 /* K levels (2 .. LAT_LEVELS, spn__lattice_block_ready) in one pass over the
@@ -363,9 +412,14 @@ static bool LK(block_pass)(spn__lattice *L, const LK_ARGS *la, bool rk4, int thr
     if (!spn__lattice_block_alloc(L, threads, LK(block_numbers)(LK(stride)(la)) * sizeof(LK_T)) ||
         !spn__lattice_cols_alloc(L, threads) || !spn__lattice_split_ready(L, threads))
         return false;
-    LK(pass) P = {L, la, rk4, K, threads, LK(runner)(rk4)};
+    LK(pass) P = {L, la, rk4, K, threads, threads > 1 && spn__lattice_sent_ready(L, K, sizeof(LK_T)),
+                  LK(runner)(rk4)};
     spn__lat_run(L, threads, threads, LK(ghost_share), LK(front_share), &P);
-    if (threads > 1) spn__lattice_split_update(L);
+    spn__lattice_state_moved(L);
+    if (threads > 1) {
+        spn__lattice_sent(L, K, sizeof(LK_T)); /* (before the split moves) */
+        spn__lattice_split_update(L);
+    }
     spn__lattice_block_sums(L, K, sums);
     return true;
 }

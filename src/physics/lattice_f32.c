@@ -266,6 +266,7 @@ static void write_back(spn_world *w, int threads, bool rebase)
     write_job job = {w, rebase};
     spn__lat_for(w->lat, threads, (size_t)w->lat->rings + 1, write_rows, &job);
     if (rebase) references(w, threads);
+    spn__lattice_state_moved(w->lat); /* (a rebase moves d to zero) */
     F->since = 0;
     F->live = rebase;
 }
@@ -333,6 +334,7 @@ static bool load(spn_world *w, int threads)
     F->params_ok = true;
     spn__lat_for(L, threads, (size_t)L->rings + 1, load_rows, w);
     references(w, threads);
+    spn__lattice_state_moved(L);
     F->since = 0;
     F->live = true;
     F->mv2.ok = false;
@@ -437,6 +439,7 @@ bool spn__lat32_explicit(spn_world *w, int threads, double dt, bool symplectic, 
     w->lat->f32->mv2.ok = false;
     double sum[L_NSUMS];
     sweep32(&a, threads, sum);
+    spn__lattice_state_moved(w->lat);
     lat_explicit_result(sum, dt, w->def.drag, r);
     end(w, threads);
     return true;
@@ -465,6 +468,7 @@ bool spn__lat32_rk4(spn_world *w, int threads, double dt, spn__step_result *r)
         a.h = stage < 3 ? frac[stage + 1] * (float)dt : (float)dt / 6;
         sweep32(&a, threads, sums[stage]);
     }
+    spn__lattice_state_moved(w->lat);
     lat_mv2_carry(&F->mv2, known, sums);
     lat_rk4_result(sums, dt, w->def.drag, r);
     end(w, threads);

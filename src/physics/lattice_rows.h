@@ -141,6 +141,14 @@ typedef struct lat_split {
     lat_share_time *took; /* per share */
     int hold;             /* tests: >= 0 holds share 0 to this many bands (two shares) */
     bool moved;           /* the last pass ran on a new split: its times are not learnt from */
+    /* The rows each share sent its neighbours at the end of the last pass
+     * (lattice_block_t.h, LK(send)): valid while `sent_ok`, for a pass of
+     * sent_K levels in numbers of sent_size bytes on the boundaries
+     * sent_first (shares + 1). */
+    uint32_t *sent_first;
+    uint32_t sent_K;
+    size_t sent_size;
+    bool sent_ok;
 } lat_split;
 
 struct spn__lattice {
@@ -492,6 +500,20 @@ void spn__lattice_split_rows(const spn__lattice *L, int t, uint32_t *R0, uint32_
  * a new split where it would shorten the slowest share's part by more than
  * a few percent. */
 void spn__lattice_split_update(spn__lattice *L);
+/* The rows sent at the end of a pass (lat_split.sent_*): whether a pass of
+ * K levels in numbers of `size` bytes may take its ghost rows from them;
+ * after a pass on threads, that it sent them; after anything that moved
+ * the state (each step, stage or pass, and each load or rebase), that
+ * they are stale. */
+bool spn__lattice_sent_ready(const spn__lattice *L, uint32_t K, size_t size);
+void spn__lattice_sent(spn__lattice *L, uint32_t K, size_t size);
+void spn__lattice_state_moved(spn__lattice *L);
+/* `bytes` (a multiple of 16, both ends 16-byte aligned) from src to dst
+ * past the caches where the processor can (non-temporal stores), then,
+ * after the last of a thread's copies, the fence that orders them before
+ * what it writes next. */
+void spn__lattice_stream(void *restrict dst, const void *restrict src, size_t bytes);
+void spn__lattice_stream_fence(void);
 /* CLOCK_MONOTONIC in ns (a share's fronts are timed by it). */
 double spn__lattice_clock_ns(void);
 /* Whether float64 RK4 passes run their AVX2 version (lattice_block_t.h,
