@@ -627,11 +627,9 @@ bool spn__lattice_gov_prefer(spn_world *w, bool threads)
 
 static double seconds_now(void) { return 1e-9 * spn__lattice_clock_ns(); }
 
-/* The threads for a unit of work on a web that may take them (threads), as
- * the governor picks below parallel_min, its timing started. A unit begun
- * and not ended (a blocked pass declined on one thread, the single step
- * taken instead) passes its pick on to the next. */
-/* Governor g's choice for a unit starting now, its timing started. */
+/* Governor g's choice for a unit starting now, its timing started. A unit
+ * begun and not ended (a blocked pass declined on one thread, the single
+ * step taken instead) passes its pick on to the next. */
 static int gov_start(lat_gov *g)
 {
     const double now = seconds_now();
@@ -640,6 +638,8 @@ static int gov_start(lat_gov *g)
     return g->mode;
 }
 
+/* The threads for a unit of work on a web that may take them (threads), as
+ * the governor picks below parallel_min, its timing started. */
 static int gov_begin(spn_world *w, int threads)
 {
     lat_gov *g = &w->lat->gov;

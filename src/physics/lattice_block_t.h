@@ -231,8 +231,12 @@ LAT_INLINE void LK(op)(LK(block) *B, double *partial, uint32_t s, uint32_t j)
     lv->cur ^= 1;
 }
 
-/* The arrays of a share's workspace before its sent rows (LK(sent)). */
-#define LK_SENT_AT (12 * LAT_LEVELS + 12 * LAT_LEVELS + 6 * 4 * (LAT_LEVELS - 1) + 6 * 8 + 9)
+/* The arrays of a share's workspace before its sent rows (LK(sent)), as
+ * LK(block_init) lays them out: per level two rows of radial and of ring
+ * forces (12), the ghost rows (2 LAT_LEVELS rows of 6), RK4's trial
+ * states (4 rows of 6 for each level but the last) and weighted sums (8
+ * rows of 6), the hub's row (6) and the assembled force (3). */
+#define LK_SENT_AT (12 * LAT_LEVELS + 6 * 2 * LAT_LEVELS + 6 * 4 * (LAT_LEVELS - 1) + 6 * 8 + 6 + 3)
 
 /* The workspace of one thread, stride numbers per array. */
 static size_t LK(block_numbers)(size_t stride) { return (LK_SENT_AT + 12 * LAT_LEVELS) * stride; }
@@ -266,6 +270,7 @@ static void LK(block_init)(LK(block) *B, const LK_ARGS *la, bool rk4, LK_T *ws, 
         for (int c = 0; c < 6; c++) B->sums[r][c] = q, q += st;
     for (int c = 0; c < 6; c++) B->hub[c] = q, q += st;
     for (int c = 0; c < 3; c++) B->F[c] = q, q += st;
+    assert(q == ws + (size_t)LK_SENT_AT * st); /* (the sent rows follow, LK(sent)) */
     const size_t cst = B->L->col_stride;
     B->dummy = col_set(cols, cst, COL_SETS - 1), B->cut = col_set(cols, cst, -1);
     for (uint32_t s = 0; s < LAT_LEVELS; s++)
@@ -315,10 +320,9 @@ static void LK(send)(const LK(block) *B, void *ws)
     const size_t st = LK(stride)(B->la), bytes = LK(padded)(L->radials) * sizeof(LK_T);
     for (uint32_t g = 0; g < 2 * B->K; g++) {
         if ((g < B->K && !B->R0) || (g >= B->K && B->R1 >= L->rings)) continue;
-        const uint32_t j = g < B->K ? B->R0 + g : B->R1 - 2 * B->K + g;
-        const size_t p0 = 1 + (size_t)j * LK(pitch)(B->la);
-        for (int c = 0; c < 6; c++)
-            spn__lattice_stream(LK(sent)(ws, st, g, c), (c < 3 ? B->X[c] : B->V[c - 3]) + p0, bytes);
+        LK_T *X[3], *V[3]; /* (an own row: the state's) */
+        LK(row_ptrs)(B, g < B->K ? B->R0 + g : B->R1 - 2 * B->K + g, X, V);
+        for (int c = 0; c < 6; c++) spn__lattice_stream(LK(sent)(ws, st, g, c), c < 3 ? X[c] : V[c - 3], bytes);
     }
     spn__lattice_stream_fence();
 }
