@@ -16,6 +16,8 @@
 #include <string.h>
 #include <spinneret/spinneret.h>
 
+#include "physics/world_internal.h" /* spn__world_plant */
+
 #include "web_checks.h"
 
 #include "physics/equilibrium_internal.h"
@@ -810,7 +812,7 @@ static void test_bad_definitions_are_named(void **state)
     d.max_cg_iterations = 0;
     assert_int_equal(spn_world_equilibrium(w, &d, NULL), SPN_ERR_INVALID);
     assert_non_null(strstr(spn_last_error(), "max_cg_iterations"));
-    spn_world_set_position(w, 3, spn_v3(INFINITY, 0, 0));
+    spn__world_plant(w, 3, spn_v3(INFINITY, 0, 0), spn_v3(0, 0, 0), UINT32_MAX, 0);
     assert_int_equal(spn_world_equilibrium(w, NULL, NULL), SPN_ERR_UNSTABLE);
     assert_non_null(strstr(spn_last_error(), "particle 3"));
     spn_precond pc;

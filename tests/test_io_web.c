@@ -15,6 +15,8 @@
 #include <unistd.h>
 #include <spinneret/spinneret.h>
 
+#include "physics/world_internal.h" /* spn__world_plant */
+
 #include "web_io_util.h"
 
 /* One row per file in tests/data/bad/: the text its message must contain. */
@@ -172,7 +174,7 @@ static void test_failed_save_leaves_nothing(void **state)
     /* A NaN deep in the particle arrays: the writer has already written the
      * header and part of the arrays when it stops. */
     spn_world *w = awkward_world();
-    spn_world_set_position(w, 9, spn_v3(0, NAN, 0));
+    spn__world_plant(w, 9, spn_v3(0, NAN, 0), spn_v3(0, 0, 0), UINT32_MAX, 0);
     assert_int_equal(spn_web_save(w, path), SPN_ERR_INVALID);
     assert_non_null(strstr(spn_last_error(), "particle 9: position is not finite"));
     assert_int_equal(spn_web_save(w, fresh), SPN_ERR_INVALID);

@@ -16,6 +16,8 @@
 #include <unistd.h>
 #include <spinneret/spinneret.h>
 
+#include "physics/world_internal.h" /* spn__world_plant */
+
 #include "web_io_util.h"
 
 static spn_buffer binary_of(const spn_world *w)
@@ -200,7 +202,8 @@ static void test_refused_world_writes_nothing(void **state)
     assert_non_null(mkdtemp(dir));
     snprintf(path, sizeof path, "%s/web.spnw", dir);
     spn_world *w = awkward_world();
-    spn_world_set_velocity(w, 9, spn_v3(0, 0, INFINITY));
+    const spn_vec3 x9 = spn_world_position(w, 9);
+    spn__world_plant(w, 9, x9, spn_v3(0, 0, INFINITY), UINT32_MAX, 0);
     spn_buffer buf = {0};
     spn_sink sink = spn_sink_buffer(&buf);
     assert_int_equal(spn_web_write_binary(w, &sink), SPN_ERR_INVALID);
@@ -208,8 +211,7 @@ static void test_refused_world_writes_nothing(void **state)
     assert_int_equal(buf.size, 0);
     assert_int_equal(spn_web_save(w, path), SPN_ERR_INVALID);
     assert_int_equal(count_files(dir), 0);
-    spn_world_set_velocity(w, 9, spn_v3(0, 0, 0));
-    spn_world_set_spring_rest(w, 2, NAN);
+    spn__world_plant(w, 9, x9, spn_v3(0, 0, 0), 2, NAN);
     assert_int_equal(spn_web_save(w, path), SPN_ERR_INVALID);
     assert_non_null(strstr(spn_last_error(), "spring 2: rest is not finite"));
     assert_int_equal(count_files(dir), 0);

@@ -92,6 +92,9 @@ static void test_bad_world_def_refused(void **state)
     }
 }
 
+/* The setters refuse what the constructors refuse, naming the particle or
+ * spring and the field, and leave the world as it was: it then steps as its
+ * clone does. */
 static void test_bad_settings_refused(void **state)
 {
     (void)state;
@@ -125,15 +128,21 @@ static void test_bad_settings_refused(void **state)
         expect_refused(spn_world_set_spring_stiffness(w, 1, bad[b], 0.25), "spring 1:", "stiffness k");
         expect_refused(spn_world_set_spring_stiffness(w, 1, 3.5, bad[b]), "spring 1:", "damping kd");
         expect_refused(spn_world_set_drag(w, bad[b]), NULL, "drag");
+        expect_refused(spn_world_set_spring_rest(w, 1, bad[b]), "spring 1:", "rest length");
         if (!isfinite(bad[b])) {
             expect_refused(spn_world_set_gravity(w, spn_v3(0, bad[b], 0)), NULL, "gravity");
             expect_refused(spn_world_set_gravity(w, spn_v3(bad[b], -9.81, 0)), NULL, "gravity");
+            expect_refused(spn_world_set_position(w, 1, spn_v3(0, 0, bad[b])), "particle 1:", "position");
+            expect_refused(spn_world_set_velocity(w, 2, spn_v3(bad[b], 0, 0)), "particle 2:", "velocity");
         }
     }
+    /* a fixed particle does not move: no velocity but 0 */
+    expect_refused(spn_world_set_velocity(w, 0, spn_v3(0, 1e-12, 0)), "particle 0 is fixed", "velocity");
+    assert_int_equal(spn_world_set_velocity(w, 0, spn_v3(0, 0, 0)), SPN_OK);
     assert_true(spn_world_mass(w, 0) == 2e-3 && spn_world_is_fixed(w, 0));
     assert_true(spn_world_mass(w, 1) == 2e-3 && !spn_world_is_fixed(w, 1));
     const spn_spring_def d = spn_world_spring_def(w, 1);
-    assert_true(d.k == 3.5 && d.kd == 0.25);
+    assert_true(d.k == 3.5 && d.kd == 0.25 && d.rest == spn_world_spring_def(c, 1).rest);
     const spn_world_def *got = spn_world_get_def(w);
     assert_true(got->drag == 0.5 && got->gravity.x == 0 && got->gravity.y == -9.81 && got->gravity.z == 0);
     for (int i = 0; i < 3; i++) {
@@ -148,6 +157,9 @@ static void test_bad_settings_refused(void **state)
     assert_int_equal(spn_world_set_mass(w, 2, 3e-3), SPN_OK);
     assert_true(spn_world_mass(w, 2) == 3e-3 && !spn_world_is_fixed(w, 2));
     assert_int_equal(spn_world_set_spring_stiffness(w, 1, 0, 0), SPN_OK);
+    assert_int_equal(spn_world_set_spring_rest(w, 1, 0), SPN_OK);
+    assert_int_equal(spn_world_set_position(w, 0, spn_v3(-1, 0, 0)), SPN_OK); /* an anchor moved by hand */
+    assert_true(spn_world_position(w, 0).x == -1 && spn_world_is_fixed(w, 0));
     assert_int_equal(spn_world_set_drag(w, 0), SPN_OK);
     assert_int_equal(spn_world_set_gravity(w, spn_v3(0, 0, -1)), SPN_OK);
     assert_true(spn_world_get_def(w)->drag == 0 && spn_world_get_def(w)->gravity.z == -1);

@@ -24,6 +24,8 @@
 #include <string.h>
 #include <spinneret/spinneret.h>
 
+#include "physics/world_internal.h" /* spn__world_plant */
+
 #include "world_settings_util.h"
 
 static double no_collision(void *user, uint32_t i, spn_vec3 from, spn_vec3 to, spn_vec3 *normal, double *keep)
@@ -199,7 +201,7 @@ static void test_locality_order(void **state)
     const double near = mean_step(w, order), far = mean_step(w, shuffled);
     print_message("mean step along the locality order %.3g m, along a scramble %.3g m\n", near, far);
     assert_true(near * 10 < far);
-    spn_world_set_position(w, 9, spn_v3(NAN, 0, 0));
+    spn__world_plant(w, 9, spn_v3(NAN, 0, 0), spn_v3(0, 0, 0), UINT32_MAX, 0);
     assert_int_equal(spn_world_locality_order(w, order), SPN_ERR_INVALID);
     assert_non_null(strstr(spn_last_error(), "particle 9"));
     assert_int_equal(spn_world_locality_order(w, NULL), SPN_ERR_INVALID);

@@ -143,9 +143,9 @@ void view_mouse_move(view_state *v, double x, double y)
     v->mouse_x = x;
     v->mouse_y = y;
     if (v->grabbed >= 0) {
+        /* a point that is not finite (a degenerate camera): the particle stays */
         spn_vec3 p = view_unproject(v, x, y, v->grab_plane_point);
-        spn_world_set_position(v->world, (uint32_t)v->grabbed, p);
-        v->grab_plane_point = p;
+        if (spn_world_set_position(v->world, (uint32_t)v->grabbed, p) == SPN_OK) v->grab_plane_point = p;
     } else if (v->orbiting) {
         v->yaw -= dx * 0.008;
         v->pitch = fmax(-1.5, fmin(1.5, v->pitch + dy * 0.008));

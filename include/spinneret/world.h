@@ -207,8 +207,13 @@ SPN_API uint32_t spn_world_particle_tag(const spn_world *w, uint32_t i);
 /// The definition that adds particle i again as it is now (position,
 /// velocity, mass, fixed, tag): for copying a world's particles into another.
 SPN_API spn_particle_def spn_world_particle_def(const spn_world *w, uint32_t i);
-SPN_API void spn_world_set_position(spn_world *w, uint32_t i, spn_vec3 p);
-SPN_API void spn_world_set_velocity(spn_world *w, uint32_t i, spn_vec3 v);
+/// Position [m] and velocity [m/s] of particle i. SPN_ERR_INVALID naming the
+/// particle, and nothing changed, when the vector is not finite (as
+/// spn_world_add_particle refuses), and when a fixed particle is given a
+/// velocity other than 0: fixed particles do not move (free one first with
+/// spn_world_set_fixed). A fixed particle can be moved by hand (set_position).
+SPN_API spn_status spn_world_set_position(spn_world *w, uint32_t i, spn_vec3 p);
+SPN_API spn_status spn_world_set_velocity(spn_world *w, uint32_t i, spn_vec3 v);
 /// Pin (fixed = true) or free a particle. Freeing one with mass 0 keeps it fixed.
 SPN_API void spn_world_set_fixed(spn_world *w, uint32_t i, bool fixed);
 /// Mass of particle i [kg] (0: fixed, as in spn_particle_def). SPN_ERR_INVALID
@@ -224,7 +229,10 @@ SPN_API spn_spring_info spn_world_spring(const spn_world *w, uint32_t s);
 /// measures the spring. Whether it is broken: spn_world_spring_is_broken.
 SPN_API spn_spring_def spn_world_spring_def(const spn_world *w, uint32_t s);
 SPN_API bool spn_world_spring_is_broken(const spn_world *w, uint32_t s);
-SPN_API void spn_world_set_spring_rest(spn_world *w, uint32_t s, double rest);
+/// Rest length of spring s [m]. SPN_ERR_INVALID naming the spring, and
+/// nothing changed, when it is negative or not finite (spn_world_add_spring
+/// reads a negative rest as "the current length"; here it is refused).
+SPN_API spn_status spn_world_set_spring_rest(spn_world *w, uint32_t s, double rest);
 /// Stiffness k [N/m] and axial damping kd [N s/m] of spring s. SPN_ERR_INVALID
 /// naming the spring and the field, and nothing changed, when either is
 /// negative or not finite (as spn_world_add_spring refuses).

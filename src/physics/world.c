@@ -247,8 +247,29 @@ spn_particle_def spn_world_particle_def(const spn_world *w, uint32_t i)
     p.tag = w->ptag[i];
     return p;
 }
-void spn_world_set_position(spn_world *w, uint32_t i, spn_vec3 p) { w->x[i] = p; }
-void spn_world_set_velocity(spn_world *w, uint32_t i, spn_vec3 v) { w->v[i] = v; }
+/* The setters refuse what no step can make and a web file cannot hold: a
+ * position, velocity or rest length that is not finite, and a fixed
+ * particle's velocity other than 0 (fixed particles do not move, and
+ * spn_world_add_particle and spn_world_set_fixed keep it 0). The writers, the
+ * equilibrium solve and the locality order still check what they read (a
+ * value planted by spn__world_plant, for their tests). */
+spn_status spn_world_set_position(spn_world *w, uint32_t i, spn_vec3 p)
+{
+    if (!spn_v3_finite(p))
+        return spn_error(SPN_ERR_INVALID, "particle %u: position must be finite, not (%g, %g, %g)", i, p.x, p.y, p.z);
+    w->x[i] = p;
+    return SPN_OK;
+}
+spn_status spn_world_set_velocity(spn_world *w, uint32_t i, spn_vec3 v)
+{
+    if (!spn_v3_finite(v))
+        return spn_error(SPN_ERR_INVALID, "particle %u: velocity must be finite, not (%g, %g, %g)", i, v.x, v.y, v.z);
+    if (spn_world_is_fixed(w, i) && (v.x != 0 || v.y != 0 || v.z != 0))
+        return spn_error(SPN_ERR_INVALID, "particle %u is fixed: its velocity stays 0, not (%g, %g, %g)", i, v.x, v.y,
+                         v.z);
+    w->v[i] = v;
+    return SPN_OK;
+}
 void spn_world_set_particle_tag(spn_world *w, uint32_t i, uint32_t tag) { w->ptag[i] = tag; }
 
 static double free_mass_of(const spn_world *w, uint32_t i) { return w->inv_mass[i] > 0 ? w->mass[i] : 0; }
@@ -314,13 +335,27 @@ spn_spring_info spn_world_spring(const spn_world *w, uint32_t s)
     return info;
 }
 
-void spn_world_set_spring_rest(spn_world *w, uint32_t s, double rest)
+static void store_rest(spn_world *w, uint32_t s, double rest)
 {
     w->rest[s] = rest;
     if (w->compiled) {
         w->hs[w->iperm[s]].rest = rest;
         spn__lattice_spring_changed(w, s);
     }
+}
+
+spn_status spn_world_set_spring_rest(spn_world *w, uint32_t s, double rest)
+{
+    if (!(rest >= 0) || !isfinite(rest))
+        return spn_error(SPN_ERR_INVALID, "spring %u: rest length must be finite and not negative, not %g", s, rest);
+    store_rest(w, s, rest);
+    return SPN_OK;
+}
+
+void spn__world_plant(spn_world *w, uint32_t i, spn_vec3 x, spn_vec3 v, uint32_t s, double rest)
+{
+    if (i < w->np) w->x[i] = x, w->v[i] = v;
+    if (s < w->ns) store_rest(w, s, rest);
 }
 
 spn_status spn_world_set_spring_stiffness(spn_world *w, uint32_t s, double k, double kd)

@@ -232,6 +232,11 @@ void spn__free_compiled(spn_world *w);
 void spn__forget_compiled(spn_world *w);
 /* Public spring s's hot record (flags folded in, see spn__spring). */
 spn__spring spn__hot_spring(const spn_world *w, uint32_t s);
+/* For tests: particle i's position and velocity and spring s's rest length
+ * written without the setters' checks (an index out of range: that part
+ * left), to plant a value no public route makes, a NaN, and test the
+ * refusal of a writer or solve that reads it. */
+void spn__world_plant(spn_world *w, uint32_t i, spn_vec3 x, spn_vec3 v, uint32_t s, double rest);
 
 /* ---- forces.c ---- */
 
