@@ -19,7 +19,11 @@
  *    fail): in the middle of a solve block Jacobi finishes it and the next
  *    step factorises again; at the start of a step (the first factorisation,
  *    or the next step's after a refusal mid-solve) the factor is dropped and
- *    the V-cycle takes over; the steps agree with block Jacobi's. */
+ *    the V-cycle takes over; the steps agree with block Jacobi's;
+ * 9. the fallbacks after it (forced by spn__imp_mg_refuse_setup): the cyclic
+ *    preconditioner refused, the V-cycle's steps; the V-cycle refused,
+ *    block Jacobi's; both, or the factor and the V-cycle, block Jacobi's;
+ *    each bit for bit the steps of the one asked for from the same state. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -470,7 +474,7 @@ static void test_factor_refused_mid_solve(void **state)
  * reads 0), the V-cycle does that step and the one after in a fraction of
  * block Jacobi's iterations, no factor is made again, and the steps agree
  * with block Jacobi's. (Where the V-cycle refuses the matrix too, in its
- * line factors, block Jacobi does the steps; no hook forces that.) (2) A
+ * line factors, block Jacobi does the steps: test_fallbacks.) (2) A
  * refusal at the first step that factorises (the second; the first is
  * block Jacobi's): the count reads 0, and that step and the ones after it
  * are the steps of the V-cycle asked for (SPN_PRECOND_MULTIGRID) from the
@@ -526,6 +530,51 @@ static void test_factor_refused_at_a_step(void **state)
     spn_world_destroy(w), spn_world_destroy(mg);
 }
 
+/* w refused as `which` says (spn__imp_mg_refuse_setup) and its clone given
+ * preconditioner pc take `steps` steps of dt: the same iterations and bits
+ * at every step (the refused preconditioners fall back in the order cyclic,
+ * V-cycle, block Jacobi, and each fallback is what asking for it gives). */
+static void same_steps(spn_world *w, unsigned which, spn_precond pc, double dt, int steps)
+{
+    spn_world *ref = spn_world_clone(w);
+    assert_non_null(ref);
+    assert_int_equal(spn_world_set_implicit_preconditioner(ref, pc), SPN_OK);
+    spn__imp_mg_refuse_setup(w, which);
+    const uint32_t n = spn_world_particle_count(w);
+    long cg = 0;
+    for (int i = 0; i < steps; i++) {
+        assert_int_equal(spn_world_step(w, dt), SPN_OK);
+        assert_int_equal(spn_world_step(ref, dt), SPN_OK);
+        assert_int_equal(spn_world_last_step(w).cg_iterations, spn_world_last_step(ref).cg_iterations);
+        assert_memory_equal(spn_world_positions(w), spn_world_positions(ref), n * sizeof(spn_vec3));
+        assert_memory_equal(spn_world_velocities(w), spn_world_velocities(ref), n * sizeof(spn_vec3));
+        cg += spn_world_last_step(w).cg_iterations;
+    }
+    print_message("refused %u: %d steps as %s's, CG %ld\n", which, steps, spn_precond_name(pc), cg);
+    spn_world_destroy(w), spn_world_destroy(ref);
+}
+
+/* The preconditioners that can refuse a step's matrix, refused by force
+ * (with valid inputs the matrix is positive definite; see stiffen_radii):
+ * on the 2,501-particle rings x radials web in a breeze the cyclic one's
+ * refusal leaves the V-cycle, the V-cycle's block Jacobi, and both block
+ * Jacobi; on the small web that is no lattice (test_factor_refused_at_a_step)
+ * a factor refused at the start of a step and then the V-cycle leave block
+ * Jacobi. A refusal that did not take would fail the bit comparison: each
+ * preconditioner's CG takes its own path. */
+static void test_fallbacks(void **state)
+{
+    (void)state;
+    same_steps(make(SPN_PRECOND_CYCLIC, 1, PLAIN), SPN__REFUSE_CYCLIC, SPN_PRECOND_MULTIGRID, 0.05, 3);
+    same_steps(make(SPN_PRECOND_MULTIGRID, 1, PLAIN), SPN__REFUSE_VCYCLE, SPN_PRECOND_BLOCK_JACOBI, 0.05, 3);
+    same_steps(make(SPN_PRECOND_CYCLIC, 1, PLAIN), SPN__REFUSE_CYCLIC | SPN__REFUSE_VCYCLE,
+               SPN_PRECOND_BLOCK_JACOBI, 0.05, 3);
+    spn_world *w = refusal_web(1);
+    assert_int_equal(spn__imp_mg_factorisations(w), 0);
+    spn__imp_mg_refuse(w, 1);
+    same_steps(w, SPN__REFUSE_VCYCLE, SPN_PRECOND_BLOCK_JACOBI, 1e-4, 3);
+}
+
 static void test_change_takes_effect(void **state)
 {
     (void)state;
@@ -574,6 +623,7 @@ int main(void)
         cmocka_unit_test(test_factor_with_a_contact),
         cmocka_unit_test(test_factor_refused_mid_solve),
         cmocka_unit_test(test_factor_refused_at_a_step),
+        cmocka_unit_test(test_fallbacks),
         cmocka_unit_test(test_change_takes_effect),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

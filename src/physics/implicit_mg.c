@@ -230,6 +230,14 @@ static bool factorise(spn_world *w, spn__imp_mg *m)
     return ok;
 }
 
+/* A refusal forced for a test (spn__imp_mg_refuse_setup), used up. */
+static bool refused(spn_world *w, unsigned which)
+{
+    if (!(w->imp_refuse_pc & which)) return false;
+    w->imp_refuse_pc &= (uint8_t)~which;
+    return true;
+}
+
 bool spn__imp_mg_prepare(spn_world *w, double h)
 {
     /* auto: where the multigrid pays (the cyclic preconditioner instead on a
@@ -274,11 +282,11 @@ bool spn__imp_mg_prepare(spn_world *w, double h)
         m->chol = NULL;
     }
     if (m->cyc) {
-        if (spn__cyc_factor(m->cyc, &m->e)) return true;
+        if (spn__cyc_factor(m->cyc, &m->e) && !refused(w, SPN__REFUSE_CYCLIC)) return true;
         spn__cyc_free(m->cyc); /* not definite: the multigrid from here on */
         m->cyc = NULL;
     }
-    if (spn__mg_setup(&m->mg, &m->e, m->inv0) != SPN_OK) {
+    if (spn__mg_setup(&m->mg, &m->e, m->inv0) != SPN_OK || refused(w, SPN__REFUSE_VCYCLE)) {
         spn__mg_free(m->mg);
         m->mg = NULL;
         m->failed = true;
@@ -333,3 +341,4 @@ uint32_t spn__imp_mg_factorisations(const spn_world *w)
 }
 
 void spn__imp_mg_refuse(spn_world *w, uint32_t n) { w->imp_refuse = n; }
+void spn__imp_mg_refuse_setup(spn_world *w, unsigned which) { w->imp_refuse_pc = (uint8_t)which; }

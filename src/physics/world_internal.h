@@ -181,6 +181,7 @@ struct spn_world {
     double *pinv;         /* implicit: per-particle inverse 3x3 block, 6 each (on demand) */
     struct spn__imp_mg *imp_mg; /* implicit: the multigrid preconditioner (implicit_mg.c, on demand) */
     uint32_t imp_refuse;  /* spn__imp_mg_refuse (tests) */
+    uint8_t imp_refuse_pc; /* spn__imp_mg_refuse_setup (tests) */
     uint8_t implicit_pc;  /* implicit preconditioner: 0 auto, 1 block Jacobi, 2 multigrid, 3 cyclic */
     double imp_bj_long;   /* auto: the shortest step at which block Jacobi took more than
                            * SPN__IMPLICIT_BJ_MAX CG iterations (0: none yet); from it up, the multigrid */
@@ -484,6 +485,13 @@ uint32_t spn__imp_mg_factorisations(const spn_world *w);
  * refused, as of a matrix not positive definite (they are still made and
  * counted), for the fallbacks to be driven on a matrix that is definite. */
 void spn__imp_mg_refuse(spn_world *w, uint32_t n);
+/* For tests: the next factorisation of the cyclic preconditioner's line
+ * systems (SPN__REFUSE_CYCLIC) and the next V-cycle set-up
+ * (SPN__REFUSE_VCYCLE) refused, as of a matrix not positive definite (each
+ * still made), to drive the fallbacks after them: cyclic -> V-cycle -> block
+ * Jacobi. */
+enum { SPN__REFUSE_CYCLIC = 1, SPN__REFUSE_VCYCLE = 2 };
+void spn__imp_mg_refuse_setup(spn_world *w, unsigned which);
 /* Every contact active, before a step's first solve. */
 void spn__contact_begin(spn_world *w);
 /* The active contacts' part of the implicit system: their forces and
