@@ -473,8 +473,9 @@ static void test_blocked_passes_float32(void **state)
 }
 
 /* The thread governor's choices (lattice.c) on made-up timings (ns per
- * particle and level, a unit 0.1 ms): threads first, then one thread, then
- * the faster kept; the other tried 2 ms later over up to 8 units and given
+ * particle and level, a unit 0.1 ms): three units of threads first, then
+ * three of one thread, each figured by its fastest (the first ones are
+ * cold), then the faster kept; the other tried 2 ms later over up to 8 units and given
  * up once it cannot win; a unit slowed by chance not switching, a stalled
  * one switching at once; each choice's wait doubling while its tries lose
  * (to 4 s) and halving when one wins. */
@@ -484,10 +485,13 @@ static void test_governor_choices(void **state)
     lat_gov g;
     memset(&g, 0, sizeof g);
     double t = 100;
-    assert_int_equal(spn__lat_gov_pick(&g, t), 1);
-    spn__lat_gov_record(&g, 2.0, t += 1e-4);
-    assert_int_equal(spn__lat_gov_pick(&g, t), 0);
-    spn__lat_gov_record(&g, 3.0, t += 1e-4);
+    const double cold[2][3] = {{9.0, 3.0, 3.5}, {60.0, 2.5, 2.0}};
+    for (int m = 1; m >= 0; m--)
+        for (int i = 0; i < 3; i++) {
+            assert_int_equal(spn__lat_gov_pick(&g, t), m);
+            spn__lat_gov_record(&g, cold[m][i], t += 1e-4);
+        }
+    assert_true(g.ns[0] == 3.0 && g.ns[1] == 2.0);
     for (int i = 0; i < 5; i++) { /* threads faster: kept, no try within 2 ms */
         assert_int_equal(spn__lat_gov_pick(&g, t), 1);
         spn__lat_gov_record(&g, 2.0, t += 1e-4);

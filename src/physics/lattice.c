@@ -555,6 +555,12 @@ static int lattice_threads(const spn_world *w)
  * choice of threads costs a hundred times what a wrong choice of one
  * thread does, so on a web between parallel_min / 8 and parallel_min
  * particles each unit of work (a step, or a blocked pass) is timed, and:
+ * - first each choice runs LAT_GOV_FIRST units, threads first, and its
+ *   figure is their minimum: a choice's first units allocate workspaces
+ *   and find the caches cold (5k web, ns a particle-step: threads' first
+ *   pass 134-170, the second 6.5-15, later ones 2.8-3.7; one thread's
+ *   first 4.6-11, later 4.2-4.5), so that figures taken from the first
+ *   unit of each kept one thread for the first 2 ms;
  * - the choice kept has a running mean of its units' cost (an eighth of
  *   each new unit), and gives way when that exceeds 1.5 times the other's
  *   last figure: one stalled unit on threads at once, one unit slowed by
@@ -574,11 +580,12 @@ static int lattice_threads(const spn_world *w)
 #define LAT_GOV_MIN_WAIT 2e-3
 #define LAT_GOV_MAX_WAIT 4.0
 #define LAT_GOV_TRY 8
+#define LAT_GOV_FIRST 3
 
 int spn__lat_gov_pick(lat_gov *g, double now)
 {
-    if (!(g->ns[1] > 0)) return g->mode = 1; /* first threads, */
-    if (!(g->ns[0] > 0)) return g->mode = 0; /* then one thread */
+    if (g->first[1] < LAT_GOV_FIRST) return g->mode = 1; /* first threads, */
+    if (g->first[0] < LAT_GOV_FIRST) return g->mode = 0; /* then one thread */
     if (!(g->wait[0] > 0)) {
         g->kept = g->ns[1] < g->ns[0];
         g->wait[0] = g->wait[1] = LAT_GOV_MIN_WAIT;
@@ -590,8 +597,8 @@ int spn__lat_gov_pick(lat_gov *g, double now)
 void spn__lat_gov_record(lat_gov *g, double ns, double now)
 {
     const int m = g->mode;
-    if (!(g->wait[0] > 0)) { /* the first two units */
-        g->ns[m] = ns;
+    if (g->first[m] < LAT_GOV_FIRST) {
+        g->ns[m] = g->first[m]++ ? fmin(g->ns[m], ns) : ns;
         return;
     }
     if (m == g->kept) {
@@ -620,7 +627,7 @@ bool spn__lattice_gov_prefer(spn_world *w, bool threads)
     if (!w->lat) return false;
     lat_gov *g = &w->lat->gov;
     g->ns[threads] = 1, g->ns[!threads] = 1e300; /* no unit measures slower than that */
-    g->kept = threads, g->try_sum = 0, g->try_units = 0;
+    g->kept = threads, g->try_sum = 0, g->try_units = 0, g->first[0] = g->first[1] = LAT_GOV_FIRST;
     g->wait[0] = g->wait[1] = LAT_GOV_MAX_WAIT, g->next = HUGE_VAL, g->t0 = -1;
     return true;
 }

@@ -104,7 +104,7 @@ static inline void lat_mv2_carry(lat_mv2 *m, bool known, double sums[][L_NSUMS])
 typedef struct lat_gov {
     double ns[2];     /* choice [0] (one thread; single steps) and [1] (threads; blocked
                        * passes): the kept choice's running mean over its units, the
-                       * other's from its last try; 0 until measured */
+                       * other's from its last try */
     double t0;        /* start of the unit being timed [s]; < 0: none */
     double next;      /* the choice not kept is tried from this time [s] */
     double wait[2];   /* ... each choice this long after it was last tried or left [s];
@@ -113,6 +113,8 @@ typedef struct lat_gov {
     int try_units;    /* its units so far (0: no try under way) */
     int mode;         /* the unit being timed: choice 0 or 1 */
     int kept;         /* the choice kept between tries */
+    int first[2];     /* each choice's units so far, up to LAT_GOV_FIRST (its figure
+                       * their minimum: the first pay for workspaces and cold caches) */
 } lat_gov;
 
 /* A governor's choice (0 or 1) for the unit starting at `now` [s], and its
