@@ -278,6 +278,23 @@ static double force_round_off_scale(const spn_world *w)
     return sqrt(s2);
 }
 
+/* Auto, on any web: block Jacobi past SPN__IMPLICIT_BJ_MAX iterations sends
+ * this step length and longer ones to the multigrid or the factor
+ * (spn__imp_mg_prepare). */
+static void bj_took_long(spn_world *w, double h)
+{
+    if (w->implicit_pc == 0 && !(w->imp_bj_long > 0 && w->imp_bj_long <= h)) w->imp_bj_long = h;
+}
+
+/* ... and this solve too, from where it is: true when prepare took it (not
+ * on a small web's steps with contacts, nor when out of memory). */
+static bool bj_too_long(spn_world *w, double h)
+{
+    if (w->implicit_pc != 0) return false;
+    bj_took_long(w, h);
+    return spn__imp_mg_prepare(w, h);
+}
+
 /* Preconditioned CG for A dv = b from dv = 0; returns the iterations. It
  * stops at relative residual def.cg_tolerance, or when the residual is down
  * to the round-off of the forces themselves (h times 1e-13 of their scale,
@@ -286,7 +303,8 @@ static double force_round_off_scale(const spn_world *w)
  * def.cg_max_iterations, or a breakdown). */
 static int solve(spn_world *w, double h, double scale, bool *unfinished)
 {
-    const bool mg = spn__imp_mg_prepare(w, h);
+    bool mg = spn__imp_mg_prepare(w, h);
+    int mg_from = 0; /* the iteration at which prepare's preconditioner took over */
     const uint32_t np = w->np;
     spn_vec3 *dv = w->tmp[T_DV], *r = w->tmp[T_R], *z = w->tmp[T_Z], *p = w->tmp[T_P];
     memset(dv, 0, np * sizeof *dv);
@@ -307,20 +325,19 @@ static int solve(spn_world *w, double h, double scale, bool *unfinished)
         cg_update(w, rz / pap, mg, &rz, &rr);
         it++;
         if (rr <= stop) break;
-        if (mg && it == SPN__IMPLICIT_RESTART && spn__imp_mg_refactor(w)) {
-            cg_update(w, 0, mg, &rz, &rr); /* z from the new factor; dv and r as they are */
+        bool restart = false;
+        if (mg) restart = it - mg_from == SPN__IMPLICIT_RESTART && spn__imp_mg_refactor(w);
+        else if (it == SPN__IMPLICIT_BJ_MAX + 1 && bj_too_long(w, h)) restart = mg = true, mg_from = it;
+        if (restart) {
+            cg_update(w, 0, mg, &rz, &rr); /* z from the new preconditioner; dv and r as they are */
             memcpy(p, z, np * sizeof *p);
             continue;
         }
         cg_direction(w, rz / rz_old);
     }
     *unfinished = rr > stop;
-    if (mg) spn__imp_mg_solved(w, it);
-    /* auto, on any web: block Jacobi that took this many iterations sends
-     * this step length and longer ones to the multigrid (spn__imp_mg_prepare) */
-    if (!mg && w->implicit_pc == 0 && it > SPN__IMPLICIT_BJ_MAX &&
-        !(w->imp_bj_long > 0 && w->imp_bj_long <= h))
-        w->imp_bj_long = h;
+    if (mg) spn__imp_mg_solved(w, it - mg_from);
+    else if (it > SPN__IMPLICIT_BJ_MAX) bj_took_long(w, h);
     return it;
 }
 

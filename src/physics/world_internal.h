@@ -448,9 +448,9 @@ void spn__invert_sym3(const double a[6], double out[6]);
  * 20k web: break-even near 2e-3 s; docs/physics-implicit-mg.md). */
 #define SPN__IMPLICIT_MG_MIN 4096u
 #define SPN__IMPLICIT_MG_DT 5e-3
-/* ... and on any web, at any step, from the step after one at which block
- * Jacobi took more than this many CG iterations (at that step's length and
- * longer): past about a hundred the V-cycle's few iterations cost less
+/* ... and on any web, at any step, once block Jacobi has taken more than
+ * this many CG iterations in a step (at that step's length and longer; that
+ * step's solve goes on with it from there): past about a hundred the V-cycle's few iterations cost less
  * whatever the tolerance and the web's size (docs/physics-implicit-mg.md,
  * "Stiff webs"), but for a small web's steps with contacts. */
 #define SPN__IMPLICIT_BJ_MAX 100
