@@ -326,7 +326,7 @@ static int solve(spn_world *w, double h, double scale, bool *unfinished)
         it++;
         if (rr <= stop) break;
         bool restart = false;
-        if (mg) restart = it - mg_from == SPN__IMPLICIT_RESTART && spn__imp_mg_refactor(w);
+        if (mg && spn__imp_mg_restart_due(w, it - mg_from) && spn__imp_mg_refactor(w)) restart = true, mg_from = it;
         else if (it == SPN__IMPLICIT_BJ_MAX + 1 && bj_too_long(w, h)) restart = mg = true, mg_from = it;
         if (restart) {
             cg_update(w, 0, mg, &rz, &rr); /* z from the new preconditioner; dv and r as they are */

@@ -28,10 +28,12 @@
  * Where auto would take the V-cycle, a web of up to SPN__IMPLICIT_DIRECT_MAX
  * free particles gets a sparse Cholesky factor of level 0 instead
  * (sparse_chol.c; ordered and analysed once with the hierarchy's signature):
- * a factor of one step's matrix preconditions the next steps too, until a
- * solve takes more than SPN__IMPLICIT_REFACTOR iterations (the next step
- * factorises) or reaches SPN__IMPLICIT_RESTART (the solve factorises this
- * step's matrix and goes on), or the step length changes. The Araneus web in
+ * a factor of one step's matrix preconditions the next steps too while a
+ * step on it costs no more than the average step since the factorisation,
+ * its price included (spn__imp_mg_solved: the next step factorises), and
+ * while a solve on it has not run that price past that average
+ * (spn__imp_mg_restart_due: the solve factorises this step's matrix and
+ * goes on), and until the step length changes. The Araneus web in
  * air: 15.8 -> 3.7 CG and 6.3 -> 1.6 ms a step (docs/physics-implicit-mg.md,
  * "A factorised preconditioner").
  * The preconditioner is a fixed linear map within a solve (a restart begins
@@ -52,9 +54,11 @@ struct spn__imp_mg {
     spn__cyc *cyc;     /* a rings x radials web: the cyclic preconditioner instead of the V-cycle */
     spn__chol *chol;   /* a small web under auto: a factor of an earlier step's matrix instead */
     bool chol_ready;   /* chol holds a factor */
-    bool chol_stale;   /* the last solve took more than SPN__IMPLICIT_REFACTOR iterations */
+    bool chol_stale;   /* the last step cost more than the factor's average step: factorise */
     bool chol_fresh;   /* the factor is of this step's matrix */
     double chol_h;     /* the step the factor's matrix was assembled for */
+    uint64_t cycle_iterations; /* since the factorisation: its price and the CG iterations */
+    uint32_t cycle_steps;      /* ... over this many steps (0: none yet) */
     uint32_t factorisations;
     uint32_t *espring; /* eq spring -> internal spring id */
     double *inv0;      /* 6 n: inverted diagonal blocks in eq order */
@@ -329,10 +333,35 @@ bool spn__imp_mg_refactor(spn_world *w)
     return true;
 }
 
+/* When to factorise again. A factor's steps cost its price once
+ * (SPN__IMPLICIT_FACTOR_PRICE) and then each step's CG iterations, which
+ * grow as the matrix moves away from the factor's. The average cost of a
+ * step since the factorisation falls while a step costs less than it, and
+ * is least where the next step would cost more: then the next step
+ * factorises. A growing sequence has its least average there (the rule of
+ * replacing a wearing part). The counts are the CG iterations, not times,
+ * so the choice, and the bits, are the same on every machine. */
 void spn__imp_mg_solved(spn_world *w, int iterations)
 {
     spn__imp_mg *m = w->imp_mg;
-    if (m && m->chol && !m->chol_fresh && iterations > SPN__IMPLICIT_REFACTOR) m->chol_stale = true;
+    if (!m || !m->chol) return;
+    const uint32_t it = (uint32_t)iterations;
+    if (m->chol_fresh) {
+        m->cycle_iterations = SPN__IMPLICIT_FACTOR_PRICE + it, m->cycle_steps = 1;
+        return;
+    }
+    if ((uint64_t)it * m->cycle_steps > m->cycle_iterations) m->chol_stale = true;
+    m->cycle_iterations += it, m->cycle_steps++;
+}
+
+bool spn__imp_mg_restart_due(const spn_world *w, int iterations)
+{
+    const spn__imp_mg *m = w->imp_mg;
+    if (!m || !m->chol || m->chol_fresh || !m->cycle_steps) return false;
+    /* iterations > average + price: a factorisation now costs less than
+     * what this solve has spent past an average step */
+    return (uint64_t)iterations * m->cycle_steps >
+           m->cycle_iterations + (uint64_t)SPN__IMPLICIT_FACTOR_PRICE * m->cycle_steps;
 }
 
 uint32_t spn__imp_mg_factorisations(const spn_world *w)

@@ -456,16 +456,14 @@ void spn__invert_sym3(const double a[6], double out[6]);
 #define SPN__IMPLICIT_BJ_MAX 100
 /* Where auto takes the multigrid on a web that is no lattice, a web of at
  * most this many free particles is factorised instead (sparse_chol.c): the
- * factor of one step's matrix preconditions the steps after it, and a step
- * whose solve took more than SPN__IMPLICIT_REFACTOR CG iterations has the
- * next one factorise its own (docs/physics-implicit-mg.md, "A factorised
- * preconditioner"). */
+ * factor of one step's matrix preconditions the steps after it until it
+ * costs more than a new one would (docs/physics-implicit-mg.md, "A
+ * factorised preconditioner", "When to factorise again"). */
 #define SPN__IMPLICIT_DIRECT_MAX 65536u
-#define SPN__IMPLICIT_REFACTOR 4
-/* A solve with a factor of an earlier step that reaches this many
- * iterations factorises this step's matrix and goes on from where it is
- * (CG restarted with the new preconditioner). */
-#define SPN__IMPLICIT_RESTART 8
+/* What a factorisation costs, in CG iterations, for that reckoning: about
+ * 12 measured on the Araneus and the 0.5 m Zilla web (2 ms against 0.17,
+ * 29 against 2.3); 8 gave the faster steps on both and on the 1 m web. */
+#define SPN__IMPLICIT_FACTOR_PRICE 8u
 typedef struct spn__imp_mg spn__imp_mg;
 void spn__imp_mg_free(spn__imp_mg *m);
 /* After w->jac and w->pinv are built for step h: (re)build or refresh the
@@ -473,8 +471,12 @@ void spn__imp_mg_free(spn__imp_mg *m);
 bool spn__imp_mg_prepare(spn_world *w, double h);
 /* z = M^-1 r over all particles (fixed rows 0). */
 void spn__imp_mg_apply(const spn_world *w, const spn_vec3 *r, spn_vec3 *z);
-/* A solve with the preconditioner took `iterations` CG iterations. */
+/* A solve with the preconditioner took `iterations` CG iterations (since
+ * it took over): with a factor kept, whether the next step factorises. */
 void spn__imp_mg_solved(spn_world *w, int iterations);
+/* Mid-solve, `iterations` into it: whether a factor of an earlier step has
+ * cost this solve more than a factorisation would (spn__imp_mg_refactor). */
+bool spn__imp_mg_restart_due(const spn_world *w, int iterations);
 /* Mid-solve: the factor of an earlier step replaced by this step's (or,
  * if that fails, by block Jacobi for the rest of the solve); false when
  * there is none to replace. CG must start again from where it is. */
