@@ -12,8 +12,10 @@
  *    included, (up to SPN__IMPLICIT_DIRECT_MAX particles) the factor of a
  *    step's matrix;
  *    the same on a small web (1,201 particles);
- * 6. that factor: kept while solves stay short, made again at a change of
- *    step, the same bits on one thread and two;
+ * 6. that factor: kept while its steps cost less than their average since it
+ *    was made; after one is outrun within a step, made at the start of the
+ *    next steps; made again at a change of step; the same bits on one
+ *    thread and two;
  * 7. a change of preconditioner mid-run takes effect at the next step;
  * 8. that factor refused (forced by spn__imp_mg_refuse: with valid inputs
  *    the matrix is positive definite, and only round-off could make it
@@ -354,6 +356,39 @@ static void test_factor_on_a_small_web(void **state)
     free(a.state), free(b.state), free(c.state);
 }
 
+/* A factor outrun within the step after its own (the 20 x 60 web falling,
+ * steps of 1e-4 s: the factor of step 4 is outrun in step 5, refactored
+ * mid-solve after some 18 iterations): the next step factorises at its
+ * start and takes one or two; outrun again in the step after that, the
+ * next two do; then a kept factor serves, and the factor is kept again. */
+static void test_factor_hold(void **state)
+{
+    (void)state;
+    spn_world *w = broken_web(1);
+    enum { STEPS = 16 };
+    long cg[STEPS];
+    bool made[STEPS];
+    uint32_t before = 0;
+    for (int i = 0; i < STEPS; i++) {
+        assert_int_equal(spn_world_step(w, 1e-4), SPN_OK);
+        cg[i] = spn_world_last_step(w).cg_iterations;
+        made[i] = spn__imp_mg_factorisations(w) > before;
+        before = spn__imp_mg_factorisations(w);
+        print_message("%ld%s ", cg[i], made[i] ? "*" : "");
+    }
+    print_message("\n");
+    spn_world_destroy(w);
+    int a = 1; /* the first step outrun: it factorised after more than a price of iterations */
+    while (a < STEPS - 5 && !(made[a] && cg[a] > (long)SPN__IMPLICIT_FACTOR_PRICE)) a++;
+    assert_true(a < STEPS - 5);
+    assert_true(made[a + 1] && cg[a + 1] <= 2);
+    assert_true(made[a + 2] && cg[a + 2] > (long)SPN__IMPLICIT_FACTOR_PRICE); /* tried, outrun again */
+    assert_true(made[a + 3] && cg[a + 3] <= 2 && made[a + 4] && cg[a + 4] <= 2);
+    int kept = 0;
+    for (int i = a + 5; i < STEPS; i++) kept += !made[i];
+    assert_true(kept >= 3);
+}
+
 /* The factor with a prey held by a contact, on a web that is no lattice
  * and big enough that auto does not keep block Jacobi for steps with
  * contacts (5,001 particles, a spring broken, dt 1e-4 s): the contacts'
@@ -626,6 +661,7 @@ int main(void)
         cmocka_unit_test(test_auto_at_short_steps),
         cmocka_unit_test(test_auto_on_a_small_web),
         cmocka_unit_test(test_factor_on_a_small_web),
+        cmocka_unit_test(test_factor_hold),
         cmocka_unit_test(test_factor_with_a_contact),
         cmocka_unit_test(test_factor_refused_mid_solve),
         cmocka_unit_test(test_factor_refused_at_a_step),

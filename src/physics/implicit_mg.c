@@ -33,7 +33,8 @@
  * its price included (spn__imp_mg_solved: the next step factorises), and
  * while a solve on it has not run that price past that average
  * (spn__imp_mg_restart_due: the solve factorises this step's matrix and
- * goes on), and until the step length changes. The Araneus web in
+ * goes on; outrun so in the step after its own, the next steps factorise
+ * at their start), and until the step length changes. The Araneus web in
  * air: 15.8 -> 3.7 CG and 6.3 -> 1.6 ms a step (docs/physics-implicit-mg.md,
  * "A factorised preconditioner").
  * The preconditioner is a fixed linear map within a solve (a restart begins
@@ -59,6 +60,7 @@ struct spn__imp_mg {
     double chol_h;     /* the step the factor's matrix was assembled for */
     uint64_t cycle_iterations; /* since the factorisation: its price and the CG iterations */
     uint32_t cycle_steps;      /* ... over this many steps (0: none yet) */
+    uint32_t hold, hold_len;   /* steps left that factorise at their start; the last hold's length */
     uint32_t factorisations;
     uint32_t *espring; /* eq spring -> internal spring id */
     double *inv0;      /* 6 n: inverted diagonal blocks in eq order */
@@ -275,7 +277,8 @@ bool spn__imp_mg_prepare(spn_world *w, double h)
     if (w->implicit_pc == 0 && !auto_mg && !m->cyc) return false; /* a short step without the cyclic one */
     assemble(m, w, h);
     if (m->chol) {
-        m->chol_fresh = !m->chol_ready || m->chol_stale || h != m->chol_h;
+        m->chol_fresh = !m->chol_ready || m->chol_stale || h != m->chol_h || m->hold > 0;
+        if (m->hold) m->hold--;
         if (m->chol_fresh) {
             m->chol_ready = factorise(w, m);
             m->chol_h = h;
@@ -330,6 +333,13 @@ bool spn__imp_mg_refactor(spn_world *w)
      * fails too */
     m->chol_ready = factorise(w, m);
     m->chol_fresh = true;
+    /* A factor that one step has outrun says the next will outrun this one
+     * too: the next steps factorise at their start, 1, 2, 4 ... 16 of them
+     * as such steps keep coming (a kept factor that serves resets it). */
+    if (m->cycle_steps == 1) {
+        m->hold_len = m->hold_len ? (2 * m->hold_len < SPN__IMPLICIT_HOLD_MAX ? 2 * m->hold_len : SPN__IMPLICIT_HOLD_MAX) : 1;
+        m->hold = m->hold_len;
+    }
     return true;
 }
 
@@ -351,6 +361,7 @@ void spn__imp_mg_solved(spn_world *w, int iterations)
         return;
     }
     if ((uint64_t)it * m->cycle_steps > m->cycle_iterations) m->chol_stale = true;
+    else if (m->cycle_steps == 1) m->hold_len = 0; /* a factor one step old served */
     m->cycle_iterations += it, m->cycle_steps++;
 }
 

@@ -464,6 +464,9 @@ void spn__invert_sym3(const double a[6], double out[6]);
  * 12 measured on the Araneus and the 0.5 m Zilla web (2 ms against 0.17,
  * 29 against 2.3); 8 gave the faster steps on both and on the 1 m web. */
 #define SPN__IMPLICIT_FACTOR_PRICE 8u
+/* A factor outrun within the step after its own has the next steps
+ * factorise at their start, up to this many in a row. */
+#define SPN__IMPLICIT_HOLD_MAX 16u
 typedef struct spn__imp_mg spn__imp_mg;
 void spn__imp_mg_free(spn__imp_mg *m);
 /* After w->jac and w->pinv are built for step h: (re)build or refresh the
