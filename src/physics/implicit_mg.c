@@ -337,8 +337,8 @@ bool spn__imp_mg_refactor(spn_world *w)
      * too: the next steps factorise at their start, 1, 2, 4 ... 16 of them
      * as such steps keep coming (a kept factor that serves resets it). */
     if (m->cycle_steps == 1) {
-        m->hold_len = m->hold_len ? (2 * m->hold_len < SPN__IMPLICIT_HOLD_MAX ? 2 * m->hold_len : SPN__IMPLICIT_HOLD_MAX) : 1;
-        m->hold = m->hold_len;
+        const uint32_t twice = 2 * m->hold_len;
+        m->hold = m->hold_len = !twice ? 1 : twice < SPN__IMPLICIT_HOLD_MAX ? twice : SPN__IMPLICIT_HOLD_MAX;
     }
     return true;
 }

@@ -450,9 +450,10 @@ void spn__invert_sym3(const double a[6], double out[6]);
 #define SPN__IMPLICIT_MG_DT 5e-3
 /* ... and on any web, at any step, once block Jacobi has taken more than
  * this many CG iterations in a step (at that step's length and longer; that
- * step's solve goes on with it from there): past about a hundred the V-cycle's few iterations cost less
- * whatever the tolerance and the web's size (docs/physics-implicit-mg.md,
- * "Stiff webs"), but for a small web's steps with contacts. */
+ * step's solve goes on with it from there): past about a hundred the
+ * V-cycle's few iterations cost less whatever the tolerance and the web's
+ * size (docs/physics-implicit-mg.md, "Stiff webs"), but for a small web's
+ * steps with contacts. */
 #define SPN__IMPLICIT_BJ_MAX 100
 /* Where auto takes the multigrid on a web that is no lattice, a web of at
  * most this many free particles is factorised instead (sparse_chol.c): the
