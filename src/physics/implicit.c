@@ -280,19 +280,13 @@ static double force_round_off_scale(const spn_world *w)
 
 /* Auto, on any web: block Jacobi past SPN__IMPLICIT_BJ_MAX iterations sends
  * this step length and longer ones to the multigrid or the factor
- * (spn__imp_mg_prepare). */
-static void bj_took_long(spn_world *w, double h)
-{
-    if (w->implicit_pc == 0 && !(w->imp_bj_long > 0 && w->imp_bj_long <= h)) w->imp_bj_long = h;
-}
-
-/* ... and this solve too, from where it is: true when prepare took it (not
- * on a small web's steps with contacts, nor when out of memory). */
-static bool bj_too_long(spn_world *w, double h)
+ * (spn__imp_mg_prepare; in the middle of a solve, that solve too). False
+ * when the preconditioner is not auto's choice. */
+static bool bj_took_long(spn_world *w, double h)
 {
     if (w->implicit_pc != 0) return false;
-    bj_took_long(w, h);
-    return spn__imp_mg_prepare(w, h);
+    if (!(w->imp_bj_long > 0 && w->imp_bj_long <= h)) w->imp_bj_long = h;
+    return true;
 }
 
 /* Preconditioned CG for A dv = b from dv = 0; returns the iterations. It
@@ -325,10 +319,13 @@ static int solve(spn_world *w, double h, double scale, bool *unfinished)
         cg_update(w, rz / pap, mg, &rz, &rr);
         it++;
         if (rr <= stop) break;
-        bool restart = false;
-        if (mg && spn__imp_mg_restart_due(w, it - mg_from) && spn__imp_mg_refactor(w)) restart = true, mg_from = it;
-        else if (it == SPN__IMPLICIT_BJ_MAX + 1 && bj_too_long(w, h)) restart = mg = true, mg_from = it;
+        bool restart;
+        if (mg) /* a factor kept from an earlier step outrun: this step's */
+            restart = spn__imp_mg_restart_due(w, it - mg_from) && spn__imp_mg_refactor(w);
+        else /* block Jacobi outrun: auto's choice (prepare declines a small web's steps with contacts) */
+            restart = mg = it == SPN__IMPLICIT_BJ_MAX + 1 && bj_took_long(w, h) && spn__imp_mg_prepare(w, h);
         if (restart) {
+            mg_from = it;
             cg_update(w, 0, mg, &rz, &rr); /* z from the new preconditioner; dv and r as they are */
             memcpy(p, z, np * sizeof *p);
             continue;
