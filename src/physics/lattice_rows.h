@@ -108,7 +108,7 @@ typedef struct lat_gov {
     double t0;        /* start of the unit being timed [s]; < 0: none */
     double next;      /* the choice not kept is tried from this time [s] */
     double wait[2];   /* ... each choice this long after it was last tried or left [s];
-                       * 0 before the first two units */
+                       * 0 until both choices' first units are in (first) */
     double try_sum;   /* ns of the try under way, summed over its units */
     int try_units;    /* its units so far (0: no try under way) */
     int mode;         /* the unit being timed: choice 0 or 1 */
