@@ -21,6 +21,17 @@
  * time, on 3x3 blocks: one index for nine multiply-adds. A column at a time, the
  * factorisation took 3.6 ms on the Araneus web, 92 and 218 ms on the Zilla
  * webs of 14k and 50k particles; a particle at a time 2.2, 30 and 82.
+ *
+ * L is stored the same way, a particle's columns together: below its
+ * diagonal block, each block of three rows is nine numbers in a row and
+ * one row-particle's number. Stored by scalar column, with an index a
+ * number (the three columns of a block in three places), the solve took
+ * 1.19 and 4.99 ms on the Zilla webs, the factorisation 19.7 and 49.1;
+ * stored by block 0.82 and 3.27, 17.7 and 42.3 (Zen 5, same bits). Blocks
+ * of float32 numbers made neither faster and moved the solve's result by up
+ * to 2.5 times its size on the larger web: the matrix is too ill-conditioned
+ * for a factor rounded to 7 digits.
+ *
  * Every factorisation walks the same reaches in the same order, so its
  * bits depend on the values only. */
 #include "sparse_chol.h"
@@ -40,11 +51,15 @@ struct spn__chol {
     size_t *dst_diag; /* 6 n: the entry of A each diagonal-block number adds into */
     size_t *dst_offd; /* 9 per neighbour entry: each number of the block's (a, b), or SIZE_MAX */
     uint32_t nadj;
-    /* the particles' elimination tree and L by scalar column, its diagonal first */
+    /* the particles' elimination tree, and L a particle's three columns at a
+     * time: the Cholesky factor of its diagonal block (6 numbers: 00 10 20
+     * 11 21 22), then one 3x3 block (row-major: the row-particle's rows, its
+     * columns) and the row-particle's number for each particle below it */
     int32_t *bparent; /* n */
-    size_t *lp;       /* N + 1 */
-    uint32_t *li;     /* lp[N] */
-    double *lx;       /* lp[N] */
+    double *ld;       /* 6 n */
+    size_t *bp;       /* n + 1: particle k's blocks are bp[k] .. bp[k + 1) */
+    double *lb;       /* 9 bp[n] */
+    uint32_t *lj;     /* bp[n] */
     /* scratch: a reach's stack, marks and path (n each), the solve's vector
      * (N), a 3x3 block of the row being formed for each particle (9 n,
      * row-major: the earlier particle's row, this one's column) and the
@@ -309,36 +324,35 @@ spn__chol *spn__chol_analyze(uint32_t n, const uint32_t *start, const int32_t *a
     spn__chol *c = calloc(1, sizeof *c);
     if (!c) return NULL;
     c->n = n, c->N = 3 * n, c->nadj = start[n];
-    const uint32_t N = c->N;
     c->perm = malloc(n * sizeof *c->perm);
     c->bparent = malloc(n * sizeof *c->bparent);
     c->stack = malloc(n * sizeof *c->stack);
     c->mark = malloc(n * sizeof *c->mark);
     c->next = malloc(n * sizeof *c->next);
-    c->x = calloc(N, sizeof *c->x);
+    c->x = calloc(c->N, sizeof *c->x);
     c->xb = calloc(9 * (size_t)n, sizeof *c->xb);
     c->filled = calloc(n, sizeof *c->filled);
-    c->lp = malloc(((size_t)N + 1) * sizeof *c->lp);
-    if (!c->perm || !c->bparent || !c->stack || !c->mark || !c->next || !c->x || !c->xb || !c->filled || !c->lp ||
-        !order(c, start, adj_other) || !upper_pattern(c, start, adj_other)) {
+    c->ld = malloc(6 * (size_t)n * sizeof *c->ld);
+    c->bp = malloc(((size_t)n + 1) * sizeof *c->bp);
+    if (!c->perm || !c->bparent || !c->stack || !c->mark || !c->next || !c->x || !c->xb || !c->filled || !c->ld ||
+        !c->bp || !order(c, start, adj_other) || !upper_pattern(c, start, adj_other)) {
         spn__chol_free(c);
         return NULL;
     }
     etree(c, c->mark);
     /* the row-particles of each particle's columns: each particle k reaches
-     * adds one to those it reaches; column 3i + b holds i's block's rows
-     * from 3i + b on, then three a row-particle */
+     * adds one to those it reaches */
     for (uint32_t k = 0; k < n; k++)
         c->mark[k] = UINT32_MAX;
     for (uint32_t k = 0; k < n; k++)
         for (uint32_t t = block_reach(c, k); t < n; t++)
             c->filled[c->stack[t]]++;
-    c->lp[0] = 0;
+    c->bp[0] = 0;
     for (uint32_t k = 0; k < n; k++)
-        for (uint32_t b = 0; b < 3; b++)
-            c->lp[3 * k + b + 1] = c->lp[3 * k + b] + (3 - b) + 3 * (size_t)c->filled[k];
-    if (c->lp[N] > max_entries || !(c->li = malloc(c->lp[N] * sizeof *c->li)) ||
-        !(c->lx = malloc(c->lp[N] * sizeof *c->lx))) {
+        c->bp[k + 1] = c->bp[k] + c->filled[k];
+    const size_t blocks = c->bp[n];
+    if (spn__chol_entries(c) > max_entries || !(c->lj = malloc((blocks ? blocks : 1) * sizeof *c->lj)) ||
+        !(c->lb = malloc(9 * (blocks ? blocks : 1) * sizeof *c->lb))) {
         spn__chol_free(c);
         return NULL;
     }
@@ -348,9 +362,8 @@ spn__chol *spn__chol_analyze(uint32_t n, const uint32_t *start, const int32_t *a
 /* The up-looking method a particle at a time: row k of L is three rows, and
  * each particle i it reaches gives a 3x3 block L(k, i), found from the
  * block X_i of the rows solved so far by the triangular block L(i, i), then
- * taken from the blocks X_j of the particles below i in i's columns. In
- * column 3i + a, after the rows of i's own block, row-particle t's three
- * rows are at 3 - a + 3 t. */
+ * taken from the blocks X_j of the particles below i in i's columns; it
+ * becomes i's next block. */
 bool spn__chol_factor(spn__chol *c, const double *diag, const double *offd)
 {
     const uint32_t N = c->N, n = c->n;
@@ -364,9 +377,7 @@ bool spn__chol_factor(spn__chol *c, const double *diag, const double *offd)
     for (uint32_t k = 0; k < n; k++)
         c->mark[k] = UINT32_MAX, c->filled[k] = 0;
     const double *ax = c->ax;
-    double *lx = c->lx, *xb = c->xb;
-    uint32_t *li = c->li;
-    const size_t *lp = c->lp;
+    double *xb = c->xb;
     bool ok = true;
     for (uint32_t k = 0; k < n && ok; k++) {
         const size_t q0 = c->ap[3 * k], q1 = c->ap[3 * k + 1], q2 = c->ap[3 * k + 2];
@@ -382,26 +393,26 @@ bool spn__chol_factor(spn__chol *c, const double *diag, const double *offd)
         double d02 = ax[q2 + e], d12 = ax[q2 + e + 1], d22 = ax[q2 + e + 2];
         for (uint32_t top = block_reach(c, k); top < n; top++) {
             const uint32_t i = c->stack[top];
-            const size_t p0 = lp[3 * i], p1 = lp[3 * i + 1], p2 = lp[3 * i + 2];
+            const double *li = c->ld + 6 * (size_t)i;
             double *x = xb + 9 * (size_t)i;
             /* Y = L(i, i)^-1 X_i: Y's rows are i's, its columns k's; L(k, i) = Y^T */
             double y[9];
             for (int b = 0; b < 3; b++) {
-                const double y0 = x[b] / lx[p0];
-                const double y1 = (x[3 + b] - lx[p0 + 1] * y0) / lx[p1];
-                y[b] = y0, y[3 + b] = y1, y[6 + b] = ((x[6 + b] - lx[p0 + 2] * y0) - lx[p1 + 1] * y1) / lx[p2];
+                const double y0 = x[b] / li[0];
+                const double y1 = (x[3 + b] - li[1] * y0) / li[3];
+                y[b] = y0, y[3 + b] = y1, y[6 + b] = ((x[6 + b] - li[2] * y0) - li[4] * y1) / li[5];
             }
             for (int m = 0; m < 9; m++)
                 x[m] = 0;
             /* X_j -= L(j, i) Y for the row-particles j of i's columns so far */
             const uint32_t f = c->filled[i];
-            for (uint32_t t = 0; t < f; t++) {
-                const double *l0 = lx + p0 + 3 + 3 * (size_t)t, *l1 = lx + p1 + 2 + 3 * (size_t)t,
-                             *l2 = lx + p2 + 1 + 3 * (size_t)t;
-                double *xj = xb + 9 * (size_t)(li[p2 + 1 + 3 * (size_t)t] / 3);
+            const double *l = c->lb + 9 * c->bp[i];
+            const uint32_t *rows = c->lj + c->bp[i];
+            for (uint32_t t = 0; t < f; t++, l += 9) {
+                double *xj = xb + 9 * (size_t)rows[t];
                 for (int r = 0; r < 3; r++)
                     for (int b = 0; b < 3; b++)
-                        xj[3 * r + b] -= (l0[r] * y[b] + l1[r] * y[3 + b]) + l2[r] * y[6 + b];
+                        xj[3 * r + b] -= (l[3 * r] * y[b] + l[3 * r + 1] * y[3 + b]) + l[3 * r + 2] * y[6 + b];
             }
             /* the diagonal block: d -= Y^T Y */
             d00 -= (y[0] * y[0] + y[3] * y[3]) + y[6] * y[6];
@@ -412,70 +423,65 @@ bool spn__chol_factor(spn__chol *c, const double *diag, const double *offd)
             d22 -= (y[2] * y[2] + y[5] * y[5]) + y[8] * y[8];
             /* L(k, i) into i's columns, as row-particle f */
             c->filled[i] = f + 1;
-            for (int a = 0; a < 3; a++) {
-                const size_t at = lp[3 * i + a] + 3 - a + 3 * (size_t)f;
+            double *to = c->lb + 9 * (c->bp[i] + f);
+            for (int a = 0; a < 3; a++)
                 for (int b = 0; b < 3; b++)
-                    lx[at + b] = y[3 * a + b], li[at + b] = 3 * k + b;
-            }
+                    to[3 * b + a] = y[3 * a + b];
+            c->lj[c->bp[i] + f] = k;
         }
         /* L(k, k): the Cholesky factor of d */
         const double l00 = sqrt(d00), l10 = d01 / l00, l20 = d02 / l00;
         const double s11 = d11 - l10 * l10, l11 = sqrt(s11), l21 = (d12 - l20 * l10) / l11;
         const double s22 = (d22 - l20 * l20) - l21 * l21, l22 = sqrt(s22);
         ok = d00 > 0 && s11 > 0 && s22 > 0 && isfinite(l00 + l10 + l20 + l11 + l21 + l22);
-        const size_t p0 = lp[3 * k], p1 = lp[3 * k + 1], p2 = lp[3 * k + 2];
-        lx[p0] = l00, lx[p0 + 1] = l10, lx[p0 + 2] = l20, lx[p1] = l11, lx[p1 + 1] = l21, lx[p2] = l22;
-        li[p0] = 3 * k, li[p0 + 1] = 3 * k + 1, li[p0 + 2] = 3 * k + 2, li[p1] = 3 * k + 1, li[p1 + 1] = 3 * k + 2;
-        li[p2] = 3 * k + 2;
+        double *lk = c->ld + 6 * (size_t)k;
+        lk[0] = l00, lk[1] = l10, lk[2] = l20, lk[3] = l11, lk[4] = l21, lk[5] = l22;
     }
     if (!ok) memset(xb, 0, 9 * (size_t)n * sizeof *xb); /* a failed row leaves values behind */
     return ok;
 }
 
-/* L y = b, then L^T x = y, in y, a particle at a time. A particle's
- * diagonal block enters A whole, so in the elimination tree 3k is the only
- * child of 3k + 1 and 3k + 1 of 3k + 2, and rows of other particles come in
- * whole triples: its three columns of L hold its 3x3 block (rows 3k + 1,
- * 3k + 2 below the first diagonal, 3k + 2 below the second) and then the
- * same rows S in the same order. Forward, the particle's three unknowns
- * come from the block and each row of S is updated by its three entries;
- * backward, the three sums over S come first, then the block. */
+/* L y = b, then L^T x = y, in y, a particle at a time. Forward, the
+ * particle's three unknowns come from its diagonal block, and each block
+ * below takes its product with them from its row-particle's three;
+ * backward, the three sums over the blocks below come first, then the
+ * diagonal block. */
 static void solve_particles(const spn__chol *c, double *y)
 {
-    const double *lx = c->lx;
     for (uint32_t k = 0; k < c->n; k++) {
-        const uint32_t j = 3 * k;
-        const size_t p0 = c->lp[j], p1 = c->lp[j + 1], p2 = c->lp[j + 2], ns = c->lp[j + 3] - p2 - 1;
-        const double y0 = y[j] / lx[p0];
-        const double y1 = (y[j + 1] - lx[p0 + 1] * y0) / lx[p1];
-        const double y2 = ((y[j + 2] - lx[p0 + 2] * y0) - lx[p1 + 1] * y1) / lx[p2];
-        y[j] = y0, y[j + 1] = y1, y[j + 2] = y2;
-        const double *a = lx + p0 + 3, *b = lx + p1 + 2, *e = lx + p2 + 1;
-        const uint32_t *rows = c->li + p2 + 1;
-        for (size_t t = 0; t < ns; t++) {
-            double *yr = y + rows[t];
-            *yr = ((*yr - a[t] * y0) - b[t] * y1) - e[t] * y2;
+        const double *lk = c->ld + 6 * (size_t)k;
+        double *yk = y + 3 * (size_t)k;
+        const double y0 = yk[0] / lk[0];
+        const double y1 = (yk[1] - lk[1] * y0) / lk[3];
+        const double y2 = ((yk[2] - lk[2] * y0) - lk[4] * y1) / lk[5];
+        yk[0] = y0, yk[1] = y1, yk[2] = y2;
+        const double *l = c->lb + 9 * c->bp[k];
+        const uint32_t *rows = c->lj + c->bp[k];
+        for (size_t t = 0, nb = c->bp[k + 1] - c->bp[k]; t < nb; t++, l += 9) {
+            double *yr = y + 3 * (size_t)rows[t];
+            for (int r = 0; r < 3; r++)
+                yr[r] = ((yr[r] - l[3 * r] * y0) - l[3 * r + 1] * y1) - l[3 * r + 2] * y2;
         }
     }
     for (uint32_t k = c->n; k-- > 0;) {
-        const uint32_t j = 3 * k;
-        const size_t p0 = c->lp[j], p1 = c->lp[j + 1], p2 = c->lp[j + 2], ns = c->lp[j + 3] - p2 - 1;
-        const double *a = lx + p0 + 3, *b = lx + p1 + 2, *e = lx + p2 + 1;
-        const uint32_t *rows = c->li + p2 + 1;
-        double s0 = y[j], s1 = y[j + 1], s2 = y[j + 2];
-        for (size_t t = 0; t < ns; t++) {
-            const double xr = y[rows[t]];
-            s0 -= a[t] * xr, s1 -= b[t] * xr, s2 -= e[t] * xr;
+        const double *lk = c->ld + 6 * (size_t)k;
+        double *yk = y + 3 * (size_t)k;
+        const double *l = c->lb + 9 * c->bp[k];
+        const uint32_t *rows = c->lj + c->bp[k];
+        double s0 = yk[0], s1 = yk[1], s2 = yk[2];
+        for (size_t t = 0, nb = c->bp[k + 1] - c->bp[k]; t < nb; t++, l += 9) {
+            const double *xr = y + 3 * (size_t)rows[t];
+            for (int r = 0; r < 3; r++)
+                s0 -= l[3 * r] * xr[r], s1 -= l[3 * r + 1] * xr[r], s2 -= l[3 * r + 2] * xr[r];
         }
-        const double x2 = s2 / lx[p2];
-        const double x1 = (s1 - lx[p1 + 1] * x2) / lx[p1];
-        y[j + 2] = x2, y[j + 1] = x1, y[j] = ((s0 - lx[p0 + 1] * x1) - lx[p0 + 2] * x2) / lx[p0];
+        const double x2 = s2 / lk[5];
+        const double x1 = (s1 - lk[4] * x2) / lk[3];
+        yk[2] = x2, yk[1] = x1, yk[0] = ((s0 - lk[1] * x1) - lk[2] * x2) / lk[0];
     }
 }
 
 void spn__chol_solve(const spn__chol *c, const double *b, double *out)
 {
-    const uint32_t N = c->N;
     double *y = c->x;
     for (uint32_t k = 0; k < c->n; k++)
         for (int a = 0; a < 3; a++)
@@ -484,17 +490,15 @@ void spn__chol_solve(const spn__chol *c, const double *b, double *out)
     for (uint32_t k = 0; k < c->n; k++)
         for (int a = 0; a < 3; a++)
             out[3 * (size_t)c->perm[k] + a] = y[3 * k + a];
-    for (uint32_t j = 0; j < N; j++)
-        y[j] = 0; /* the factorisation's dense row starts at zero */
 }
 
-size_t spn__chol_entries(const spn__chol *c) { return c->lp[c->N]; }
+size_t spn__chol_entries(const spn__chol *c) { return 6 * (size_t)c->n + 9 * c->bp[c->n]; }
 
 void spn__chol_free(spn__chol *c)
 {
     if (!c) return;
     free(c->perm), free(c->ap), free(c->ai), free(c->ax), free(c->dst_diag), free(c->dst_offd);
-    free(c->bparent), free(c->lp), free(c->li), free(c->lx), free(c->stack), free(c->mark), free(c->next), free(c->x);
-    free(c->xb), free(c->filled);
+    free(c->bparent), free(c->ld), free(c->bp), free(c->lb), free(c->lj), free(c->stack), free(c->mark), free(c->next);
+    free(c->x), free(c->xb), free(c->filled);
     free(c);
 }
