@@ -36,6 +36,14 @@
  * Renumbering the particles in a postorder of the elimination tree, for
  * locality, took 7-12% off the factorisation and added 18-26% to the
  * solve (a particle's parent then comes next, and waits for its stores).
+ * Threads were tried: the elimination tree cut into 16 bins of subtrees,
+ * whose rows the factorisation forms side by side and whose unknowns the
+ * solves find side by side, the tree's top on one thread. The top holds
+ * half the factorisation's work on the Zilla webs (their trees have no
+ * large dense part: 98 of the 1 m web's 50k particles), and grouping each
+ * bin's particles together slowed the solve as the postorder did: a step
+ * of the 1 m web took 81 ms on one thread and 71 on two, against 70 and 71
+ * in one piece. Not kept.
  *
  * Every factorisation walks the same reaches in the same order, so its
  * bits depend on the values only. */
