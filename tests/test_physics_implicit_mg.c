@@ -11,7 +11,9 @@
  *    until a step takes it over a hundred iterations, then, that step
  *    included, (up to SPN__IMPLICIT_DIRECT_MAX particles) the factor of a
  *    step's matrix;
- *    the same on a small web (1,201 particles);
+ *    the same on a small web (1,201 particles); a solve on the cyclic
+ *    preconditioner past a hundred iterations is not handed over (auto's
+ *    steps are the cyclic one's, bit for bit);
  * 6. that factor: kept while its steps cost less than their average since it
  *    was made; after one is outrun within a step, made at the start of the
  *    next steps; made again at a change of step; the same bits on one
@@ -214,6 +216,51 @@ static void test_auto_at_short_steps(void **state)
     assert_true(dv <= 1e-6 * vmax);
     assert_true((cg_auto - first_auto) * 4 < cg_bj - first_bj); /* steps 2 and 3 */
     free(a), free(b);
+}
+
+/* auto's solve on a preconditioner past SPN__IMPLICIT_BJ_MAX iterations is
+ * left alone: the block-Jacobi hand-over at the 101st iteration is for a
+ * solve on block Jacobi only. The 5,001-particle rings x radials web with
+ * its springs in one quadrant three times as stiff (out of balance: the
+ * cyclic preconditioner, exact for the rings' average, needs over a
+ * hundred iterations by the fifth step of 1e-4 s) takes the same CG
+ * counts and bits under auto as under the cyclic preconditioner asked
+ * for. Until 8c82767, auto restarted such a solve at its 101st iteration
+ * (150 and 178 iterations at the last two steps against 144 and 170). */
+static void test_auto_long_solve_on_a_preconditioner(void **state)
+{
+    (void)state;
+    spn_world_def wd = spn_world_def_default();
+    wd.integrator = SPN_INTEGRATOR_IMPLICIT;
+    spn_orb_scene_def od = spn_orb_scene_def_default();
+    od.rings = 40, od.radials = 125;
+    spn_world *w = NULL;
+    assert_int_equal(spn_scene_orb(&wd, &od, &w), SPN_OK);
+    assert_int_equal(spn_world_set_solver_tolerance(w, 1e-10, 1000), SPN_OK);
+    for (uint32_t s = 0, ns = spn_world_spring_count(w); s < ns; s++) {
+        const spn_spring_info sp = spn_world_spring(w, s);
+        const spn_vec3 a = spn_world_position(w, sp.a);
+        if (a.x > 0 && a.y > 0) assert_int_equal(spn_world_set_spring_stiffness(w, s, 3 * sp.k, sp.kd), SPN_OK);
+    }
+    spn_world *ref = spn_world_clone(w);
+    assert_non_null(ref);
+    assert_int_equal(spn_world_set_implicit_preconditioner(w, SPN_PRECOND_AUTO), SPN_OK);
+    assert_int_equal(spn_world_set_implicit_preconditioner(ref, SPN_PRECOND_CYCLIC), SPN_OK);
+    const uint32_t n = spn_world_particle_count(w);
+    int longest = 0;
+    for (int i = 0; i < 6; i++) {
+        assert_int_equal(spn_world_step(w, 1e-4), SPN_OK);
+        assert_int_equal(spn_world_step(ref, 1e-4), SPN_OK);
+        const int cg = spn_world_last_step(w).cg_iterations;
+        print_message("step %d: CG %d under auto, %d cyclic\n", i + 1, cg, spn_world_last_step(ref).cg_iterations);
+        assert_int_equal(cg, spn_world_last_step(ref).cg_iterations);
+        assert_memory_equal(spn_world_positions(w), spn_world_positions(ref), n * sizeof(spn_vec3));
+        assert_memory_equal(spn_world_velocities(w), spn_world_velocities(ref), n * sizeof(spn_vec3));
+        if (cg > longest) longest = cg;
+    }
+    assert_true(longest > SPN__IMPLICIT_BJ_MAX + 1); /* the case is reached */
+    assert_true(longest < 1000);                     /* and the solves finish */
+    spn_world_destroy(w), spn_world_destroy(ref);
 }
 
 /* The same rule on a web under SPN__IMPLICIT_MG_MIN particles, which auto
@@ -659,6 +706,7 @@ int main(void)
         cmocka_unit_test(test_refused),
         cmocka_unit_test(test_cyclic_matches_block_jacobi),
         cmocka_unit_test(test_auto_at_short_steps),
+        cmocka_unit_test(test_auto_long_solve_on_a_preconditioner),
         cmocka_unit_test(test_auto_on_a_small_web),
         cmocka_unit_test(test_factor_on_a_small_web),
         cmocka_unit_test(test_factor_hold),
