@@ -434,32 +434,29 @@ static air_cell cell_of(const spn_air_field *air, spn_vec3 p)
 
 static double lerp(double a, double b, double f) { return a + (b - a) * f; }
 
-/* Trilinear interpolation of eight corner values q in a cell (fractions fr). */
-static double trilinear(const double q[8], const double fr[3])
-{
-    const double x00 = lerp(q[0], q[1], fr[0]), x10 = lerp(q[2], q[3], fr[0]);
-    const double x01 = lerp(q[4], q[5], fr[0]), x11 = lerp(q[6], q[7], fr[0]);
-    return lerp(lerp(x00, x10, fr[1]), lerp(x01, x11, fr[1]), fr[2]);
-}
-
-/* Slices a and b interpolated in a cell, then linearly between them by f,
- * component by component on plain doubles (as spn_vec3 temporaries they
- * went through the stack: 48 ns a sample). */
+/* Slices a and b interpolated in a cell (trilinear: along x, then y, then
+ * z), then linearly between them by f, component by component on plain
+ * doubles read straight from the slices. (As spn_vec3 temporaries they
+ * went through the stack: 48 ns a sample; gathered first into an array of
+ * 48 numbers, 36 ns on the Araneus web's segments; so, 29. Zen 5.) */
+_Static_assert(sizeof(spn_vec3) == 3 * sizeof(double), "interpolate2 reads a slice's nodes as numbers");
 static spn_vec3 interpolate2(const spn_air_field *air, const air_slice *a, const air_slice *b, double f,
                              const air_cell *cl)
 {
     const size_t sx = 1, sy = (size_t)air->n[0], sz = sy * (size_t)air->n[1];
     const size_t at[8] = {0, sx, sy, sy + sx, sz, sz + sx, sz + sy, sz + sy + sx};
-    double q[2][3][8];
-    for (int k = 0; k < 2; k++) {
-        const spn_vec3 *u = (k ? b : a)->u + cl->base;
-        for (int j = 0; j < 8; j++) {
-            const spn_vec3 c = u[at[j]];
-            q[k][0][j] = c.x, q[k][1][j] = c.y, q[k][2][j] = c.z;
-        }
-    }
     double out[3];
-    for (int c = 0; c < 3; c++) out[c] = lerp(trilinear(q[0][c], cl->fr), trilinear(q[1][c], cl->fr), f);
+    for (int c = 0; c < 3; c++) {
+        double in[2];
+        for (int k = 0; k < 2; k++) {
+            const double *u = (const double *)((k ? b : a)->u + cl->base) + c;
+            const double fx = cl->fr[0];
+            const double x00 = lerp(u[3 * at[0]], u[3 * at[1]], fx), x10 = lerp(u[3 * at[2]], u[3 * at[3]], fx);
+            const double x01 = lerp(u[3 * at[4]], u[3 * at[5]], fx), x11 = lerp(u[3 * at[6]], u[3 * at[7]], fx);
+            in[k] = lerp(lerp(x00, x10, cl->fr[1]), lerp(x01, x11, cl->fr[1]), cl->fr[2]);
+        }
+        out[c] = lerp(in[0], in[1], f);
+    }
     return spn_v3(out[0], out[1], out[2]);
 }
 
