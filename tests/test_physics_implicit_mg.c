@@ -137,18 +137,27 @@ static void test_cyclic_matches_block_jacobi(void **state)
  * (SPN__IMPLICIT_BJ_MAX), and the factor's from there on, the steps after
  * it too (a web this small is factorised instead of given the V-cycle).
  * `broken`: break spring 1200 first; `steps` steps of dt. */
-/* web_steps below; `held`: a 0.2 g body pressing on spring 600 by a contact. */
-static spn_vec3 *web_steps_held(int rings, int radials, spn_precond pc, bool broken, bool held, double dt, int steps,
-                                long *cg)
+/* A rings x radials web on the implicit solver, flat, CG to 1e-10
+ * (threads: spn_world_def.threads). */
+static spn_world *orb_web(int rings, int radials, int threads)
 {
     spn_world_def wd = spn_world_def_default();
     wd.integrator = SPN_INTEGRATOR_IMPLICIT;
+    wd.threads = threads;
     spn_orb_scene_def od = spn_orb_scene_def_default();
     od.rings = rings, od.radials = radials;
     spn_world *w = NULL;
     assert_int_equal(spn_scene_orb(&wd, &od, &w), SPN_OK);
-    assert_int_equal(spn_world_set_implicit_preconditioner(w, pc), SPN_OK);
     assert_int_equal(spn_world_set_solver_tolerance(w, 1e-10, 1000), SPN_OK);
+    return w;
+}
+
+/* web_steps below; `held`: a 0.2 g body pressing on spring 600 by a contact. */
+static spn_vec3 *web_steps_held(int rings, int radials, spn_precond pc, bool broken, bool held, double dt, int steps,
+                                long *cg)
+{
+    spn_world *w = orb_web(rings, radials, 0);
+    assert_int_equal(spn_world_set_implicit_preconditioner(w, pc), SPN_OK);
     if (broken) spn_world_break_spring(w, 1200);
     if (held) hold_body(w, 600, spn_v3(0, 0, 0));
     *cg = 0;
@@ -230,13 +239,7 @@ static void test_auto_at_short_steps(void **state)
 static void test_auto_long_solve_on_a_preconditioner(void **state)
 {
     (void)state;
-    spn_world_def wd = spn_world_def_default();
-    wd.integrator = SPN_INTEGRATOR_IMPLICIT;
-    spn_orb_scene_def od = spn_orb_scene_def_default();
-    od.rings = 40, od.radials = 125;
-    spn_world *w = NULL;
-    assert_int_equal(spn_scene_orb(&wd, &od, &w), SPN_OK);
-    assert_int_equal(spn_world_set_solver_tolerance(w, 1e-10, 1000), SPN_OK);
+    spn_world *w = orb_web(40, 125, 0);
     for (uint32_t s = 0, ns = spn_world_spring_count(w); s < ns; s++) {
         const spn_spring_info sp = spn_world_spring(w, s);
         const spn_vec3 a = spn_world_position(w, sp.a);
@@ -346,14 +349,7 @@ enum { FACTOR_STEPS = 24, FACTOR_AFTER = 3 };
  * is no lattice), CG to 1e-10. */
 static spn_world *broken_web(int threads)
 {
-    spn_world_def wd = spn_world_def_default();
-    wd.integrator = SPN_INTEGRATOR_IMPLICIT;
-    wd.threads = threads;
-    spn_orb_scene_def od = spn_orb_scene_def_default();
-    od.rings = 20, od.radials = 60;
-    spn_world *w = NULL;
-    assert_int_equal(spn_scene_orb(&wd, &od, &w), SPN_OK);
-    assert_int_equal(spn_world_set_solver_tolerance(w, 1e-10, 1000), SPN_OK);
+    spn_world *w = orb_web(20, 60, threads);
     spn_world_break_spring(w, 1200);
     return w;
 }
