@@ -227,6 +227,34 @@ static void test_auto_at_short_steps(void **state)
     free(a), free(b);
 }
 
+/* w refused as `which` says (spn__imp_mg_refuse_setup; 0: nothing) and its
+ * clone given preconditioner pc take `steps` steps of dt: the same
+ * iterations and bits at every step (the refused preconditioners fall back
+ * in the order cyclic, V-cycle, block Jacobi, and each fallback is what
+ * asking for it gives). Returns the most CG iterations a step took. */
+static long same_steps(spn_world *w, unsigned which, spn_precond pc, double dt, int steps)
+{
+    spn_world *ref = spn_world_clone(w);
+    assert_non_null(ref);
+    assert_int_equal(spn_world_set_implicit_preconditioner(ref, pc), SPN_OK);
+    spn__imp_mg_refuse_setup(w, which);
+    const uint32_t n = spn_world_particle_count(w);
+    long cg = 0, longest = 0;
+    for (int i = 0; i < steps; i++) {
+        assert_int_equal(spn_world_step(w, dt), SPN_OK);
+        assert_int_equal(spn_world_step(ref, dt), SPN_OK);
+        assert_int_equal(spn_world_last_step(w).cg_iterations, spn_world_last_step(ref).cg_iterations);
+        assert_memory_equal(spn_world_positions(w), spn_world_positions(ref), n * sizeof(spn_vec3));
+        assert_memory_equal(spn_world_velocities(w), spn_world_velocities(ref), n * sizeof(spn_vec3));
+        cg += spn_world_last_step(w).cg_iterations;
+        if (spn_world_last_step(w).cg_iterations > longest) longest = spn_world_last_step(w).cg_iterations;
+    }
+    print_message("refused %u: %d steps as %s's, CG %ld, at most %ld a step\n", which, steps, spn_precond_name(pc), cg,
+                  longest);
+    spn_world_destroy(w), spn_world_destroy(ref);
+    return longest;
+}
+
 /* auto's solve on a preconditioner past SPN__IMPLICIT_BJ_MAX iterations is
  * left alone: the block-Jacobi hand-over at the 101st iteration is for a
  * solve on block Jacobi only. The 5,001-particle rings x radials web with
@@ -245,25 +273,10 @@ static void test_auto_long_solve_on_a_preconditioner(void **state)
         const spn_vec3 a = spn_world_position(w, sp.a);
         if (a.x > 0 && a.y > 0) assert_int_equal(spn_world_set_spring_stiffness(w, s, 3 * sp.k, sp.kd), SPN_OK);
     }
-    spn_world *ref = spn_world_clone(w);
-    assert_non_null(ref);
     assert_int_equal(spn_world_set_implicit_preconditioner(w, SPN_PRECOND_AUTO), SPN_OK);
-    assert_int_equal(spn_world_set_implicit_preconditioner(ref, SPN_PRECOND_CYCLIC), SPN_OK);
-    const uint32_t n = spn_world_particle_count(w);
-    int longest = 0;
-    for (int i = 0; i < 6; i++) {
-        assert_int_equal(spn_world_step(w, 1e-4), SPN_OK);
-        assert_int_equal(spn_world_step(ref, 1e-4), SPN_OK);
-        const int cg = spn_world_last_step(w).cg_iterations;
-        print_message("step %d: CG %d under auto, %d cyclic\n", i + 1, cg, spn_world_last_step(ref).cg_iterations);
-        assert_int_equal(cg, spn_world_last_step(ref).cg_iterations);
-        assert_memory_equal(spn_world_positions(w), spn_world_positions(ref), n * sizeof(spn_vec3));
-        assert_memory_equal(spn_world_velocities(w), spn_world_velocities(ref), n * sizeof(spn_vec3));
-        if (cg > longest) longest = cg;
-    }
+    const long longest = same_steps(w, 0, SPN_PRECOND_CYCLIC, 1e-4, 6);
     assert_true(longest > SPN__IMPLICIT_BJ_MAX + 1); /* the case is reached */
     assert_true(longest < 1000);                     /* and the solves finish */
-    spn_world_destroy(w), spn_world_destroy(ref);
 }
 
 /* The same rule on a web under SPN__IMPLICIT_MG_MIN particles, which auto
@@ -612,30 +625,6 @@ static void test_factor_refused_at_a_step(void **state)
         assert_true(e.dv <= 1e-6 * e.vmax);
     }
     spn_world_destroy(w);
-}
-
-/* w refused as `which` says (spn__imp_mg_refuse_setup) and its clone given
- * preconditioner pc take `steps` steps of dt: the same iterations and bits
- * at every step (the refused preconditioners fall back in the order cyclic,
- * V-cycle, block Jacobi, and each fallback is what asking for it gives). */
-static void same_steps(spn_world *w, unsigned which, spn_precond pc, double dt, int steps)
-{
-    spn_world *ref = spn_world_clone(w);
-    assert_non_null(ref);
-    assert_int_equal(spn_world_set_implicit_preconditioner(ref, pc), SPN_OK);
-    spn__imp_mg_refuse_setup(w, which);
-    const uint32_t n = spn_world_particle_count(w);
-    long cg = 0;
-    for (int i = 0; i < steps; i++) {
-        assert_int_equal(spn_world_step(w, dt), SPN_OK);
-        assert_int_equal(spn_world_step(ref, dt), SPN_OK);
-        assert_int_equal(spn_world_last_step(w).cg_iterations, spn_world_last_step(ref).cg_iterations);
-        assert_memory_equal(spn_world_positions(w), spn_world_positions(ref), n * sizeof(spn_vec3));
-        assert_memory_equal(spn_world_velocities(w), spn_world_velocities(ref), n * sizeof(spn_vec3));
-        cg += spn_world_last_step(w).cg_iterations;
-    }
-    print_message("refused %u: %d steps as %s's, CG %ld\n", which, steps, spn_precond_name(pc), cg);
-    spn_world_destroy(w), spn_world_destroy(ref);
 }
 
 /* The preconditioners that can refuse a step's matrix, refused by force
