@@ -2,7 +2,9 @@
  * - fill: one time slice of the air field's cached grid (spn_air_prepare),
  *   the grid the animation runner makes at most (48^3 nodes) and a small
  *   one, 64 modes: milliseconds of CPU a slice;
- * - sample: spn_air_sample at points inside the grid, ns a call;
+ * - sample: spn_air_sample at random points inside the grid, ns a call;
+ *   sample_batch: spn_air_sample_batch at the same points, 512 a call (as a
+ *   world takes them), ns a point;
  * - web: a species web (Araneus, seed 1; 1,924 particles) animated for
  *   0.2 s on the implicit solver (its 2 ms substeps), in still air and in
  *   the default wind (`spinneret animate web.json --solver implicit
@@ -50,21 +52,35 @@ static void bench_fill(int n, double load)
     double cpu = bench_cpu_now() - c0;
     printf("{\"bench\":\"air\",\"case\":\"fill\",\"nodes\":%d,\"modes\":64,\"ms_per_slice\":%.3f,\"load\":%.2f}\n",
            n * n * n, 1e3 * cpu / slices, load);
-    /* sampling inside the grid between two filled slices */
+    /* sampling inside the grid between two filled slices, at random points
+     * (drawn first), one call a point and then in batches of a world's run */
     spn_air_prepare(air, 3.2e-3, 3.2e-3);
     spn_rng rng;
     spn_rng_seed(&rng, 3);
-    enum { SAMPLES = 1 << 20 };
-    spn_vec3 sum = spn_v3(0, 0, 0);
-    c0 = bench_cpu_now();
-    for (int i = 0; i < SAMPLES; i++) {
+    enum { POINTS = 1 << 14, ROUNDS = 64, RUN = 512 };
+    spn_vec3 *p = malloc(POINTS * sizeof *p), *u = malloc(POINTS * sizeof *u);
+    if (!p || !u) fail("points");
+    for (int i = 0; i < POINTS; i++) {
         const double x = spn_rng_range(&rng, -0.5, 0.5), y = spn_rng_range(&rng, -0.5, 0.5);
-        const spn_vec3 p = spn_v3(x, y, spn_rng_range(&rng, -0.5, 0.5));
-        sum = spn_v3_add(sum, spn_air_sample(air, 3.2e-3, p));
+        p[i] = spn_v3(x, y, spn_rng_range(&rng, -0.5, 0.5));
     }
-    cpu = bench_cpu_now() - c0;
-    printf("{\"bench\":\"air\",\"case\":\"sample\",\"nodes\":%d,\"ns_per_sample\":%.1f,\"check\":%.3g,\"load\":%.2f}\n",
-           n * n * n, 1e9 * cpu / SAMPLES, sum.x + sum.y + sum.z, load);
+    for (int batch = 0; batch < 2; batch++) {
+        spn_vec3 sum = spn_v3(0, 0, 0);
+        c0 = bench_cpu_now();
+        for (int r = 0; r < ROUNDS; r++) {
+            if (batch)
+                for (int i = 0; i < POINTS; i += RUN) spn_air_sample_batch(air, 3.2e-3, p + i, u + i, RUN);
+            else
+                for (int i = 0; i < POINTS; i++) u[i] = spn_air_sample(air, 3.2e-3, p[i]);
+            sum = spn_v3_add(sum, u[r]);
+        }
+        cpu = bench_cpu_now() - c0;
+        printf("{\"bench\":\"air\",\"case\":\"%s\",\"nodes\":%d,\"ns_per_sample\":%.1f,\"check\":%.3g,"
+               "\"load\":%.2f}\n",
+               batch ? "sample_batch" : "sample", n * n * n, 1e9 * cpu / ((double)POINTS * ROUNDS),
+               sum.x + sum.y + sum.z, load);
+    }
+    free(p), free(u);
     spn_air_destroy(air);
 }
 

@@ -183,13 +183,76 @@ static void test_turbulence_statistics(void **state)
     spn_air_destroy(air);
 }
 
+/* n points of spn_air_sample_batch against spn_air_sample, bit for bit,
+ * each run of `runs` lengths starting where the last ended (so the vector
+ * loop's tails and starts fall everywhere). */
+static void same_as_samples(spn_air_field *air, double t, const spn_vec3 *p, size_t n)
+{
+    spn_vec3 *out = malloc(n * sizeof *out);
+    assert_non_null(out);
+    static const size_t runs[] = {1, 7, 8, 9, 0, 3, 16, 33, 5, 64, 2};
+    for (size_t at = 0, r = 0; at < n; r++) {
+        size_t len = runs[r % (sizeof runs / sizeof *runs)];
+        if (len > n - at) len = n - at;
+        spn_air_sample_batch(air, t, p + at, out + at, len);
+        at += len;
+    }
+    for (size_t i = 0; i < n; i++) {
+        const spn_vec3 one = spn_air_sample(air, t, p[i]);
+        if (memcmp(&one, &out[i], sizeof one) != 0)
+            fail_msg("t %.17g, point %zu (%g, %g, %g): batch (%.17g, %.17g, %.17g) against (%.17g, %.17g, %.17g)", t, i,
+                     p[i].x, p[i].y, p[i].z, out[i].x, out[i].y, out[i].z, one.x, one.y, one.z);
+    }
+    free(out);
+}
+
+/* spn_air_sample_batch is spn_air_sample point by point, to the bit: on the
+ * grid at the prepared times (a step's start, end and midpoint) and at
+ * another time between its slices, at points inside the box, outside it
+ * (clamped), on its faces and NaN; and exact (no grid, or a time whose
+ * slices are not ready), where both evaluate the field itself. */
+static void test_batch_samples_same_bits(void **state)
+{
+    (void)state;
+    spn_air_def d = spn_air_def_default();
+    d.speed = 2;
+    d.turbulence = 0.3;
+    spn_air_field *air;
+    assert_int_equal(spn_air_create(&d, &air), SPN_OK);
+    enum { N = 3000 };
+    spn_vec3 *p = malloc(N * sizeof *p);
+    assert_non_null(p);
+    spn_rng rng;
+    spn_rng_seed(&rng, 11);
+    const spn_vec3 lo = spn_v3(-0.3, -0.25, -0.1), hi = spn_v3(0.3, 0.25, 0.12);
+    for (int i = 0; i < N; i++) { /* most inside, some up to half the box beyond it */
+        const double s = i % 5 ? 1.0 : 2.0;
+        p[i] = spn_v3(s * spn_rng_range(&rng, lo.x, hi.x), s * spn_rng_range(&rng, lo.y, hi.y),
+                      s * spn_rng_range(&rng, lo.z, hi.z));
+    }
+    p[0] = lo, p[1] = hi, p[2] = spn_v3(hi.x, lo.y, hi.z), p[3] = spn_v3(NAN, 0, 0), p[4] = spn_v3(0, NAN, NAN);
+    p[5] = spn_v3(INFINITY, -INFINITY, 0);
+    same_as_samples(air, 1.0, p, 40); /* no grid: the field itself */
+    assert_int_equal(spn_air_set_grid(air, lo, hi, 17, 13, 9, 5e-3), SPN_OK);
+    const double t0 = 1.0, t1 = 1.0 + 7e-3;
+    assert_int_equal(spn_air_prepare(air, t0, t1), SPN_OK);
+    const double times[4] = {t0, t1, 0.5 * (t0 + t1), t0 + 0.3 * (t1 - t0)};
+    for (int k = 0; k < 4; k++) same_as_samples(air, times[k], p, N);
+    same_as_samples(air, 50.0, p, 40); /* slices not ready: the field itself */
+    printf("# %d points at 4 times on a 17 x 13 x 9 grid, and exact: the batch gives the samples' bits\n", N);
+    free(p);
+    spn_air_destroy(air);
+}
+
 /* A web in turbulent air stepped on 1 and 2 threads: the samples of a
  * pure air function (spn_air_attach declares spn_air_sample so) are taken
  * on the world's threads, and the states are the same bits as on one
- * thread and as with the samples taken serially; the air moved the web.
- * The spring pass takes threads for 800 segments in air here (parallel_min
- * 1,024 with the air's weight of 8). `speed` 0: still air. */
-static double *air_run(int threads, bool pure, double speed, uint32_t *n)
+ * thread, as with the samples taken serially, and as with one call of the
+ * air function a segment instead of its batch (`batch` false); the air
+ * moved the web. The spring pass takes threads for 800 segments in air
+ * here (parallel_min 1,024 with the air's weight of 8). `speed` 0: still
+ * air. */
+static double *air_run(int threads, bool pure, bool batch, double speed, uint32_t *n)
 {
     spn_world_def wd = spn_world_def_default();
     wd.threads = threads;
@@ -206,6 +269,7 @@ static double *air_run(int threads, bool pure, double speed, uint32_t *n)
                      SPN_OK);
     spn_air_attach(air, w);
     if (!pure) spn_world_set_air_pure(w, false);
+    if (!batch) spn_world_set_air_batch(w, NULL);
     const double dt = 0.5 * spn_world_stable_step(w, 0);
     for (int i = 0; i < 300; i++) {
         const double t = spn_world_time(w);
@@ -228,16 +292,19 @@ static void test_air_on_threads(void **state)
 {
     (void)state;
     uint32_t n;
-    double *one = air_run(1, true, 3, &n), *two = air_run(2, true, 3, &n), *serial = air_run(2, false, 3, &n),
-           *still = air_run(2, true, 0, &n);
+    double *one = air_run(1, true, true, 3, &n), *two = air_run(2, true, true, 3, &n),
+           *serial = air_run(2, false, true, 3, &n), *points = air_run(2, true, false, 3, &n),
+           *still = air_run(2, true, true, 0, &n);
     const size_t bytes = 6 * (size_t)n * sizeof *one;
     assert_memory_equal(one, two, bytes);
     assert_memory_equal(two, serial, bytes);
+    assert_memory_equal(two, points, bytes);
     double moved = 0;
     for (size_t i = 0; i < 6 * (size_t)n; i++) moved = fmax(moved, fabs(one[i] - still[i]));
-    printf("# air on 1 and 2 threads: same bits; largest change the air made %.3g\n", moved);
+    printf("# air on 1 and 2 threads, in batches and point by point: same bits; largest change the air made %.3g\n",
+           moved);
     assert_true(moved > 0);
-    free(one), free(two), free(serial), free(still);
+    free(one), free(two), free(serial), free(points), free(still);
 }
 
 static void test_rejects_bad_air(void **state)
@@ -263,6 +330,7 @@ int main(void)
         cmocka_unit_test(test_segment_drag_formula),
         cmocka_unit_test(test_web_billows_with_speed),
         cmocka_unit_test(test_turbulence_statistics),
+        cmocka_unit_test(test_batch_samples_same_bits),
         cmocka_unit_test(test_air_on_threads),
         cmocka_unit_test(test_rejects_bad_air),
     };

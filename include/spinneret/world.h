@@ -288,6 +288,16 @@ SPN_API void spn_world_set_air(spn_world *w, spn_air_fn fn, void *user, double r
 /// a spring: the spring pass takes threads from parallel_min / 8 segments
 /// with air). Same results on any thread count. spn_world_set_air clears it.
 SPN_API void spn_world_set_air_pure(spn_world *w, bool pure);
+/// The air at many points at once: out[i] the air velocity at position[i],
+/// i < n, at time t.
+typedef void (*spn_air_batch_fn)(void *user, double t, const spn_vec3 *position, spn_vec3 *out, size_t n);
+/// Optional, beside the air function (same user pointer): one that samples
+/// many points in a call, giving at each what the air function gives there,
+/// bit for bit (spn_air_sample_batch is spn_air_sample's, and spn_air_attach
+/// sets it). The world then takes its samples through it, a run of tagged
+/// segments at a time (from several threads when pure). NULL: one call per
+/// segment. spn_world_set_air clears it.
+SPN_API void spn_world_set_air_batch(spn_world *w, spn_air_batch_fn fn);
 /// The air function (NULL: still air); its user pointer, rho and mu into the
 /// arguments that are not NULL (rho 1.204, mu 1.81e-5 until set).
 SPN_API spn_air_fn spn_world_air(const spn_world *w, void **user, double *rho, double *mu);

@@ -78,6 +78,17 @@ static spn_vec3 runner_air(void *user, double t, spn_vec3 p)
     return spn_air_sample(r->air, t, p);
 }
 
+static void runner_air_batch(void *user, double t, const spn_vec3 *p, spn_vec3 *out, size_t n)
+{
+    runner *r = user;
+    if (r->def.wind_stop >= 0 && t >= r->def.wind_stop) {
+        for (size_t i = 0; i < n; i++)
+            out[i] = spn_v3(0, 0, 0);
+        return;
+    }
+    spn_air_sample_batch(r->air, t, p, out, n);
+}
+
 static spn_status check_def(const spn_anim_def *d)
 {
     if (!(d->duration >= 0) || !(d->duration <= 1e5)) return spn_error(SPN_ERR_INVALID, "duration must be in [0, 1e5] s");
@@ -128,6 +139,7 @@ static spn_status make_air(runner *r, spn_world *w)
     if (st != SPN_OK) return st;
     spn_air_attach(r->air, w);
     spn_world_set_air(w, runner_air, r, ad.rho, ad.mu);
+    spn_world_set_air_batch(w, runner_air_batch);
     spn_world_set_air_pure(w, true); /* as spn_air_sample */
     if (r->impact && spn__world_applies_air()) spn_impact_track_air(r->impact, runner_air, r, ad.rho, ad.mu);
     return SPN_OK;

@@ -460,22 +460,80 @@ static spn_vec3 interpolate2(const spn_air_field *air, const air_slice *a, const
     return spn_v3(out[0], out[1], out[2]);
 }
 
+/* Time t as a sample takes it: one of the prepared times, or found now. */
+static air_time sample_time(const spn_air_field *air, double t)
+{
+    for (int i = 0; i < 3; i++)
+        if (air->times[i].t == t) return air->times[i];
+    return time_of(air, t);
+}
+
 spn_vec3 spn_air_sample(void *user, double t, spn_vec3 p)
 {
     const spn_air_field *air = user;
     if (!air->grid) return spn_air_velocity(air, t, p);
-    const air_time *k = NULL;
-    for (int i = 0; i < 3 && !k; i++)
-        if (air->times[i].t == t) k = &air->times[i];
-    const air_time at = k ? *k : time_of(air, t);
+    const air_time at = sample_time(air, t);
     if (!at.a || !at.b) return spn_air_velocity(air, t, p);
     const air_cell cl = cell_of(air, p);
     return spn_v3_add(at.mean, interpolate2(air, at.a, at.b, at.f, &cl));
 }
 
+/* spn_air_sample at n points between the slices of `at`: cell_of and
+ * interpolate2 written for one point a loop pass, each of its operations
+ * in the same order, so that GCC vectorises the loop with the points in
+ * the lanes (the corners are gathered) and every version gives
+ * spn_air_sample's bits. Node indices are ints: a grid has at most 2^22
+ * nodes (spn_air_set_grid), 3 * 2^22 numbers. Points were 29-50 ns a sample
+ * one by one on the Zen 5 (the chains of a cell's lookups and of its 42
+ * linear interpolations, one point at a time); here they are 14 ns, eight
+ * at a time, at random points of a 48 x 48 x 30 grid. */
+SPN__KERNEL static void sample_points(const spn_air_field *air, const air_time *at, const spn_vec3 *restrict p,
+                                      spn_vec3 *restrict out, size_t n)
+{
+    const double *restrict A = (const double *)at->a->u, *restrict B = (const double *)at->b->u, f = at->f;
+    const spn_vec3 mean = at->mean;
+    const int nx = air->n[0], ny = air->n[1], nz = air->n[2];
+    const double lx = air->lo.x, ly = air->lo.y, lz = air->lo.z;
+    const double wx = air->hi.x - lx, wy = air->hi.y - ly, wz = air->hi.z - lz;
+    const int sy = 3 * nx, sz = 3 * nx * ny; /* (numbers from a node to the next along y and z) */
+    for (size_t i = 0; i < n; i++) {
+        /* cell_of, an axis at a time: NaN to 0, clamped to the box */
+        double gx = (p[i].x - lx) / wx * (nx - 1), gy = (p[i].y - ly) / wy * (ny - 1),
+               gz = (p[i].z - lz) / wz * (nz - 1);
+        gx = gx > 0 ? gx : 0, gy = gy > 0 ? gy : 0, gz = gz > 0 ? gz : 0;
+        gx = gx > nx - 1 ? nx - 1 : gx, gy = gy > ny - 1 ? ny - 1 : gy, gz = gz > nz - 1 ? nz - 1 : gz;
+        int ix = (int)gx, iy = (int)gy, iz = (int)gz;
+        ix = ix > nx - 2 ? nx - 2 : ix, iy = iy > ny - 2 ? ny - 2 : iy, iz = iz > nz - 2 ? nz - 2 : iz;
+        const double fx = gx - ix, fy = gy - iy, fz = gz - iz;
+        const int b = 3 * ix + sy * iy + sz * iz;
+        /* interpolate2, component c from the numbers at q (indices, not
+         * pointers, so that GCC sees the gathers) */
+#define AIR_LERP3(S, q)                                                                                                \
+    lerp(lerp(lerp(S[q], S[q + 3], fx), lerp(S[q + sy], S[q + sy + 3], fx), fy),                                       \
+         lerp(lerp(S[q + sz], S[q + sz + 3], fx), lerp(S[q + sz + sy], S[q + sz + sy + 3], fx), fy), fz)
+        const double ux = lerp(AIR_LERP3(A, b), AIR_LERP3(B, b), f);
+        const double uy = lerp(AIR_LERP3(A, b + 1), AIR_LERP3(B, b + 1), f);
+        const double uz = lerp(AIR_LERP3(A, b + 2), AIR_LERP3(B, b + 2), f);
+#undef AIR_LERP3
+        out[i].x = mean.x + ux, out[i].y = mean.y + uy, out[i].z = mean.z + uz;
+    }
+}
+
+void spn_air_sample_batch(void *user, double t, const spn_vec3 *p, spn_vec3 *out, size_t n)
+{
+    const spn_air_field *air = user;
+    const air_time at = air->grid ? sample_time(air, t) : (air_time){0};
+    if (!at.a || !at.b) {
+        for (size_t i = 0; i < n; i++) out[i] = spn_air_velocity(air, t, p[i]);
+        return;
+    }
+    sample_points(air, &at, p, out, n);
+}
+
 void spn_air_attach(spn_air_field *air, spn_world *w)
 {
     spn_world_set_air(w, spn_air_sample, air, air->def.rho, air->def.mu);
+    spn_world_set_air_batch(w, spn_air_sample_batch);
     spn_world_set_air_pure(w, true); /* sampling only reads the field */
     for (uint32_t tag = 0; tag < 64; tag++) {
         double d = spn_thread_diameter(tag);

@@ -113,19 +113,47 @@ static int pass_threads(const spn_world *w, uint32_t n, bool air)
     return spn__threads(w, air && n < UINT32_MAX / SPN__AIR_WEIGHT ? n * SPN__AIR_WEIGHT : n);
 }
 
+/* The midpoint of segment s. */
+static spn_vec3 midpoint(const spn_world *w, const spn_vec3 *x, uint32_t s)
+{
+    return spn_v3_scale(spn_v3_add(x[w->hs[s].a], x[spn__end_b(w->hs[s])]), 0.5);
+}
+
+/* Segments a batch air function samples in one call at most (a share of
+ * the threads' work, and the length of a run of midpoints in the cache). */
+#define SPN__AIR_RUN 512u
+
 /* Air velocity at each tagged segment's midpoint: serially in the internal
  * spring order, or, with a pure air function (spn_world_set_air_pure), on
- * `threads` threads (each segment's sample its own, so the same values). */
+ * `threads` threads (each segment's sample its own, so the same values).
+ * With a batch function (spn_world_set_air_batch), each run of tagged
+ * segments in a piece of SPN__AIR_RUN in one call, its midpoints first. */
 static void sample_air(spn_world *w, double t, const spn_vec3 *x, int threads)
 {
-    (void)threads; /* (used by the OpenMP pragma only) */
+    (void)threads; /* (used by the OpenMP pragmas only) */
     const uint32_t ns = w->ns;
+    if (w->air_batch) {
+        const uint32_t pieces = (ns + SPN__AIR_RUN - 1) / SPN__AIR_RUN;
 #pragma omp parallel for schedule(static) num_threads(threads) if (w->air_pure && threads > 1)
-    for (uint32_t s = 0; s < ns; s++) {
-        if (!(w->sdiam[s] > 0)) continue;
-        spn_vec3 mid = spn_v3_scale(spn_v3_add(x[w->hs[s].a], x[spn__end_b(w->hs[s])]), 0.5);
-        w->wind[s] = w->air_fn(w->air_user, t, mid);
+        for (uint32_t piece = 0; piece < pieces; piece++) {
+            const uint32_t end = piece * SPN__AIR_RUN + SPN__AIR_RUN < ns ? piece * SPN__AIR_RUN + SPN__AIR_RUN : ns;
+            for (uint32_t lo = piece * SPN__AIR_RUN; lo < end;) {
+                if (!(w->sdiam[lo] > 0)) {
+                    lo++;
+                    continue;
+                }
+                uint32_t hi = lo;
+                for (; hi < end && w->sdiam[hi] > 0; hi++)
+                    w->mid[hi] = midpoint(w, x, hi);
+                w->air_batch(w->air_user, t, w->mid + lo, w->wind + lo, hi - lo);
+                lo = hi;
+            }
+        }
+        return;
     }
+#pragma omp parallel for schedule(static) num_threads(threads) if (w->air_pure && threads > 1)
+    for (uint32_t s = 0; s < ns; s++)
+        if (w->sdiam[s] > 0) w->wind[s] = w->air_fn(w->air_user, t, midpoint(w, x, s));
 }
 
 /* Springs [lo, hi): forces into fs, sums added to sums[0..2]. Compiled for

@@ -542,6 +542,7 @@ spn_collide_fn spn_world_collide_callback(const spn_world *w, void **user)
 void spn_world_set_air(spn_world *w, spn_air_fn fn, void *user, double rho, double mu)
 {
     w->air_fn = fn;
+    w->air_batch = NULL;
     w->air_user = user;
     w->air_rho = rho;
     w->air_mu = mu;
@@ -549,6 +550,8 @@ void spn_world_set_air(spn_world *w, spn_air_fn fn, void *user, double rho, doub
 }
 
 void spn_world_set_air_pure(spn_world *w, bool pure) { w->air_pure = pure; }
+
+void spn_world_set_air_batch(spn_world *w, spn_air_batch_fn fn) { w->air_batch = fn; }
 
 spn_air_fn spn_world_air(const spn_world *w, void **user, double *rho, double *mu)
 {

@@ -176,6 +176,7 @@ struct spn_world {
     spn_vec3 *tmp[SPN_TMP_COUNT]; /* per-particle scratch, allocated on demand */
     spn_vec3 *fair;       /* per-spring air force (on demand) */
     spn_vec3 *wind;       /* per-spring air velocity at the midpoint (on demand) */
+    spn_vec3 *mid;        /* per-spring midpoints, for a batch air function (air_batch) */
     double *cair;         /* per-spring linear air-drag coefficient (on demand) */
     spn__jac *jac;        /* implicit: per-spring Jacobian (on demand) */
     double *pinv;         /* implicit: per-particle inverse 3x3 block, 6 each (on demand) */
@@ -205,6 +206,7 @@ struct spn_world {
     spn_collide_fn collide_fn;
     void *collide_user;
     spn_air_fn air_fn;
+    spn_air_batch_fn air_batch; /* NULL: a call of air_fn a segment */
     void *air_user;
     double air_rho, air_mu;
     bool air_pure;      /* air_fn may be called from several threads (spn_world_set_air_pure) */
