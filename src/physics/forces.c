@@ -16,6 +16,7 @@
  * order, so it may keep state (a seeded gust generator, say). */
 #include "world_internal.h"
 #include "chunk.h"
+#include "core/kernel.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -97,34 +98,71 @@ double spn_cylinder_drag_coefficient(double re)
     return blend(ln_re / 0.69314718055994530942); /* (ln 2) */
 }
 
-/* Air force on segment s (both ends together) and its linear coefficient c
- * (F = c u_n), at the state (x, v) with air velocity w->wind[s]. */
-static spn_vec3 air_force(const spn_world *w, uint32_t s, const spn_vec3 *x, const spn_vec3 *v, double *c)
+/* Air forces on segments [lo, hi) (both ends together) and their linear
+ * coefficients c (F = c u_n), at the state (x, v) with air velocity
+ * w->wind[s], into w->fair and w->cair: the drag of docs/physics.md on the
+ * normal component u_n of the air relative to the segment's midpoint.
+ * Three passes over chunks of SPN_CHUNK, so that the first and the last
+ * vectorise: the geometry up to the Reynolds number, the drag coefficient
+ * (a library logarithm or power, one segment at a time), then the force.
+ * Each operation is the one-segment code's, in its order, so every
+ * version gives its bits; a segment without diameter, broken, of zero
+ * length or in still relative air gets exact zeros, selected after. One
+ * segment at a time (forty-ninth session and before) the chain of two
+ * square roots, a division and the drag law took some 20 ns a segment. */
+SPN__KERNEL static void air_forces(spn_world *w, uint32_t lo, uint32_t hi, const spn_vec3 *x, const spn_vec3 *v)
 {
-    const spn_vec3 zero = {0, 0, 0};
-    *c = 0;
-    const double d = w->sdiam[s];
-    if (!(d > 0) || (w->hflags[s] & SPN_SPRING_BROKEN)) return zero;
-    const uint32_t a = w->hs[s].a, b = spn__end_b(w->hs[s]);
-    const spn_vec3 l = spn_v3_sub(x[a], x[b]);
-    const double len = spn_v3_len(l);
-    if (!(len > 0)) return zero;
-    const spn_vec3 t = spn_v3_scale(l, 1 / len);
-    const spn_vec3 vm = spn_v3_scale(spn_v3_add(v[a], v[b]), 0.5);
-    const spn_vec3 u = spn_v3_sub(w->wind[s], vm);
-    const spn_vec3 un = spn_v3_sub(u, spn_v3_scale(t, spn_v3_dot(t, u)));
-    const double speed = spn_v3_len(un);
-    if (!(speed > 0)) return zero;
-    const double re = w->air_rho * speed * d / w->air_mu;
-    *c = 0.5 * w->air_rho * spn_cylinder_drag_coefficient(re) * d * len * speed;
-    return spn_v3_scale(un, *c);
+    double re[SPN_CHUNK], len[SPN_CHUNK], speed[SPN_CHUNK], cd[SPN_CHUNK];
+    double ux[SPN_CHUNK], uy[SPN_CHUNK], uz[SPN_CHUNK];
+    const spn__spring *restrict hs = w->hs;
+    const double *restrict sdiam = w->sdiam;
+    const uint8_t *restrict hflags = w->hflags;
+    /* (as numbers, indexed: GCC vectorises the gathers of indexed numbers,
+     * not of a struct's members) */
+    const double *restrict X = (const double *)x, *restrict V = (const double *)v;
+    const double *restrict U = (const double *)w->wind;
+    double *restrict F = (double *)w->fair, *restrict cair = w->cair;
+    const double rho = w->air_rho, mu = w->air_mu;
+    for (uint32_t s0 = lo; s0 < hi; s0 += SPN_CHUNK) {
+        const uint32_t n = hi - s0 < SPN_CHUNK ? hi - s0 : SPN_CHUNK;
+        /* (the chunk's arrays from its first segment, so that j indexes them) */
+        const spn__spring *restrict h = hs + s0;
+        const double *restrict d = sdiam + s0, *restrict u = U + 3 * (size_t)s0;
+        const uint8_t *restrict fl = hflags + s0;
+        double *restrict f = F + 3 * (size_t)s0, *restrict c = cair + s0;
+        for (uint32_t j = 0; j < n; j++) {
+            const size_t a = 3 * (size_t)h[j].a, b = 3 * (size_t)spn__end_b(h[j]);
+            const double lx = X[a] - X[b], ly = X[a + 1] - X[b + 1], lz = X[a + 2] - X[b + 2];
+            const double l = sqrt(lx * lx + ly * ly + lz * lz), inv = 1 / l;
+            const double tx = lx * inv, ty = ly * inv, tz = lz * inv;
+            const double vx = (V[a] + V[b]) * 0.5, vy = (V[a + 1] + V[b + 1]) * 0.5, vz = (V[a + 2] + V[b + 2]) * 0.5;
+            const double wx = u[3 * j] - vx, wy = u[3 * j + 1] - vy, wz = u[3 * j + 2] - vz;
+            const double along = tx * wx + ty * wy + tz * wz;
+            const double nx = wx - tx * along, ny = wy - ty * along, nz = wz - tz * along;
+            const double sp = sqrt(nx * nx + ny * ny + nz * nz);
+            const bool on = (d[j] > 0) & !(fl[j] & SPN_SPRING_BROKEN) & (l > 0) & (sp > 0); /* (no branches) */
+            re[j] = on ? rho * sp * d[j] / mu : -1;                                         /* (-1: off) */
+            len[j] = l, speed[j] = sp, ux[j] = nx, uy[j] = ny, uz[j] = nz;
+        }
+        for (uint32_t j = 0; j < n; j++)
+            cd[j] = re[j] >= 0 ? spn_cylinder_drag_coefficient(re[j]) : 0;
+        for (uint32_t j = 0; j < n; j++) {
+            const bool on = re[j] >= 0;
+            const double cj = 0.5 * rho * cd[j] * d[j] * len[j] * speed[j];
+            c[j] = on ? cj : 0;
+            f[3 * j] = on ? ux[j] * cj : 0, f[3 * j + 1] = on ? uy[j] * cj : 0, f[3 * j + 2] = on ? uz[j] * cj : 0;
+        }
+    }
 }
 
 /* A segment in air costs the spring pass about this many springs: its
  * sample of the air (40-90 ns with spn_air_sample) and drag law (a
  * logarithm or more) against 5-10 ns for the spring (bench/bench_air.c:
  * 90 against 11 ns a spring-step, Zen 5). So with air the pass takes
- * threads from parallel_min / SPN__AIR_WEIGHT segments. */
+ * threads from parallel_min / SPN__AIR_WEIGHT segments. (Since the
+ * fiftieth session, with the samples in batches and air_forces, about 47
+ * against 11: a weight of 4 would do, but 8 was left, which only moves
+ * where webs of 4,096 to 8,192 segments take threads; not measured.) */
 #define SPN__AIR_WEIGHT 8u
 
 /* Threads for the spring pass of n springs, air included or not. */
@@ -207,7 +245,7 @@ void spn__spring_pass(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 
         spring_range(hs, lo, hi, x, v, fs, sums);
         const double energy = sums[0], power = sums[1];
         if (air)
-            for (uint32_t s = lo; s < hi; s++) w->fair[s] = air_force(w, s, x, v, &w->cair[s]);
+            air_forces(w, lo, hi, x, v);
         partial[(size_t)blk * SPN_NSUMS + 0] = energy;
         partial[(size_t)blk * SPN_NSUMS + 1] = power;
     }
