@@ -249,9 +249,8 @@ static void test_batch_samples_same_bits(void **state)
  * on the world's threads, and the states are the same bits as on one
  * thread, as with the samples taken serially, and as with one call of the
  * air function a segment instead of its batch (`batch` false); the air
- * moved the web. The spring pass takes threads for 800 segments in air
- * here (parallel_min 1,024 with the air's weight of 8). `speed` 0: still
- * air. */
+ * moved the web. The spring pass takes threads for its 1,600 segments here
+ * (parallel_min 1,024). `speed` 0: still air. */
 static double *air_run(int threads, bool pure, bool batch, double speed, uint32_t *n)
 {
     spn_world_def wd = spn_world_def_default();

@@ -283,10 +283,9 @@ SPN_API void spn_world_set_air(spn_world *w, spn_air_fn fn, void *user, double r
 /// Declare the air function pure: its result depends on its arguments and on
 /// nothing it changes, so it may be called from several threads at once and
 /// in any order (spn_air_sample is; spn_air_attach declares it). The samples
-/// of a force evaluation are then taken on the world's threads once there are
-/// enough tagged segments (the air makes a segment several times dearer than
-/// a spring: the spring pass takes threads from parallel_min / 8 segments
-/// with air). Same results on any thread count. spn_world_set_air clears it.
+/// of a force evaluation are then taken on the world's threads when the
+/// spring pass takes them (from parallel_min segments). Same results on any
+/// thread count. spn_world_set_air clears it.
 SPN_API void spn_world_set_air_pure(spn_world *w, bool pure);
 /// The air at many points at once: out[i] the air velocity at position[i],
 /// i < n, at time t.

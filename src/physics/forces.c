@@ -155,22 +155,6 @@ SPN__KERNEL static void air_forces(spn_world *w, uint32_t lo, uint32_t hi, const
     }
 }
 
-/* A segment in air costs the spring pass about this many springs: its
- * sample of the air (40-90 ns with spn_air_sample) and drag law (a
- * logarithm or more) against 5-10 ns for the spring (bench/bench_air.c:
- * 90 against 11 ns a spring-step, Zen 5). So with air the pass takes
- * threads from parallel_min / SPN__AIR_WEIGHT segments. (Since the
- * fiftieth session, with the samples in batches and air_forces, about 47
- * against 11: a weight of 4 would do, but 8 was left, which only moves
- * where webs of 4,096 to 8,192 segments take threads; not measured.) */
-#define SPN__AIR_WEIGHT 8u
-
-/* Threads for the spring pass of n springs, air included or not. */
-static int pass_threads(const spn_world *w, uint32_t n, bool air)
-{
-    return spn__threads(w, air && n < UINT32_MAX / SPN__AIR_WEIGHT ? n * SPN__AIR_WEIGHT : n);
-}
-
 /* The midpoint of segment s. */
 static spn_vec3 midpoint(const spn_world *w, const spn_vec3 *x, uint32_t s)
 {
@@ -233,7 +217,11 @@ void spn__spring_pass(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 
 {
     const uint32_t ns = w->ns, nb = spn__blocks(ns);
     const bool air = spn__air_active(w);
-    const int threads = pass_threads(w, ns, air);
+    /* (threads as without air: until the fiftieth session a segment in air
+     * counted as 8 springs, its sample and drag law then some 80 ns against
+     * a spring's 10, so the pass took threads from parallel_min / 8
+     * segments; see docs/physics.md, "Air drag on threads") */
+    const int threads = spn__threads(w, ns);
     if (air) sample_air(w, t, x, threads);
     spn_vec3 *restrict fs = w->fs;
     const spn__spring *restrict hs = w->hs;
