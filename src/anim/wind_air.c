@@ -407,58 +407,7 @@ spn_status spn_air_prepare(spn_air_field *air, double t0, double t1)
     return SPN_OK;
 }
 
-/* A point's grid cell (clamped to the box): its first node and the
- * fractions along each axis. */
-typedef struct air_cell {
-    size_t base;
-    double fr[3];
-} air_cell;
-
-static air_cell cell_of(const spn_air_field *air, spn_vec3 p)
-{
-    double c[3] = {p.x, p.y, p.z}, lo[3] = {air->lo.x, air->lo.y, air->lo.z}, hi[3] = {air->hi.x, air->hi.y, air->hi.z};
-    air_cell cl;
-    int i0[3];
-    for (int a = 0; a < 3; a++) {
-        double g = (c[a] - lo[a]) / (hi[a] - lo[a]) * (air->n[a] - 1);
-        /* (fmax, fmin: NaN to 0) */
-        if (!(g > 0)) g = 0;
-        if (g > air->n[a] - 1) g = air->n[a] - 1;
-        i0[a] = (int)g;
-        if (i0[a] > air->n[a] - 2) i0[a] = air->n[a] - 2;
-        cl.fr[a] = g - i0[a];
-    }
-    cl.base = (size_t)i0[0] + (size_t)i0[1] * (size_t)air->n[0] + (size_t)i0[2] * (size_t)air->n[0] * (size_t)air->n[1];
-    return cl;
-}
-
 static double lerp(double a, double b, double f) { return a + (b - a) * f; }
-
-/* Slices a and b interpolated in a cell (trilinear: along x, then y, then
- * z), then linearly between them by f, component by component on plain
- * doubles read straight from the slices. (As spn_vec3 temporaries they
- * went through the stack: 48 ns a sample; gathered first into an array of
- * 48 numbers, 36 ns on the Araneus web's segments; so, 29. Zen 5.) */
-_Static_assert(sizeof(spn_vec3) == 3 * sizeof(double), "interpolate2 reads a slice's nodes as numbers");
-static spn_vec3 interpolate2(const spn_air_field *air, const air_slice *a, const air_slice *b, double f,
-                             const air_cell *cl)
-{
-    const size_t sx = 1, sy = (size_t)air->n[0], sz = sy * (size_t)air->n[1];
-    const size_t at[8] = {0, sx, sy, sy + sx, sz, sz + sx, sz + sy, sz + sy + sx};
-    double out[3];
-    for (int c = 0; c < 3; c++) {
-        double in[2];
-        for (int k = 0; k < 2; k++) {
-            const double *u = (const double *)((k ? b : a)->u + cl->base) + c;
-            const double fx = cl->fr[0];
-            const double x00 = lerp(u[3 * at[0]], u[3 * at[1]], fx), x10 = lerp(u[3 * at[2]], u[3 * at[3]], fx);
-            const double x01 = lerp(u[3 * at[4]], u[3 * at[5]], fx), x11 = lerp(u[3 * at[6]], u[3 * at[7]], fx);
-            in[k] = lerp(lerp(x00, x10, cl->fr[1]), lerp(x01, x11, cl->fr[1]), cl->fr[2]);
-        }
-        out[c] = lerp(in[0], in[1], f);
-    }
-    return spn_v3(out[0], out[1], out[2]);
-}
 
 /* Time t as a sample takes it: one of the prepared times, or found now. */
 static air_time sample_time(const spn_air_field *air, double t)
@@ -468,66 +417,91 @@ static air_time sample_time(const spn_air_field *air, double t)
     return time_of(air, t);
 }
 
-spn_vec3 spn_air_sample(void *user, double t, spn_vec3 p)
+/* What a sample between the slices of a time reads: the slices as
+ * numbers, the time's fraction between them and its mean wind, the grid. */
+typedef struct air_points {
+    const double *a, *b;
+    double f;
+    spn_vec3 mean;
+    int nx, ny, nz, sy, sz; /* (sy, sz: numbers from a node to the next along y and z) */
+    double lx, ly, lz, wx, wy, wz;
+} air_points;
+
+_Static_assert(sizeof(spn_vec3) == 3 * sizeof(double), "sample_at reads a slice's nodes as numbers");
+static air_points points_of(const spn_air_field *air, const air_time *at)
 {
-    const spn_air_field *air = user;
-    if (!air->grid) return spn_air_velocity(air, t, p);
-    const air_time at = sample_time(air, t);
-    if (!at.a || !at.b) return spn_air_velocity(air, t, p);
-    const air_cell cl = cell_of(air, p);
-    return spn_v3_add(at.mean, interpolate2(air, at.a, at.b, at.f, &cl));
+    const int nx = air->n[0], ny = air->n[1];
+    return (air_points){(const double *)at->a->u, (const double *)at->b->u, at->f, at->mean, nx, ny, air->n[2],
+                        3 * nx, 3 * nx * ny, air->lo.x, air->lo.y, air->lo.z, air->hi.x - air->lo.x,
+                        air->hi.y - air->lo.y, air->hi.z - air->lo.z};
 }
 
-/* spn_air_sample at n points between the slices of `at`: cell_of and
- * interpolate2 written for one point a loop pass, each of its operations
- * in the same order, so that GCC vectorises the loop with the points in
- * the lanes (the corners are gathered) and every version gives
- * spn_air_sample's bits. Node indices are ints: a grid has at most 2^22
- * nodes (spn_air_set_grid), 3 * 2^22 numbers. Points were 29-50 ns a sample
- * one by one on the Zen 5 (the chains of a cell's lookups and of its 42
- * linear interpolations, one point at a time); here they are 14 ns, eight
- * at a time, at random points of a 48 x 48 x 30 grid. */
-SPN__KERNEL static void sample_points(const spn_air_field *air, const air_time *at, const spn_vec3 *restrict p,
-                                      spn_vec3 *restrict out, size_t n)
+/* The field at *p into *out: p's grid cell (clamped to the box, NaN to
+ * its low corner), the two slices interpolated in it (trilinear: along x,
+ * then y, then z), then linearly between them by f, component by
+ * component, read straight from the slices, and the mean wind added. Node
+ * indices are ints: a grid has at most 2^22 nodes (spn_air_set_grid),
+ * 3 * 2^22 numbers. spn_air_sample takes one point and sample_points many,
+ * so the two give the same bits. On the Zen 5 (bench_air) a point alone
+ * takes 28 ns on a 16^3 grid (32-35 with the cell and the interpolation
+ * as functions of their own before the fiftieth session; 48 ns as spn_vec3
+ * temporaries through the stack, 36 gathered first into an array of 48
+ * numbers), in sample_points' lanes 14.5. */
+static inline __attribute__((always_inline)) void sample_at(const air_points *g, const spn_vec3 *p, spn_vec3 *out)
 {
-    const double *restrict A = (const double *)at->a->u, *restrict B = (const double *)at->b->u, f = at->f;
-    const spn_vec3 mean = at->mean;
-    const int nx = air->n[0], ny = air->n[1], nz = air->n[2];
-    const double lx = air->lo.x, ly = air->lo.y, lz = air->lo.z;
-    const double wx = air->hi.x - lx, wy = air->hi.y - ly, wz = air->hi.z - lz;
-    const int sy = 3 * nx, sz = 3 * nx * ny; /* (numbers from a node to the next along y and z) */
-    for (size_t i = 0; i < n; i++) {
-        /* cell_of, an axis at a time: NaN to 0, clamped to the box */
-        double gx = (p[i].x - lx) / wx * (nx - 1), gy = (p[i].y - ly) / wy * (ny - 1),
-               gz = (p[i].z - lz) / wz * (nz - 1);
-        gx = gx > 0 ? gx : 0, gy = gy > 0 ? gy : 0, gz = gz > 0 ? gz : 0;
-        gx = gx > nx - 1 ? nx - 1 : gx, gy = gy > ny - 1 ? ny - 1 : gy, gz = gz > nz - 1 ? nz - 1 : gz;
-        int ix = (int)gx, iy = (int)gy, iz = (int)gz;
-        ix = ix > nx - 2 ? nx - 2 : ix, iy = iy > ny - 2 ? ny - 2 : iy, iz = iz > nz - 2 ? nz - 2 : iz;
-        const double fx = gx - ix, fy = gy - iy, fz = gz - iz;
-        const int b = 3 * ix + sy * iy + sz * iz;
-        /* interpolate2, component c from the numbers at q (indices, not
-         * pointers, so that GCC sees the gathers) */
+    const int nx = g->nx, ny = g->ny, nz = g->nz, sy = g->sy, sz = g->sz;
+    double gx = (p->x - g->lx) / g->wx * (nx - 1), gy = (p->y - g->ly) / g->wy * (ny - 1),
+           gz = (p->z - g->lz) / g->wz * (nz - 1);
+    gx = gx > 0 ? gx : 0, gy = gy > 0 ? gy : 0, gz = gz > 0 ? gz : 0;
+    gx = gx > nx - 1 ? nx - 1 : gx, gy = gy > ny - 1 ? ny - 1 : gy, gz = gz > nz - 1 ? nz - 1 : gz;
+    int ix = (int)gx, iy = (int)gy, iz = (int)gz;
+    ix = ix > nx - 2 ? nx - 2 : ix, iy = iy > ny - 2 ? ny - 2 : iy, iz = iz > nz - 2 ? nz - 2 : iz;
+    const double fx = gx - ix, fy = gy - iy, fz = gz - iz;
+    const int b = 3 * ix + sy * iy + sz * iz;
+    const double *restrict A = g->a, *restrict B = g->b;
+    /* component c of the slice S from the numbers at q (indices, not
+     * pointers, so that GCC sees the gathers in sample_points) */
 #define AIR_LERP3(S, q)                                                                                                \
     lerp(lerp(lerp(S[q], S[q + 3], fx), lerp(S[q + sy], S[q + sy + 3], fx), fy),                                       \
          lerp(lerp(S[q + sz], S[q + sz + 3], fx), lerp(S[q + sz + sy], S[q + sz + sy + 3], fx), fy), fz)
-        const double ux = lerp(AIR_LERP3(A, b), AIR_LERP3(B, b), f);
-        const double uy = lerp(AIR_LERP3(A, b + 1), AIR_LERP3(B, b + 1), f);
-        const double uz = lerp(AIR_LERP3(A, b + 2), AIR_LERP3(B, b + 2), f);
+    const double ux = lerp(AIR_LERP3(A, b), AIR_LERP3(B, b), g->f);
+    const double uy = lerp(AIR_LERP3(A, b + 1), AIR_LERP3(B, b + 1), g->f);
+    const double uz = lerp(AIR_LERP3(A, b + 2), AIR_LERP3(B, b + 2), g->f);
 #undef AIR_LERP3
-        out[i].x = mean.x + ux, out[i].y = mean.y + uy, out[i].z = mean.z + uz;
-    }
+    out->x = g->mean.x + ux, out->y = g->mean.y + uy, out->z = g->mean.z + uz;
+}
+
+/* sample_at at n points, a point a loop pass: GCC vectorises the loop with
+ * the points in the lanes (the corners gathered by index), each lane
+ * sample_at's operations in their order, so every version gives
+ * spn_air_sample's bits. (g by value: through a pointer, even to a local
+ * copy, GCC 12 found the loop not worth vectorising.) */
+SPN__KERNEL static void sample_points(air_points g, const spn_vec3 *restrict p, spn_vec3 *restrict out, size_t n)
+{
+    for (size_t i = 0; i < n; i++) sample_at(&g, p + i, out + i);
 }
 
 void spn_air_sample_batch(void *user, double t, const spn_vec3 *p, spn_vec3 *out, size_t n)
 {
     const spn_air_field *air = user;
     const air_time at = air->grid ? sample_time(air, t) : (air_time){0};
-    if (!at.a || !at.b) {
+    if (!at.a || !at.b) { /* no grid, or its slices not ready: the field itself */
         for (size_t i = 0; i < n; i++) out[i] = spn_air_velocity(air, t, p[i]);
         return;
     }
-    sample_points(air, &at, p, out, n);
+    const air_points g = points_of(air, &at);
+    sample_points(g, p, out, n);
+}
+
+spn_vec3 spn_air_sample(void *user, double t, spn_vec3 p)
+{
+    const spn_air_field *air = user;
+    const air_time at = air->grid ? sample_time(air, t) : (air_time){0};
+    if (!at.a || !at.b) return spn_air_velocity(air, t, p);
+    const air_points g = points_of(air, &at);
+    spn_vec3 u;
+    sample_at(&g, &p, &u);
+    return u;
 }
 
 void spn_air_attach(spn_air_field *air, spn_world *w)
