@@ -71,17 +71,20 @@ static void thesis_only(void *user, const spn_world *w, double t, const spn_vec3
     spn_thesis_wind_force(r->thesis, w, t, x, v, f);
 }
 
+/* Whether the wind has stopped by time t (--wind-stop): still air then. */
+static bool wind_stopped(const runner *r, double t) { return r->def.wind_stop >= 0 && t >= r->def.wind_stop; }
+
 static spn_vec3 runner_air(void *user, double t, spn_vec3 p)
 {
     runner *r = user;
-    if (r->def.wind_stop >= 0 && t >= r->def.wind_stop) return spn_v3(0, 0, 0);
+    if (wind_stopped(r, t)) return spn_v3(0, 0, 0);
     return spn_air_sample(r->air, t, p);
 }
 
 static void runner_air_batch(void *user, double t, const spn_vec3 *p, spn_vec3 *out, size_t n)
 {
     runner *r = user;
-    if (r->def.wind_stop >= 0 && t >= r->def.wind_stop) {
+    if (wind_stopped(r, t)) {
         for (size_t i = 0; i < n; i++)
             out[i] = spn_v3(0, 0, 0);
         return;
