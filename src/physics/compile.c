@@ -32,7 +32,6 @@ void spn__free_compiled(spn_world *w)
     for (int i = 0; i < SPN_TMP_COUNT; i++) free(w->tmp[i]);
     free(w->fair);
     free(w->wind);
-    free(w->mid);
     free(w->cair);
     free(w->jac);
     free(w->pinv);
@@ -46,7 +45,7 @@ void spn__forget_compiled(spn_world *w)
     w->adj_start = w->adj = w->perm = w->iperm = w->a_start = w->b_start = w->b_adj = NULL;
     w->hs = NULL;
     w->hflags = NULL;
-    w->fs = w->f = w->fext = w->x0 = w->v0 = w->fair = w->wind = w->mid = NULL;
+    w->fs = w->f = w->fext = w->x0 = w->v0 = w->fair = w->wind = NULL;
     w->sdiam = w->cair = w->partial = w->pinv = NULL;
     w->jac = NULL;
     w->imp_mg = NULL;
@@ -111,9 +110,8 @@ static bool alloc_air(spn_world *w)
     if (!w->any_diam) return true;
     w->fair = calloc(w->ns, sizeof *w->fair);
     w->wind = calloc(w->ns, sizeof *w->wind);
-    w->mid = calloc(w->ns, sizeof *w->mid);
     w->cair = calloc(w->ns, sizeof *w->cair);
-    return w->fair && w->wind && w->mid && w->cair;
+    return w->fair && w->wind && w->cair;
 }
 
 /* The internal spring order: by lower particle id, ties in public order

@@ -179,6 +179,7 @@ static void sample_air(spn_world *w, double t, const spn_vec3 *x, int threads)
 #pragma omp parallel for schedule(static) num_threads(threads) if (w->air_pure && threads > 1)
         for (uint32_t piece = 0; piece < pieces; piece++) {
             const uint32_t end = piece * SPN__AIR_RUN + SPN__AIR_RUN < ns ? piece * SPN__AIR_RUN + SPN__AIR_RUN : ns;
+            spn_vec3 mid[SPN__AIR_RUN]; /* (a run's midpoints: 12 KiB of the thread's stack) */
             for (uint32_t lo = piece * SPN__AIR_RUN; lo < end;) {
                 if (!(w->sdiam[lo] > 0)) {
                     lo++;
@@ -186,8 +187,8 @@ static void sample_air(spn_world *w, double t, const spn_vec3 *x, int threads)
                 }
                 uint32_t hi = lo;
                 for (; hi < end && w->sdiam[hi] > 0; hi++)
-                    w->mid[hi] = midpoint(w, x, hi);
-                w->air_batch(w->air_user, t, w->mid + lo, w->wind + lo, hi - lo);
+                    mid[hi - lo] = midpoint(w, x, hi);
+                w->air_batch(w->air_user, t, mid, w->wind + lo, hi - lo);
                 lo = hi;
             }
         }

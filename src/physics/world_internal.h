@@ -176,7 +176,6 @@ struct spn_world {
     spn_vec3 *tmp[SPN_TMP_COUNT]; /* per-particle scratch, allocated on demand */
     spn_vec3 *fair;       /* per-spring air force (on demand) */
     spn_vec3 *wind;       /* per-spring air velocity at the midpoint (on demand) */
-    spn_vec3 *mid;        /* per-spring midpoints, for a batch air function (air_batch) */
     double *cair;         /* per-spring linear air-drag coefficient (on demand) */
     spn__jac *jac;        /* implicit: per-spring Jacobian (on demand) */
     double *pinv;         /* implicit: per-particle inverse 3x3 block, 6 each (on demand) */
