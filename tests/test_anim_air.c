@@ -1,8 +1,10 @@
 /* Air on threads: the drag on one straight segment is 1/2 rho C_d d L |u_n| u_n
  * from the normal component of the wind only (none when the wind runs along
- * it); a web in steady air settles to a deflected shape whose deflection grows
- * with wind speed, and comes back to rest when the wind stops; the turbulent
- * field has the rms and the zero divergence it is built with. */
+ * it), and the air's power on it is that force times its ends' velocities
+ * (spn_world_air_power); a web in steady air settles to a deflected shape
+ * whose deflection grows with wind speed, and comes back to rest when the
+ * wind stops; the turbulent field has the rms and the zero divergence it is
+ * built with. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -71,6 +73,58 @@ static void test_segment_drag_formula(void **state)
     /* Along the segment: no force at all. */
     spn_vec3 g = force_on_end(spn_v3(1, 0, 0), speed);
     assert_true(spn_v3_len(g) == 0);
+}
+
+/* The air's power on a segment along x, its free end moving at vz, in a
+ * steady wind of 2 m/s along z, against 1/2 rho C_d d L |u| u (v_a + v_b) / 2
+ * from the formula, u = 2 minus its midpoint's speed: each end takes half the
+ * force at its own velocity, and a fixed end (at rest) none. */
+static void power_on_segment(double vz, bool fixed_end, double *power, double *expect)
+{
+    spn_world_def wd = spn_world_def_default();
+    wd.gravity = spn_v3(0, 0, 0);
+    spn_world *w = spn_world_create(&wd);
+    spn_particle_def p = spn_particle_def_default();
+    p.mass = 1e-3;
+    spn_spring_def s = spn_spring_def_default();
+    p.position = spn_v3(0, 0, 0);
+    assert_int_equal(spn_world_add_particle(w, &p, &s.a), SPN_OK);
+    p.position = spn_v3(0.02, 0, 0);
+    assert_int_equal(spn_world_add_particle(w, &p, &s.b), SPN_OK);
+    s.k = 1;
+    s.tag = SPN_THREAD_RADIUS;
+    assert_int_equal(spn_world_add_spring(w, &s, NULL), SPN_OK);
+    assert_true(spn_world_air_power(w) == 0); /* no air yet */
+    spn_air_field *air = steady(2, spn_v3(0, 0, 1));
+    spn_air_attach(air, w);
+    if (fixed_end)
+        spn_world_set_fixed(w, 0, true);
+    else
+        assert_int_equal(spn_world_set_velocity(w, 0, spn_v3(0, 0, vz)), SPN_OK);
+    assert_int_equal(spn_world_set_velocity(w, 1, spn_v3(0, 0, vz)), SPN_OK);
+    *power = spn_world_air_power(w);
+    const double v0 = spn_world_velocity(w, 0).z, v1 = spn_world_velocity(w, 1).z;
+    const double rho = 1.204, mu = 1.81e-5, d = spn_thread_diameter(SPN_THREAD_RADIUS), L = 0.02;
+    const double u = 2 - (v0 + v1) / 2, re = rho * fabs(u) * d / mu;
+    const double force = 0.5 * rho * spn_cylinder_drag_coefficient(re) * d * L * fabs(u) * u;
+    *expect = force * ((fixed_end ? 0 : v0) + v1) / 2;
+    spn_world_destroy(w);
+    spn_air_destroy(air);
+}
+
+static void test_air_power(void **state)
+{
+    (void)state;
+    const double vz[] = {0.5, 3, -1, 2};
+    for (int i = 0; i < 4; i++)
+        for (int fixed = 0; fixed < 2; fixed++) {
+            double power, expect;
+            power_on_segment(vz[i], fixed, &power, &expect);
+            printf("# segment at %g m/s in 2 m/s air%s: power %.6g W, formula %.6g W\n", vz[i],
+                   fixed ? ", one end fixed" : "", power, expect);
+            assert_true(fabs(power - expect) <= 1e-12 * fabs(expect));
+            assert_true(vz[i] == 2 && !fixed ? power == 0 : fabs(power) > 1e-9); /* the air drives or brakes it */
+        }
 }
 
 /* The hub's deflection along the wind after `wind_time` of steady wind, and
@@ -327,6 +381,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_segment_drag_formula),
+        cmocka_unit_test(test_air_power),
         cmocka_unit_test(test_web_billows_with_speed),
         cmocka_unit_test(test_turbulence_statistics),
         cmocka_unit_test(test_batch_samples_same_bits),

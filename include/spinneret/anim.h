@@ -225,8 +225,8 @@ SPN_API void spn_impact_force(void *user, const spn_world *w, double t, const sp
 SPN_API double spn_impact_contact_stiffness(const spn_impact *impact);
 /// Particle id of prey i.
 SPN_API uint32_t spn_impact_prey_particle(const spn_impact *impact, int i);
-/// Tell the ledger the world has an air field / a wind force (for the work terms).
-SPN_API void spn_impact_track_air(spn_impact *impact, spn_air_fn fn, void *user, double rho, double mu);
+/// Tell the ledger the world's force callback carries a wind (its work term);
+/// the air's work it takes from the world (spn_world_air_power).
 SPN_API void spn_impact_track_wind(spn_impact *impact, spn_force_fn fn, void *user);
 /// Before every step of `dt`: with the implicit solver, hand the world the
 /// prey's contacts (spn_world_set_contacts) so it integrates them implicitly.

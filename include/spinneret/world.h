@@ -300,6 +300,13 @@ SPN_API void spn_world_set_air_batch(spn_world *w, spn_air_batch_fn fn);
 /// The air function (NULL: still air); its user pointer, rho and mu into the
 /// arguments that are not NULL (rho 1.204, mu 1.81e-5 until set).
 SPN_API spn_air_fn spn_world_air(const spn_world *w, void **user, double *rho, double *mu);
+/// The power of the air's drag on the free particles at the world's state
+/// and time [W], positive when the air drives the web: each tagged segment's
+/// force (half on each end) dotted with its ends' velocities, as the next
+/// step's force evaluation gives it, samples and all. 0 without air (no air
+/// function, or no thread with a diameter); NAN if the world does not
+/// compile. Call it between steps: it uses the step's scratch.
+SPN_API double spn_world_air_power(spn_world *w);
 /// Thread diameter [m] for springs with `tag` (0: no aerodynamic drag).
 SPN_API void spn_world_set_tag_diameter(spn_world *w, uint32_t tag, double diameter);
 /// The diameter set for `tag` (0 when none).

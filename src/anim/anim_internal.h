@@ -23,9 +23,4 @@ spn_status spn__world_with_breaks(const spn_world *w, double scale, spn_world **
  * `small_scale` [m], slices 5 ms apart. */
 spn_status spn__air_grid_over_web(spn_air_field *air, const spn_world *w, double small_scale);
 
-/* True when this build's world applies aerodynamic drag (probed once on a
- * single segment in a steady wind), so the energy ledger counts the air's work
- * only when the air really acts. */
-bool spn__world_applies_air(void);
-
 #endif

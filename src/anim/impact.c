@@ -24,8 +24,8 @@
  * kinetic energy: elastic energy per thread kind, dissipation by the springs'
  * damping per kind (kd (l' . l/|l|)^2 integrated by the trapezoid rule over
  * the steps), elastic energy lost when a spring breaks, work of the air on the
- * threads (the drag formula of world.h evaluated on the segments) and of any
- * wind force, and the contact potential. The balance
+ * threads (the world's own drag, spn_world_air_power) and of any wind force,
+ * and the contact potential. The balance
  *   E(t) + damping + broken - air work - wind work = E(0)
  * holds to the integrator's accuracy: its residual is the report's
  * balance_error. */
@@ -434,14 +434,6 @@ void spn_impact_force(void *user, const spn_world *w, double t, const spn_vec3 *
     lift(im, w, f);
     /* With the implicit solver the world applies the listed contacts itself. */
     if (!im->listed) spn__impact_contact(im, x, f);
-}
-
-void spn_impact_track_air(spn_impact *im, spn_air_fn fn, void *user, double rho, double mu)
-{
-    im->air_fn = fn;
-    im->air_user = user;
-    im->rho = rho;
-    im->mu = mu;
 }
 
 void spn_impact_track_wind(spn_impact *im, spn_force_fn fn, void *user)

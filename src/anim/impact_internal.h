@@ -53,9 +53,6 @@ struct spn_impact {
     double air_prev, wind_prev, air_work, wind_work;
     double total0, prey_ke0, contact;
     uint32_t breaks;
-    spn_air_fn air_fn;
-    void *air_user;
-    double rho, mu;
     spn_force_fn wind_fn;
     void *wind_user;
     spn_vec3 *fbuf;

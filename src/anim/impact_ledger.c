@@ -29,31 +29,6 @@ static void spring_energies(spn_impact *im, const spn_world *w, const spn_vec3 *
     }
 }
 
-/* Power of the air drag on the threads (world.h's formula on each segment,
- * half the force to each end): positive when the air drives the web. */
-static double air_power(const spn_impact *im, const spn_world *w, const spn_vec3 *x, const spn_vec3 *v)
-{
-    if (!im->air_fn) return 0;
-    double p = 0, t = spn_world_time(w);
-    for (uint32_t s = 0; s < im->ns; s++) {
-        if (im->broken[s] || !(im->diam[s] > 0)) continue;
-        uint32_t a = im->sa[s], b = im->sb[s];
-        spn_vec3 l = spn_v3_sub(x[b], x[a]);
-        double len = spn_v3_len(l);
-        if (len <= 0) continue;
-        spn_vec3 e = spn_v3_scale(l, 1 / len), mid = spn_v3_scale(spn_v3_add(x[a], x[b]), 0.5);
-        spn_vec3 vm = spn_v3_scale(spn_v3_add(v[a], v[b]), 0.5);
-        spn_vec3 u = spn_v3_sub(im->air_fn(im->air_user, t, mid), vm);
-        spn_vec3 un = spn_v3_sub(u, spn_v3_scale(e, spn_v3_dot(u, e)));
-        double speed = spn_v3_len(un), re = im->rho * speed * im->diam[s] / im->mu;
-        double mag = 0.5 * im->rho * spn_cylinder_drag_coefficient(re) * im->diam[s] * len * speed;
-        double pa = spn_world_is_fixed(w, a) ? 0 : 0.5 * spn_v3_dot(un, v[a]);
-        double pb = spn_world_is_fixed(w, b) ? 0 : 0.5 * spn_v3_dot(un, v[b]);
-        p += mag * (pa + pb);
-    }
-    return p;
-}
-
 static double wind_power(spn_impact *im, const spn_world *w, const spn_vec3 *x, const spn_vec3 *v)
 {
     if (!im->wind_fn) return 0;
@@ -127,7 +102,7 @@ void spn_impact_after_step(spn_impact *im, spn_world *w, double dt)
         im->kinds[i].damping += a * im->damp_prev[i] + b * damp[i];
         im->damp_prev[i] = damp[i];
     }
-    double pv = viscous_power(w, v), pa = air_power(im, w, x, v), pw = wind_power(im, w, x, v);
+    double pv = viscous_power(w, v), pa = spn_world_air_power(w), pw = wind_power(im, w, x, v);
     im->viscous += a * im->viscous_prev + b * pv;
     im->air_work += a * im->air_prev + b * pa;
     im->wind_work += a * im->wind_prev + b * pw;

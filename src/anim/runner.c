@@ -144,7 +144,6 @@ static spn_status make_air(runner *r, spn_world *w)
     spn_world_set_air(w, runner_air, r, ad.rho, ad.mu);
     spn_world_set_air_batch(w, runner_air_batch);
     spn_world_set_air_pure(w, true); /* as spn_air_sample */
-    if (r->impact && spn__world_applies_air()) spn_impact_track_air(r->impact, runner_air, r, ad.rho, ad.mu);
     return SPN_OK;
 }
 

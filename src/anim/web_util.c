@@ -148,34 +148,3 @@ spn_status spn__world_with_breaks(const spn_world *w, double scale, spn_world **
     *out = c;
     return SPN_OK;
 }
-
-static spn_vec3 probe_air(void *user, double t, spn_vec3 p)
-{
-    (void)user;
-    (void)t;
-    (void)p;
-    return spn_v3(0, 0, 1);
-}
-
-bool spn__world_applies_air(void)
-{
-    spn_world_def d = spn_world_def_default();
-    d.gravity = spn_v3(0, 0, 0);
-    spn_world *w = spn_world_create(&d);
-    if (!w) return false;
-    spn_particle_def p = spn_particle_def_default();
-    spn_spring_def s = spn_spring_def_default();
-    p.mass = 1e-6;
-    p.position = spn_v3(0, 0, 0);
-    spn_world_add_particle(w, &p, &s.a);
-    p.position = spn_v3(0.01, 0, 0);
-    spn_world_add_particle(w, &p, &s.b);
-    s.k = 1;
-    s.tag = 1;
-    spn_world_add_spring(w, &s, NULL);
-    spn_world_set_air(w, probe_air, NULL, 1.2, 1.8e-5);
-    spn_world_set_tag_diameter(w, 1, 1e-4);
-    bool moved = spn_world_step(w, 1e-3) == SPN_OK && spn_world_velocity(w, 0).z > 0;
-    spn_world_destroy(w);
-    return moved;
-}

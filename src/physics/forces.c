@@ -267,6 +267,35 @@ bool spn__external(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v)
     return true;
 }
 
+double spn_world_air_power(spn_world *w)
+{
+    if (spn_world_compile(w) != SPN_OK) return NAN;
+    if (!spn__air_active(w)) return 0;
+    const uint32_t ns = w->ns, nb = spn__blocks(ns);
+    const int threads = spn__threads(w, ns);
+    const spn_vec3 *x = w->x, *v = w->v;
+    sample_air(w, w->t, x, threads);
+    double *partial = w->partial;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (uint32_t blk = 0; blk < nb; blk++) {
+        const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < ns ? lo + SPN_BLOCK : ns;
+        air_forces(w, lo, hi, x, v);
+        double p = 0;
+        for (uint32_t s = lo; s < hi; s++) {
+            if (!(w->sdiam[s] > 0)) continue;
+            const uint32_t a = w->hs[s].a, b = spn__end_b(w->hs[s]);
+            /* half the segment's force on each end; a fixed end takes no work */
+            const spn_vec3 va = w->inv_mass[a] > 0 ? v[a] : spn_v3(0, 0, 0);
+            const spn_vec3 vb = w->inv_mass[b] > 0 ? v[b] : spn_v3(0, 0, 0);
+            p += 0.5 * spn_v3_dot(w->fair[s], spn_v3_add(va, vb));
+        }
+        partial[(size_t)blk * SPN_NSUMS] = p;
+    }
+    double power = 0;
+    for (uint32_t blk = 0; blk < nb; blk++) power += partial[(size_t)blk * SPN_NSUMS];
+    return power;
+}
+
 void spn__gather(spn_world *w, const spn_vec3 *x, const spn_vec3 *v, bool has_ext, spn_vec3 *f, spn__eval *e)
 {
     (void)x;
