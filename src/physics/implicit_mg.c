@@ -36,7 +36,8 @@
  * goes on; outrun so in the step after its own, the next steps factorise
  * at their start), and until the step length changes. The Araneus web in
  * air: 15.8 -> 3.7 CG and 6.3 -> 1.6 ms a step (docs/physics-implicit-mg.md,
- * "A factorised preconditioner").
+ * "A factorised preconditioner"). A small web's steps with contacts take
+ * the factor or block Jacobi, a lattice web's too (spn__imp_mg_prepare).
  * The preconditioner is a fixed linear map within a solve (a restart begins
  * CG again from where it is), so CG's result
  * differs from block Jacobi's only within the solver tolerance; every product
@@ -55,6 +56,8 @@ struct spn__imp_mg {
     spn__cyc *cyc;     /* a rings x radials web: the cyclic preconditioner instead of the V-cycle */
     spn__chol *chol;   /* a small web under auto: a factor of an earlier step's matrix instead */
     bool chol_ready;   /* chol holds a factor */
+    bool chol_on;      /* the factor preconditions this step (on a lattice web: a step with contacts) */
+    bool chol_tried;   /* the factor was analysed (at create; a lattice web's at its first contacts) */
     bool chol_stale;   /* the last step cost more than the factor's average step: factorise */
     bool chol_fresh;   /* the factor is of this step's matrix */
     double chol_h;     /* the step the factor's matrix was assembled for */
@@ -156,6 +159,13 @@ static bool map_springs(spn__imp_mg *m, const spn_world *w)
     return k == e->m;
 }
 
+static void analyse(spn__imp_mg *m)
+{
+    m->chol_tried = true;
+    if (m->e.n <= SPN__IMPLICIT_DIRECT_MAX)
+        m->chol = spn__chol_analyze(m->e.n, m->e.adj_start, m->e.adj_other, 200 * (size_t)m->e.n);
+}
+
 static spn__imp_mg *create(const spn_world *w)
 {
     spn__imp_mg *m = calloc(1, sizeof *m);
@@ -183,10 +193,10 @@ static spn__imp_mg *create(const spn_world *w)
         const char *why;
         m->cyc = spn__cyc_build(&m->e, &why);
     }
-    /* auto on a small web that is no lattice: the factor (NULL if it would
-     * hold more than 200 numbers a particle: the V-cycle then) */
-    if (w->implicit_pc == 0 && !m->cyc && m->e.n <= SPN__IMPLICIT_DIRECT_MAX)
-        m->chol = spn__chol_analyze(m->e.n, m->e.adj_start, m->e.adj_other, 200 * (size_t)m->e.n);
+    /* auto on a web that is no lattice: the factor (NULL if it would hold
+     * more than 200 numbers a particle: the V-cycle then); a lattice web's
+     * only for its steps with contacts (spn__imp_mg_prepare) */
+    if (w->implicit_pc == 0 && !m->cyc) analyse(m);
     return m;
 }
 
@@ -255,11 +265,7 @@ bool spn__imp_mg_prepare(spn_world *w, double h)
      * few iterations and nothing to set up, unless it took too many at this
      * step length or a shorter one (imp_bj_long: a web of stiff silk) */
     const bool auto_pc = w->implicit_pc == 0, auto_big = auto_pc && w->np >= SPN__IMPLICIT_MG_MIN;
-    /* (a small web's steps with contacts stay on block Jacobi: the cycle
-     * sees a held prey's particles through their diagonal blocks only, and
-     * needed so many iterations there that test_anim_strike's small
-     * Araneus webs took 80 s instead of 12) */
-    const bool long_rule = auto_pc && w->imp_bj_long > 0 && h >= w->imp_bj_long && (auto_big || w->ncontacts == 0);
+    const bool long_rule = auto_pc && w->imp_bj_long > 0 && h >= w->imp_bj_long;
     const bool auto_mg = (auto_big && h >= SPN__IMPLICIT_MG_DT) || long_rule;
     const bool want = w->implicit_pc >= 2 || auto_mg || (auto_big && w->lat);
     if (!want) return false;
@@ -275,8 +281,20 @@ bool spn__imp_mg_prepare(spn_world *w, double h)
     spn__imp_mg *m = w->imp_mg;
     if (m->failed || m->e.n == 0) return false;
     if (w->implicit_pc == 0 && !auto_mg && !m->cyc) return false; /* a short step without the cyclic one */
+    /* A small web's steps with contacts take the factor, or block Jacobi.
+     * Every preconditioner here sees a held prey's particles through their
+     * diagonal blocks only, so CG must build the prey's coupling to the web
+     * itself: on top of the exact factor that takes a few iterations (the
+     * difference is of low rank: test_anim_strike's Araneus webs 9-17 CG a
+     * step, 17 s -> 1.2 s, where block Jacobi ran to its 1,000), but on top
+     * of the V-cycle or the cyclic preconditioner many (the strike on
+     * scene:orb 12 s -> 39 s, the small Araneus webs once 12 s -> 80 s). */
+    const bool contacts = auto_pc && !auto_big && w->ncontacts;
+    if (contacts && !m->chol_tried) analyse(m);
+    if (contacts && !m->chol) return false;
+    m->chol_on = m->chol && (!m->cyc || contacts);
     assemble(m, w, h);
-    if (m->chol) {
+    if (m->chol_on) {
         m->chol_fresh = !m->chol_ready || m->chol_stale || h != m->chol_h || m->hold > 0;
         if (m->hold) m->hold--;
         if (m->chol_fresh) {
@@ -287,6 +305,8 @@ bool spn__imp_mg_prepare(spn_world *w, double h)
         if (m->chol_ready) return true;
         spn__chol_free(m->chol); /* not definite: the multigrid from here on */
         m->chol = NULL;
+        m->chol_on = false;
+        if (contacts) return false;
     }
     if (m->cyc) {
         if (spn__cyc_factor(m->cyc, &m->e) && !refused(w, SPN__REFUSE_CYCLIC)) return true;
@@ -315,9 +335,9 @@ void spn__imp_mg_apply(const spn_world *w, const spn_vec3 *r, spn_vec3 *z)
         z[i] = spn_v3(q[0] * ri.x + q[3] * ri.y + q[4] * ri.z, q[3] * ri.x + q[1] * ri.y + q[5] * ri.z,
                       q[4] * ri.x + q[5] * ri.y + q[2] * ri.z);
     }
-    if (m->chol && !m->chol_ready) return; /* a factorisation failed mid-solve (spn__imp_mg_refactor) */
+    if (m->chol_on && !m->chol_ready) return; /* a factorisation failed mid-solve (spn__imp_mg_refactor) */
     for (uint32_t i = 0; i < n; i++) memcpy(m->r + 3 * (size_t)i, &r[e->world_id[i]], 3 * sizeof(double));
-    if (m->chol) spn__chol_solve(m->chol, m->r, m->z);
+    if (m->chol_on) spn__chol_solve(m->chol, m->r, m->z);
     else if (m->cyc) spn__cyc_apply(m->cyc, e, m->r, m->z);
     else spn__mg_apply(m->mg, e, m->r, m->z);
     for (uint32_t i = 0; i < n; i++) memcpy(&z[e->world_id[i]], m->z + 3 * (size_t)i, 3 * sizeof(double));
@@ -326,7 +346,7 @@ void spn__imp_mg_apply(const spn_world *w, const spn_vec3 *r, spn_vec3 *z)
 bool spn__imp_mg_refactor(spn_world *w)
 {
     spn__imp_mg *m = w->imp_mg;
-    if (!m || !m->chol || m->chol_fresh) return false;
+    if (!m || !m->chol_on || m->chol_fresh) return false;
     /* level 0 still holds this step's matrix (assemble) */
     /* not definite: block Jacobi for the rest of this solve (apply), and the
      * next step's prepare factorises again, and drops the factor if that
@@ -354,7 +374,7 @@ bool spn__imp_mg_refactor(spn_world *w)
 void spn__imp_mg_solved(spn_world *w, int iterations)
 {
     spn__imp_mg *m = w->imp_mg;
-    if (!m || !m->chol) return;
+    if (!m || !m->chol_on) return;
     const uint32_t it = (uint32_t)iterations;
     if (m->chol_fresh) {
         m->cycle_iterations = SPN__IMPLICIT_FACTOR_PRICE + it, m->cycle_steps = 1;
@@ -368,7 +388,7 @@ void spn__imp_mg_solved(spn_world *w, int iterations)
 bool spn__imp_mg_restart_due(const spn_world *w, int iterations)
 {
     const spn__imp_mg *m = w->imp_mg;
-    if (!m || !m->chol || m->chol_fresh || !m->cycle_steps) return false;
+    if (!m || !m->chol_on || m->chol_fresh || !m->cycle_steps) return false;
     /* iterations > average + price: a factorisation now costs less than
      * what this solve has spent past an average step */
     return (uint64_t)iterations * m->cycle_steps >
