@@ -112,11 +112,68 @@ static void test_fast_strike_breaks_through(void **state)
     assert_true(rep.impact.balance_error <= 0.02 * rep.impact.prey_kinetic_start);
 }
 
+/* The physical builder's threads are laid 75-250% over-extended (Mehla 2005)
+ * and settle taut far past any silk's breaking strain from their rest
+ * lengths. Struck, the web keeps them: they break at their strain past the
+ * length they have when the prey comes (spn__break_length), where before
+ * every radius broke at the first step. A slow prey is held with no radius
+ * broken; a fast one tears a hole round the strike (its thesis silk is soft)
+ * and the rest of the web holds. */
+static void test_overextended_web_keeps_its_threads(void **state)
+{
+    (void)state;
+    static const spn_vec3 anchors[4] = {{-0.4, 0.42, 0}, {0.42, 0.38, 0}, {0.4, -0.45, 0}, {-0.42, -0.38, 0}};
+    const double speeds[2] = {0.5, 8};
+    for (int i = 0; i < 2; i++) {
+        spn_physical_def d = spn_physical_def_default();
+        d.anchors = anchors;
+        d.anchor_count = 4;
+        spn_world *w = NULL;
+        assert_int_equal(spn_web_build_physical(&d, &w), SPN_OK);
+        spn_settle_report sr;
+        assert_int_equal(spn_web_settle(w, 5, &sr), SPN_OK);
+        uint32_t past = 0, intact = 0;
+        for (uint32_t s = 0; s < spn_world_spring_count(w); s++) {
+            const spn_spring_info in = spn_world_spring(w, s);
+            intact += !in.broken;
+            past += in.tag == SPN_THREAD_RADIUS && in.length > in.rest * (1 + spn_thread_breaking_strain(in.tag));
+        }
+        assert_true(past > 100); /* the case is reached: radii past the silk's breaking strain */
+        spn_prey_def prey = {{0.01, 0.01, 0.02}, {0, 0, -speeds[i]}, 2e-4, 0.005};
+        spn_anim_def ad = spn_anim_def_default();
+        ad.duration = 0.05;
+        ad.fps = 100;
+        ad.prey = &prey;
+        ad.nprey = 1;
+        spn_anim_report rep;
+        assert_int_equal(spn_animate(&w, &ad, NULL, NULL, &rep), SPN_OK);
+        uint32_t radii = 0;
+        for (int k = 0; k < rep.impact.nkinds; k++)
+            if (rep.impact.kinds[k].tag == SPN_THREAD_RADIUS) radii = rep.impact.kinds[k].breaks;
+        printf("# physical web (%u radius segments past 27%% strain), prey at %g m/s: %s, %u of %u springs broken "
+               "(%u radius), at most %.3g m from the strike, web radius %.3g m\n",
+               past, speeds[i], spn_prey_outcome_name(rep.impact.outcome[0]), rep.impact.breaks, intact, radii,
+               rep.impact.break_distance_max, rep.impact.web_radius);
+        assert_true(rep.impact.outcome[0] != SPN_PREY_MISSED);
+        if (i == 0) {
+            assert_true(rep.impact.outcome[0] != SPN_PREY_PASSED);
+            assert_int_equal(radii, 0);
+            assert_true(rep.impact.breaks <= 10);
+        } else {
+            assert_true(rep.impact.breaks >= 10 && rep.impact.breaks * 20 < intact);
+            assert_true(radii * 20 < past);
+            assert_true(rep.impact.break_distance_max < 0.5 * rep.impact.web_radius);
+        }
+        spn_world_destroy(w);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_slow_strike_is_stopped),
         cmocka_unit_test(test_fast_strike_breaks_through),
+        cmocka_unit_test(test_overextended_web_keeps_its_threads),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -83,7 +83,7 @@ static spn_world *copy_like_prey(spn_world *w, double scale)
         assert_true(in.a == out.a && in.b == out.b && in.k == out.k && in.kd == out.kd && in.rest == out.rest);
         assert_true(in.tag == out.tag && in.broken == out.broken && in.break_min == out.break_min);
         double strain = spn_thread_breaking_strain(in.tag) * scale;
-        double want = isfinite(strain) ? fmin(in.break_max, in.rest * (1 + strain)) : in.break_max;
+        double want = isfinite(strain) ? fmin(in.break_max, spn__break_length(in, strain)) : in.break_max;
         assert_true(out.break_max == want);
         assert_int_equal(spn_world_set_spring_breaks(w, s, out.break_min, out.break_max), SPN_OK);
     }

@@ -13,9 +13,14 @@ uint32_t spn__hub_particle(const spn_world *w);
 double spn__web_radius(const spn_world *w, uint32_t centre);
 /* Bounding box of the web particles (prey excluded). */
 void spn__web_bounds(const spn_world *w, spn_vec3 *lo, spn_vec3 *hi);
+/* The length spring `in` breaks at, `strain` its kind's breaking strain:
+ * rest * (1 + strain), or, for a spring already that long (a rest length
+ * that is no silk's slack, as the physical builder's), its length now
+ * times (1 + strain). */
+double spn__break_length(spn_spring_info in, double strain);
 /* A copy of `w` that steps as w would (spn_world_clone plus the contacts:
  * every setting and callback), but that its intact springs of a breakable
- * kind get break_max = min(break_max, rest * (1 + strain * scale)). */
+ * kind get break_max = min(break_max, spn__break_length(strain * scale)). */
 spn_status spn__world_with_breaks(const spn_world *w, double scale, spn_world **out);
 
 /* Cache `air` on the grid the animation runner uses for web `w` (runner.c):

@@ -123,6 +123,17 @@ void spn__web_bounds(const spn_world *w, spn_vec3 *lo, spn_vec3 *hi)
     if (lo->x > hi->x) *lo = *hi = spn_v3(0, 0, 0);
 }
 
+/* A thread breaks at `strain` past its rest length; one already at that
+ * length holds by a rest length that is no silk's slack (the physical
+ * builder lays its threads 75-250% over-extended so that they settle taut,
+ * Mehla 2005 sec. 5.1, far past any silk's breaking strain), so it breaks
+ * at `strain` past the length it has now. */
+double spn__break_length(spn_spring_info in, double strain)
+{
+    const double from_rest = in.rest * (1 + strain);
+    return in.length >= from_rest ? in.length * (1 + strain) : from_rest;
+}
+
 /* The copy is a clone, so it carries everything set on w (lattice switch,
  * precision, implicit preconditioner, callbacks, air, diameters, hysteresis,
  * colliders, the adaptive stepper's state), then the contacts, which a clone
@@ -139,7 +150,7 @@ spn_status spn__world_with_breaks(const spn_world *w, double scale, spn_world **
         spn_spring_info in = spn_world_spring(w, s);
         double strain = spn_thread_breaking_strain(in.tag) * scale;
         if (!in.broken && isfinite(strain) && in.rest > 0)
-            st = spn_world_set_spring_breaks(c, s, in.break_min, fmin(in.break_max, in.rest * (1 + strain)));
+            st = spn_world_set_spring_breaks(c, s, in.break_min, fmin(in.break_max, spn__break_length(in, strain)));
     }
     if (st != SPN_OK) {
         spn_world_destroy(c);
