@@ -68,7 +68,8 @@ struct spn_air_field {
     double slice_dt;
     air_slice slices[MAX_SLICES];
     /* fill_slice's scratch: per mode cos and sin of its phase along each
-     * axis (n[0] + n[1] + n[2] of each), and a grid row's sums */
+     * axis (axis_stride: n[0] rounded up to eight, zeros past it, then
+     * n[1] + n[2]), and a grid row's sums */
     double *axis_cos, *axis_sin, *row;
     /* the times spn_air_prepare was last told of (t0, t1 and their
      * midpoint), at which a step samples every segment */
@@ -227,6 +228,10 @@ spn_vec3 spn_air_velocity(const spn_air_field *air, double t, spn_vec3 p)
     return spn_v3_add(mean, turbulence_at(air, t, advection(air, t), p));
 }
 
+/* Numbers per mode in axis_cos and axis_sin: the x axis padded to a
+ * multiple of eight (slice_row reads eight at a time), then y and z. */
+static size_t axis_stride(int nx, int ny, int nz) { return ((size_t)nx + 7) / 8 * 8 + (size_t)ny + nz; }
+
 spn_status spn_air_set_grid(spn_air_field *air, spn_vec3 lo, spn_vec3 hi, int nx, int ny, int nz, double slice_dt)
 {
     if (nx < 2 || ny < 2 || nz < 2 || (int64_t)nx * ny * nz > 1 << 22)
@@ -241,7 +246,7 @@ spn_status spn_air_set_grid(spn_air_field *air, spn_vec3 lo, spn_vec3 hi, int nx
         air->slices[i].u = u;
         air->slices[i].index = INT64_MIN;
     }
-    const size_t axes = (size_t)air->nmodes * ((size_t)nx + ny + nz);
+    const size_t axes = (size_t)air->nmodes * axis_stride(nx, ny, nz);
     double *c = realloc(air->axis_cos, axes * sizeof *c);
     if (c) air->axis_cos = c;
     double *sn = c ? realloc(air->axis_sin, axes * sizeof *sn) : NULL;
@@ -276,13 +281,14 @@ typedef double air_v8 __attribute__((vector_size(8 * sizeof(double))));
  * the modes added in their order (see fill_slice); `w` is 2 nmodes doubles
  * of scratch. Eight nodes at a time, their sums held in vectors through
  * all the modes (a node's sum is the same sequence of operations as one
- * node at a time: the rest of the row goes so); vectorised for each
+ * node at a time; the row's last eight may reach into the x axis'
+ * padding, whose sums are not stored); vectorised for each
  * instruction set (CMakeLists.txt compiles this file with the physics
  * kernels' flags); no contraction, so every version gives the same bits. */
 SPN__KERNEL static void slice_row(const spn_air_field *air, int j, int k, double *restrict w, spn_vec3 *restrict out)
 {
     const int nx = air->n[0], ny = air->n[1], nm = air->nmodes;
-    const size_t per = (size_t)nx + ny + air->n[2];
+    const size_t per = axis_stride(nx, ny, air->n[2]), y0 = per - ny - air->n[2];
     if (air->def.turbulence == 0) {
         for (int i = 0; i < nx; i++) out[i] = spn_v3(0, 0, 0);
         return;
@@ -291,11 +297,10 @@ SPN__KERNEL static void slice_row(const spn_air_field *air, int j, int k, double
     double *restrict re = w, *restrict im = w + nm;
     for (int n = 0; n < nm; n++) {
         const double *ca = air->axis_cos + (size_t)n * per, *sa = air->axis_sin + (size_t)n * per;
-        const double cb = ca[nx + j], sb = sa[nx + j], cc = ca[nx + ny + k], sc = sa[nx + ny + k];
+        const double cb = ca[y0 + j], sb = sa[y0 + j], cc = ca[y0 + ny + k], sc = sa[y0 + ny + k];
         re[n] = cb * cc - sb * sc, im[n] = sb * cc + cb * sc;
     }
-    int i = 0;
-    for (; i + 8 <= nx; i += 8) {
+    for (int i = 0; i < nx; i += 8) {
         air_v8 ux = {0}, uy = {0}, uz = {0};
         for (int n = 0; n < nm; n++) {
             air_v8 c, s;
@@ -305,16 +310,8 @@ SPN__KERNEL static void slice_row(const spn_air_field *air, int j, int k, double
             const spn_vec3 xi = air->modes[n].xi;
             ux += xi.x * v, uy += xi.y * v, uz += xi.z * v;
         }
-        for (int l = 0; l < 8; l++) out[i + l] = spn_v3(ux[l], uy[l], uz[l]);
-    }
-    for (; i < nx; i++) {
-        double ux = 0, uy = 0, uz = 0;
-        for (int n = 0; n < nm; n++) {
-            const double v = air->axis_cos[(size_t)n * per + i] * re[n] - air->axis_sin[(size_t)n * per + i] * im[n];
-            const spn_vec3 xi = air->modes[n].xi;
-            ux += xi.x * v, uy += xi.y * v, uz += xi.z * v;
-        }
-        out[i] = spn_v3(ux, uy, uz);
+        const int lanes = nx - i < 8 ? nx - i : 8; /* (the last eight may run past the row: padding) */
+        for (int l = 0; l < lanes; l++) out[i + l] = spn_v3(ux[l], uy[l], uz[l]);
     }
 }
 
@@ -339,7 +336,7 @@ static void fill_slice(spn_air_field *air, air_slice *s, int64_t index)
 {
     const double t = (double)index * air->slice_dt, shift = advection(air, t);
     const int nx = air->n[0], ny = air->n[1], nz = air->n[2], nm = air->nmodes;
-    const size_t per = (size_t)nx + ny + nz;
+    const size_t per = axis_stride(nx, ny, nz), y0 = per - ny - nz;
     for (int n = 0; n < nm; n++) {
         const air_mode *m = &air->modes[n];
         double *c = air->axis_cos + (size_t)n * per, *sn = air->axis_sin + (size_t)n * per;
@@ -348,13 +345,14 @@ static void fill_slice(spn_air_field *air, air_slice *s, int64_t index)
             const double a = m->k.x * node_position(air, i, 0, 0).x;
             c[i] = cos(a), sn[i] = sin(a);
         }
+        for (size_t i = (size_t)nx; i < y0; i++) c[i] = sn[i] = 0; /* padding */
         for (int j = 0; j < ny; j++) {
             const double b = m->k.y * node_position(air, 0, j, 0).y;
-            c[nx + j] = cos(b), sn[nx + j] = sin(b);
+            c[y0 + j] = cos(b), sn[y0 + j] = sin(b);
         }
         for (int k = 0; k < nz; k++) {
             const double g = m->k.z * node_position(air, 0, 0, k).z + c0;
-            c[nx + ny + k] = cos(g), sn[nx + ny + k] = sin(g);
+            c[y0 + ny + k] = cos(g), sn[y0 + ny + k] = sin(g);
         }
     }
     for (int k = 0; k < nz; k++)
