@@ -29,15 +29,16 @@ static spn_air_field *steady(double speed, spn_vec3 dir)
     return air;
 }
 
-/* One step from rest of a free segment along x in wind `u`: the velocity each
- * end gains, divided by dt and multiplied by its mass, is the force on it. */
-static spn_vec3 force_on_end(spn_vec3 wind_dir, double speed)
+/* A radius segment 2 cm long along x between two free particles of SEG_MASS,
+ * without gravity. */
+#define SEG_MASS 1e-3
+static spn_world *segment(void)
 {
     spn_world_def wd = spn_world_def_default();
     wd.gravity = spn_v3(0, 0, 0);
     spn_world *w = spn_world_create(&wd);
     spn_particle_def p = spn_particle_def_default();
-    p.mass = 1e-3;
+    p.mass = SEG_MASS;
     spn_spring_def s = spn_spring_def_default();
     p.position = spn_v3(0, 0, 0);
     assert_int_equal(spn_world_add_particle(w, &p, &s.a), SPN_OK);
@@ -46,11 +47,19 @@ static spn_vec3 force_on_end(spn_vec3 wind_dir, double speed)
     s.k = 1;
     s.tag = SPN_THREAD_RADIUS;
     assert_int_equal(spn_world_add_spring(w, &s, NULL), SPN_OK);
+    return w;
+}
+
+/* One step from rest of a free segment along x in wind `u`: the velocity each
+ * end gains, divided by dt and multiplied by its mass, is the force on it. */
+static spn_vec3 force_on_end(spn_vec3 wind_dir, double speed)
+{
+    spn_world *w = segment();
     spn_air_field *air = steady(speed, wind_dir);
     spn_air_attach(air, w);
     const double dt = 1e-6;
     assert_int_equal(spn_world_step(w, dt), SPN_OK);
-    spn_vec3 f = spn_v3_scale(spn_world_velocity(w, 0), p.mass / dt);
+    spn_vec3 f = spn_v3_scale(spn_world_velocity(w, 0), SEG_MASS / dt);
     spn_world_destroy(w);
     spn_air_destroy(air);
     return f;
@@ -81,19 +90,7 @@ static void test_segment_drag_formula(void **state)
  * force at its own velocity, and a fixed end (at rest) none. */
 static void power_on_segment(double vz, bool fixed_end, double *power, double *expect)
 {
-    spn_world_def wd = spn_world_def_default();
-    wd.gravity = spn_v3(0, 0, 0);
-    spn_world *w = spn_world_create(&wd);
-    spn_particle_def p = spn_particle_def_default();
-    p.mass = 1e-3;
-    spn_spring_def s = spn_spring_def_default();
-    p.position = spn_v3(0, 0, 0);
-    assert_int_equal(spn_world_add_particle(w, &p, &s.a), SPN_OK);
-    p.position = spn_v3(0.02, 0, 0);
-    assert_int_equal(spn_world_add_particle(w, &p, &s.b), SPN_OK);
-    s.k = 1;
-    s.tag = SPN_THREAD_RADIUS;
-    assert_int_equal(spn_world_add_spring(w, &s, NULL), SPN_OK);
+    spn_world *w = segment();
     assert_true(spn_world_air_power(w) == 0); /* no air yet */
     spn_air_field *air = steady(2, spn_v3(0, 0, 1));
     spn_air_attach(air, w);
