@@ -84,7 +84,6 @@ static spn_status cache_springs(spn_impact *im, const spn_world *w)
     im->k = malloc(ns * sizeof *im->k + 1);
     im->kd = malloc(ns * sizeof *im->kd + 1);
     im->rest = malloc(ns * sizeof *im->rest + 1);
-    im->diam = malloc(ns * sizeof *im->diam + 1);
     im->tension_only = malloc(ns + 1);
     im->broken = malloc(ns + 1);
     im->slot = malloc(ns + 1);
@@ -98,7 +97,7 @@ static spn_status cache_springs(spn_impact *im, const spn_world *w)
     im->cend = malloc((size_t)(im->nprey ? im->nprey : 1) * ns * sizeof *im->cend + 1);
     if (!im->x0 || !im->v0 || !im->coff || !im->cend) return spn_error(SPN_ERR_NOMEM, "out of memory");
     for (size_t i = 0; i < (size_t)im->nprey * ns; i++) im->coff[i] = im->cend[i] = -1;
-    if (!im->sa || !im->sb || !im->k || !im->kd || !im->rest || !im->diam || !im->tension_only || !im->broken ||
+    if (!im->sa || !im->sb || !im->k || !im->kd || !im->rest || !im->tension_only || !im->broken ||
         !im->slot || !im->tag || !im->rest0 || !im->len0 || !im->fbuf)
         return spn_error(SPN_ERR_NOMEM, "out of memory");
     double kmax = 0;
@@ -111,7 +110,6 @@ static spn_status cache_springs(spn_impact *im, const spn_world *w)
         im->rest[s] = in.rest;
         im->rest0[s] = in.rest;
         im->len0[s] = in.length;
-        im->diam[s] = spn_thread_diameter(in.tag);
         im->tension_only[s] = in.tension_only;
         im->broken[s] = in.broken;
         im->slot[s] = (uint8_t)slot_of(im, in.tag);
@@ -241,7 +239,6 @@ void spn_impact_destroy(spn_impact *im)
     free(im->k);
     free(im->kd);
     free(im->rest);
-    free(im->diam);
     free(im->tension_only);
     free(im->broken);
     free(im->slot);

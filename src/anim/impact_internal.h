@@ -40,7 +40,7 @@ struct spn_impact {
     /* springs, cached at creation (the graph does not change) */
     uint32_t ns, np;
     uint32_t *sa, *sb;
-    double *k, *kd, *rest, *diam;
+    double *k, *kd, *rest;
     uint8_t *tension_only, *broken, *slot;
     uint32_t *tag;
     double *rest0;  /* rest lengths at creation (yield and breaking refer to them) */
