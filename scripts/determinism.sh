@@ -13,7 +13,8 @@ first=$1/spinneret
 # A web above the parallel threshold (32768 particles), so 2 threads really split the loops.
 "$first" export scene:orb:200x200 -o "$T/big.json" || exit 1
 "$first" export scene:orb:12x16 -o "$T/small.json" || exit 1
-# A species web, whose implicit steps in wind take the sparse factor (docs/physics-implicit-mg.md).
+# A species web, whose implicit steps in wind, and struck by a prey, take the sparse factor
+# (docs/physics-implicit-mg.md).
 "$first" build --species araneus -o "$T/araneus.json" || exit 1
 DATA=$(cd "$(dirname "$0")/.." && pwd)/tests/data
 
@@ -35,6 +36,7 @@ commands=(
   "animate $T/small.json -o OUTf --save-states OUT --wind air --wind-speed 3 --duration 0.2 --fps 10 --size 48x48 --quiet --solver implicit"
   "animate $T/big.json -o OUTf --save-states OUT --wind air --wind-speed 3 --duration 0.02 --fps 100 --substeps 4 --size 48x48 --quiet --solver implicit"
   "animate $T/araneus.json -o OUTf --save-states OUT --wind air --duration 0.04 --fps 50 --size 48x48 --quiet --solver implicit"
+  "animate $T/araneus.json -o OUTf --save-states OUT --duration 0.04 --fps 100 --size 48x48 --quiet --solver implicit --impact 0.03,0.02,0.01;0,0,-1;0.0002;0.006"
 )
 
 differ=0
