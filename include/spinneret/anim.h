@@ -168,9 +168,9 @@ typedef struct spn_kind_energy {
 
 typedef enum spn_prey_outcome {
     SPN_PREY_MISSED = 0,   ///< never touched a thread
-    SPN_PREY_STOPPED,      ///< arrested by the web, no longer touching it
-    SPN_PREY_PASSED,       ///< went through the web
-    SPN_PREY_BOUNCED,      ///< thrown back
+    SPN_PREY_STOPPED,      ///< arrested by the web (under half its first speed), no longer touching it
+    SPN_PREY_PASSED,       ///< went through the web (beyond it, or flying on at half its first speed or more)
+    SPN_PREY_BOUNCED,      ///< thrown back (in front of the web, or flying back at half its first speed)
     SPN_PREY_HELD          ///< stopped and still in contact with the web (touching it or glued)
 } spn_prey_outcome;
 

@@ -183,6 +183,7 @@ static spn_status add_prey(spn_impact *im, spn_world *w, const spn_prey_def *pre
         if (st != SPN_OK) return st;
         im->radius[i] = prey[i].radius;
         im->dir0[i] = spn_v3_norm(prey[i].velocity);
+        im->speed0[i] = spn_v3_len(prey[i].velocity);
     }
     im->nprey = nprey;
     return SPN_OK;

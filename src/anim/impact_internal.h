@@ -27,6 +27,7 @@ struct spn_impact {
     uint32_t prey[MAX_PREY];
     double radius[MAX_PREY];
     spn_vec3 dir0[MAX_PREY];
+    double speed0[MAX_PREY];
     bool touched[MAX_PREY];
     bool hit_known[MAX_PREY];
     spn_vec3 hit[MAX_PREY];      /* prey centre at the end of its first step in contact */
