@@ -47,8 +47,12 @@
 #include "sparse_chol.h"
 #include "world_internal.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* Prey particles whose rows prey_rows keeps exact (the impact's MAX_PREY). */
+#define SPN__PREY_ROWS_MAX 8u
 
 struct spn__imp_mg {
     spn__eq e;
@@ -70,6 +74,15 @@ struct spn__imp_mg {
     double *r, *z;     /* 3 n */
     uint64_t sig;      /* of the live springs and fixed particles it was built for */
     bool failed;       /* the build failed for this signature: block Jacobi until it changes */
+    /* Steps with contacts on the factor (prey_rows): the prey's rows and
+     * columns of A kept exactly, by their Schur complement on the factor. */
+    int32_t *local;    /* world particle -> eq id, -1 for none */
+    double h;          /* the step prepare was last asked for */
+    uint32_t nprey;    /* prey (contacts' bodies outside the system) kept so; 0: block Jacobi's */
+    uint32_t prey[SPN__PREY_ROWS_MAX];
+    double *cols;      /* 3 nprey columns of 3 n: B, the web's rows of the prey's columns of A */
+    double *xcols;     /* the same: X = F^-1 B */
+    double schur[3 * SPN__PREY_ROWS_MAX * 3 * SPN__PREY_ROWS_MAX]; /* S = C - B^T X, its Cholesky factor */
 };
 
 /* A change of choice drops the hierarchy: create() decided from the choice
@@ -114,6 +127,7 @@ void spn__imp_mg_free(spn__imp_mg *m)
     spn__chol_free(m->chol);
     spn__eq_free(&m->e);
     free(m->espring), free(m->inv0), free(m->r), free(m->z);
+    free(m->local), free(m->cols), free(m->xcols);
     free(m);
 }
 
@@ -136,12 +150,9 @@ static uint64_t signature(const spn_world *w)
 static bool map_springs(spn__imp_mg *m, const spn_world *w)
 {
     const spn__eq *e = &m->e;
-    int32_t *local = malloc((w->np ? w->np : 1) * sizeof *local);
+    int32_t *local = m->local = malloc((w->np ? w->np : 1) * sizeof *local);
     m->espring = malloc((e->m ? e->m : 1) * sizeof *m->espring);
-    if (!local || !m->espring) {
-        free(local);
-        return false;
-    }
+    if (!local || !m->espring) return false;
     for (uint32_t i = 0; i < w->np; i++) local[i] = -1;
     for (uint32_t l = 0; l < e->nl; l++) local[e->world_id[l]] = (int32_t)l;
     uint32_t k = 0;
@@ -155,7 +166,6 @@ static bool map_springs(spn__imp_mg *m, const spn_world *w)
             if (k < e->m) m->espring[k] = w->iperm[s];
             k++;
         }
-    free(local);
     return k == e->m;
 }
 
@@ -209,6 +219,31 @@ static bool in_contact(const spn_world *w, uint32_t i)
     return false;
 }
 
+/* Each active contact's coupling of its segment's ends, h^2 k (1 - u) u n n^T
+ * (contact.c), into the off-diagonal blocks of their spring's entries, for
+ * the factor (prey_rows); their diagonal parts are in level 0 already. */
+static void contact_offd(spn__imp_mg *m, const spn_world *w, double h)
+{
+    spn__eq *e = &m->e;
+    for (uint32_t k = 0; k < w->ncontacts; k++) {
+        const spn_contact *c = &w->contacts[k];
+        const int32_t a = m->local[c->a], b = m->local[c->b];
+        if (!c->active || a < 0 || b < 0 || (uint32_t)a >= e->n || (uint32_t)b >= e->n || a == b) continue;
+        const double s = h * h * c->k * (1 - c->u) * c->u;
+        const spn_vec3 n = c->n;
+        const double add[6] = {s * n.x * n.x, s * n.y * n.y, s * n.z * n.z,
+                               s * n.x * n.y, s * n.x * n.z, s * n.y * n.z};
+        for (int end = 0; end < 2; end++) {
+            const int32_t row = end ? b : a, col = end ? a : b;
+            for (uint32_t j = e->adj_start[row]; j < e->adj_start[row + 1]; j++)
+                if (e->adj_other[j] == col) { /* (the factor sums entries between one pair: the first takes it) */
+                    for (int f = 0; f < 6; f++) e->offd[6 * (size_t)j + f] += add[f];
+                    break;
+                }
+        }
+    }
+}
+
 /* Level 0 from the step's Jacobian (w->jac) and block inverses (w->pinv). */
 static void assemble(spn__imp_mg *m, const spn_world *w, double h)
 {
@@ -234,6 +269,86 @@ static void assemble(spn__imp_mg *m, const spn_world *w, double h)
             o[3] = -ax * u.x * u.y, o[4] = -ax * u.x * u.z, o[5] = -ax * u.y * u.z;
         }
     }
+    if (m->chol_on && w->ncontacts) contact_offd(m, w, h);
+}
+
+/* The prey's rows and columns of A kept exact on top of the factor F. A
+ * prey's body has no springs, so the system (level 0) leaves it out, and
+ * its contacts couple it to the web: with B the web's rows of the prey's
+ * columns (h^2 k w_e n n^T at each contact's segment ends) and C the prey's
+ * own blocks, M = [F B; B^T C] is applied through its Schur complement
+ * S = C - B^T F^-1 B, three rows a prey (spn__imp_mg_apply). CG otherwise
+ * builds these couplings an iteration at a time. Needs 3 solves a prey
+ * each time the factor or the contacts change (prepare, refactor). */
+static void prey_rows(spn__imp_mg *m, const spn_world *w, double h)
+{
+    const spn__eq *e = &m->e;
+    const size_t len = 3 * (size_t)e->n;
+    m->nprey = 0;
+    if (!m->chol_on || !m->chol_ready || !w->ncontacts || !e->n) return;
+    uint32_t np = 0;
+    for (uint32_t k = 0; k < w->ncontacts; k++) {
+        const spn_contact *c = &w->contacts[k];
+        if (!c->active || m->local[c->p] >= 0 || !(w->inv_mass[c->p] > 0)) continue;
+        uint32_t q = 0;
+        while (q < np && m->prey[q] != c->p) q++;
+        if (q == np && np < SPN__PREY_ROWS_MAX) m->prey[np++] = c->p;
+    }
+    if (!np) return;
+    if (!m->cols) {
+        m->cols = malloc(3 * SPN__PREY_ROWS_MAX * len * sizeof *m->cols);
+        m->xcols = malloc(3 * SPN__PREY_ROWS_MAX * len * sizeof *m->xcols);
+        if (!m->cols || !m->xcols) {
+            free(m->cols), free(m->xcols);
+            m->cols = m->xcols = NULL;
+            return;
+        }
+    }
+    memset(m->cols, 0, 3 * np * len * sizeof *m->cols);
+    for (uint32_t k = 0; k < w->ncontacts; k++) {
+        const spn_contact *c = &w->contacts[k];
+        uint32_t q = 0;
+        while (q < np && m->prey[q] != c->p) q++;
+        if (!c->active || q == np) continue;
+        const uint32_t ends[2] = {c->a, c->b};
+        const double wt[2] = {-(1 - c->u), -c->u}, nv[3] = {c->n.x, c->n.y, c->n.z};
+        for (int t = 0; t < 2; t++) {
+            const int32_t l = m->local[ends[t]];
+            if (l < 0 || (uint32_t)l >= e->n) continue;
+            for (int cc = 0; cc < 3; cc++)
+                for (int r = 0; r < 3; r++)
+                    m->cols[(3 * q + cc) * len + 3 * (size_t)l + r] += h * h * c->k * wt[t] * nv[r] * nv[cc];
+        }
+    }
+    for (uint32_t i = 0; i < 3 * np; i++) spn__chol_solve(m->chol, m->cols + i * len, m->xcols + i * len);
+    /* S = C - B^T X, lower triangle, then its Cholesky factor in place */
+    const uint32_t d = 3 * np;
+    double *S = m->schur;
+    for (uint32_t i = 0; i < d; i++)
+        for (uint32_t j = 0; j <= i; j++) {
+            double dot = 0;
+            for (size_t f = 0; f < len; f++) dot += m->cols[i * len + f] * m->xcols[j * len + f];
+            S[i * d + j] = -dot;
+        }
+    for (uint32_t q = 0; q < np; q++) {
+        double cq[6]; /* the prey's block: its block Jacobi inverse inverted back */
+        spn__invert_sym3(w->pinv + 6 * (size_t)m->prey[q], cq);
+        static const uint8_t sym[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b <= a; b++) S[(3 * q + a) * d + 3 * q + b] += cq[sym[a][b]];
+    }
+    for (uint32_t j = 0; j < d; j++) {
+        double djj = S[j * d + j];
+        for (uint32_t k = 0; k < j; k++) djj -= S[j * d + k] * S[j * d + k];
+        if (!(djj > 0) || !isfinite(djj)) return; /* not definite (a stale factor): block Jacobi's blocks */
+        S[j * d + j] = sqrt(djj);
+        for (uint32_t i = j + 1; i < d; i++) {
+            double v = S[i * d + j];
+            for (uint32_t k = 0; k < j; k++) v -= S[i * d + k] * S[j * d + k];
+            S[i * d + j] = v / S[j * d + j];
+        }
+    }
+    m->nprey = np;
 }
 
 /* A factorisation of level 0 (assemble): false when the matrix is not
@@ -279,6 +394,8 @@ bool spn__imp_mg_prepare(spn_world *w, double h)
         w->imp_mg->sig = sig;
     }
     spn__imp_mg *m = w->imp_mg;
+    m->h = h;
+    m->nprey = 0;
     if (m->failed || m->e.n == 0) return false;
     if (w->implicit_pc == 0 && !auto_mg && !m->cyc) return false; /* a short step without the cyclic one */
     /* A small web's steps with contacts take the factor, or block Jacobi.
@@ -302,7 +419,10 @@ bool spn__imp_mg_prepare(spn_world *w, double h)
             m->chol_h = h;
         }
         m->chol_stale = false;
-        if (m->chol_ready) return true;
+        if (m->chol_ready) {
+            prey_rows(m, w, h);
+            return true;
+        }
         spn__chol_free(m->chol); /* not definite: the multigrid from here on */
         m->chol = NULL;
         m->chol_on = false;
@@ -340,7 +460,29 @@ void spn__imp_mg_apply(const spn_world *w, const spn_vec3 *r, spn_vec3 *z)
     if (m->chol_on) spn__chol_solve(m->chol, m->r, m->z);
     else if (m->cyc) spn__cyc_apply(m->cyc, e, m->r, m->z);
     else spn__mg_apply(m->mg, e, m->r, m->z);
+    double t[3 * SPN__PREY_ROWS_MAX];
+    const uint32_t d = m->chol_on ? 3 * m->nprey : 0;
+    if (d) { /* the prey's rows (prey_rows): t = S^-1 (r_p - B^T y), then y -= X t */
+        const size_t len = 3 * (size_t)n;
+        for (uint32_t i = 0; i < d; i++) {
+            double v = (&r[m->prey[i / 3]].x)[i % 3];
+            for (size_t f = 0; f < len; f++) v -= m->cols[i * len + f] * m->z[f];
+            t[i] = v;
+        }
+        const double *S = m->schur;
+        for (uint32_t i = 0; i < d; i++) {
+            for (uint32_t k = 0; k < i; k++) t[i] -= S[i * d + k] * t[k];
+            t[i] /= S[i * d + i];
+        }
+        for (uint32_t i = d; i-- > 0;) {
+            for (uint32_t k = i + 1; k < d; k++) t[i] -= S[k * d + i] * t[k];
+            t[i] /= S[i * d + i];
+        }
+        for (uint32_t i = 0; i < d; i++)
+            for (size_t f = 0; f < len; f++) m->z[f] -= m->xcols[i * len + f] * t[i];
+    }
     for (uint32_t i = 0; i < n; i++) memcpy(&z[e->world_id[i]], m->z + 3 * (size_t)i, 3 * sizeof(double));
+    for (uint32_t q = 0; 3 * q < d; q++) z[m->prey[q]] = spn_v3(t[3 * q], t[3 * q + 1], t[3 * q + 2]);
 }
 
 bool spn__imp_mg_refactor(spn_world *w)
@@ -353,6 +495,7 @@ bool spn__imp_mg_refactor(spn_world *w)
      * fails too */
     m->chol_ready = factorise(w, m);
     m->chol_fresh = true;
+    prey_rows(m, w, m->h);
     /* A factor that one step has outrun says the next will outrun this one
      * too: the next steps factorise at their start, 1, 2, 4 ... 16 of them
      * as such steps keep coming (a kept factor that serves resets it). */
