@@ -79,6 +79,7 @@ struct spn__imp_mg {
     int32_t *local;    /* world particle -> eq id, -1 for none */
     double h;          /* the step prepare was last asked for */
     uint32_t nprey;    /* prey (contacts' bodies outside the system) kept so; 0: block Jacobi's */
+    uint32_t cols_cap; /* prey the columns have room for */
     uint32_t prey[SPN__PREY_ROWS_MAX];
     double *cols;      /* 3 nprey columns of 3 n: B, the web's rows of the prey's columns of A */
     double *xcols;     /* the same: X = F^-1 B */
@@ -295,14 +296,12 @@ static void prey_rows(spn__imp_mg *m, const spn_world *w, double h)
         if (q == np && np < SPN__PREY_ROWS_MAX) m->prey[np++] = c->p;
     }
     if (!np) return;
-    if (!m->cols) {
-        m->cols = malloc(3 * SPN__PREY_ROWS_MAX * len * sizeof *m->cols);
-        m->xcols = malloc(3 * SPN__PREY_ROWS_MAX * len * sizeof *m->xcols);
-        if (!m->cols || !m->xcols) {
-            free(m->cols), free(m->xcols);
-            m->cols = m->xcols = NULL;
-            return;
-        }
+    if (np > m->cols_cap) { /* (out of memory: block Jacobi's blocks for the prey) */
+        free(m->cols), free(m->xcols);
+        m->cols = malloc(3 * np * len * sizeof *m->cols);
+        m->xcols = malloc(3 * np * len * sizeof *m->xcols);
+        m->cols_cap = m->cols && m->xcols ? np : 0;
+        if (!m->cols_cap) return;
     }
     memset(m->cols, 0, 3 * np * len * sizeof *m->cols);
     for (uint32_t k = 0; k < w->ncontacts; k++) {
