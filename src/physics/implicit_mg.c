@@ -43,6 +43,7 @@
  * differs from block Jacobi's only within the solver tolerance; every product
  * is summed in a fixed order, so the bits do not depend on the thread count. */
 #include "core/big_alloc.h"
+#include "equilibrium_bsr.h"
 #include "equilibrium_internal.h"
 #include "sparse_chol.h"
 #include "world_internal.h"
@@ -281,6 +282,14 @@ static void assemble(spn__imp_mg *m, const spn_world *w, double h)
  * S = C - B^T F^-1 B, three rows a prey (spn__imp_mg_apply). CG otherwise
  * builds these couplings an iteration at a time. Needs 3 solves a prey
  * each time the factor or the contacts change (prepare, refactor). */
+/* The slot of prey particle p among the first np of m->prey (np: none). */
+static uint32_t prey_slot(const spn__imp_mg *m, uint32_t np, uint32_t p)
+{
+    uint32_t q = 0;
+    while (q < np && m->prey[q] != p) q++;
+    return q;
+}
+
 static void prey_rows(spn__imp_mg *m, const spn_world *w, double h)
 {
     const spn__eq *e = &m->e;
@@ -291,9 +300,7 @@ static void prey_rows(spn__imp_mg *m, const spn_world *w, double h)
     for (uint32_t k = 0; k < w->ncontacts; k++) {
         const spn_contact *c = &w->contacts[k];
         if (!c->active || m->local[c->p] >= 0 || !(w->inv_mass[c->p] > 0)) continue;
-        uint32_t q = 0;
-        while (q < np && m->prey[q] != c->p) q++;
-        if (q == np && np < SPN__PREY_ROWS_MAX) m->prey[np++] = c->p;
+        if (prey_slot(m, np, c->p) == np && np < SPN__PREY_ROWS_MAX) m->prey[np++] = c->p;
     }
     if (!np) return;
     if (np > m->cols_cap) { /* (out of memory: block Jacobi's blocks for the prey) */
@@ -306,8 +313,7 @@ static void prey_rows(spn__imp_mg *m, const spn_world *w, double h)
     memset(m->cols, 0, 3 * np * len * sizeof *m->cols);
     for (uint32_t k = 0; k < w->ncontacts; k++) {
         const spn_contact *c = &w->contacts[k];
-        uint32_t q = 0;
-        while (q < np && m->prey[q] != c->p) q++;
+        const uint32_t q = prey_slot(m, np, c->p);
         if (!c->active || q == np) continue;
         const uint32_t ends[2] = {c->a, c->b};
         const double wt[2] = {-(1 - c->u), -c->u}, nv[3] = {c->n.x, c->n.y, c->n.z};
@@ -336,17 +342,10 @@ static void prey_rows(spn__imp_mg *m, const spn_world *w, double h)
         for (int a = 0; a < 3; a++)
             for (int b = 0; b <= a; b++) S[(3 * q + a) * d + 3 * q + b] += cq[sym[a][b]];
     }
-    for (uint32_t j = 0; j < d; j++) {
-        double djj = S[j * d + j];
-        for (uint32_t k = 0; k < j; k++) djj -= S[j * d + k] * S[j * d + k];
-        if (!(djj > 0) || !isfinite(djj)) return; /* not definite (a stale factor): block Jacobi's blocks */
-        S[j * d + j] = sqrt(djj);
-        for (uint32_t i = j + 1; i < d; i++) {
-            double v = S[i * d + j];
-            for (uint32_t k = 0; k < j; k++) v -= S[i * d + k] * S[j * d + k];
-            S[i * d + j] = v / S[j * d + j];
-        }
-    }
+    /* not definite (a stale factor): block Jacobi's blocks */
+    if (!spn__dense_cholesky(S, d, 1)) return;
+    for (uint32_t j = 0; j < d; j++)
+        if (!isfinite(S[j * d + j])) return;
     m->nprey = np;
 }
 
@@ -460,7 +459,7 @@ void spn__imp_mg_apply(const spn_world *w, const spn_vec3 *r, spn_vec3 *z)
     else if (m->cyc) spn__cyc_apply(m->cyc, e, m->r, m->z);
     else spn__mg_apply(m->mg, e, m->r, m->z);
     double t[3 * SPN__PREY_ROWS_MAX];
-    const uint32_t d = m->chol_on ? 3 * m->nprey : 0;
+    const uint32_t d = 3 * m->nprey; /* (0 unless the factor preconditions: prey_rows) */
     if (d) { /* the prey's rows (prey_rows): t = S^-1 (r_p - B^T y), then y -= X t */
         const size_t len = 3 * (size_t)n;
         for (uint32_t i = 0; i < d; i++) {
@@ -468,15 +467,7 @@ void spn__imp_mg_apply(const spn_world *w, const spn_vec3 *r, spn_vec3 *z)
             for (size_t f = 0; f < len; f++) v -= m->cols[i * len + f] * m->z[f];
             t[i] = v;
         }
-        const double *S = m->schur;
-        for (uint32_t i = 0; i < d; i++) {
-            for (uint32_t k = 0; k < i; k++) t[i] -= S[i * d + k] * t[k];
-            t[i] /= S[i * d + i];
-        }
-        for (uint32_t i = d; i-- > 0;) {
-            for (uint32_t k = i + 1; k < d; k++) t[i] -= S[k * d + i] * t[k];
-            t[i] /= S[i * d + i];
-        }
+        spn__dense_cholesky_solve(m->schur, d, t, t, 1);
         for (uint32_t i = 0; i < d; i++)
             for (size_t f = 0; f < len; f++) m->z[f] -= m->xcols[i * len + f] * t[i];
     }
