@@ -29,7 +29,7 @@ typedef struct chunk {
 /* Springs hs[0..n) into the chunk. A spring whose end b is at or past
  * b_limit is loaded as if both ends were a (no force; the caller has its
  * force from elsewhere and must not read b: another thread may be moving it). */
-static inline void chunk_load(chunk *restrict c, const spn__spring *restrict hs, uint32_t n,
+SPN__INLINE void chunk_load(chunk *restrict c, const spn__spring *restrict hs, uint32_t n,
                               const spn_vec3 *restrict x, const spn_vec3 *restrict v, uint32_t b_limit)
 {
     for (uint32_t j = 0; j < n; j++) {
@@ -45,7 +45,7 @@ static inline void chunk_load(chunk *restrict c, const spn__spring *restrict hs,
 
 /* Force on end a of each spring of the chunk, into fs; the elastic energy,
  * and damping power of each into c->e, c->p. */
-static inline void chunk_forces(chunk *restrict c, uint32_t n, spn_vec3 *restrict fs)
+SPN__INLINE void chunk_forces(chunk *restrict c, uint32_t n, spn_vec3 *restrict fs)
 {
     for (uint32_t j = 0; j < n; j++) {
         const double lx = c->lx[j], ly = c->ly[j], lz = c->lz[j];
@@ -72,7 +72,7 @@ static inline void chunk_forces(chunk *restrict c, uint32_t n, spn_vec3 *restric
 
 /* Adds the chunk's sums to out[0..1], four independent partial sums each
  * (a fixed order, whatever the vector width of the loop above). */
-static inline void chunk_sums(const chunk *restrict c, uint32_t n, double *out)
+SPN__INLINE void chunk_sums(const chunk *restrict c, uint32_t n, double *out)
 {
     double e0 = 0, e1 = 0, e2 = 0, e3 = 0, p0 = 0, p1 = 0, p2 = 0, p3 = 0;
     uint32_t j = 0;
@@ -87,7 +87,7 @@ static inline void chunk_sums(const chunk *restrict c, uint32_t n, double *out)
 
 
 /* Springs list[0..n) (internal ids) into the chunk. */
-static inline void chunk_load_list(chunk *restrict c, const spn__spring *restrict hs, const uint32_t *restrict list,
+SPN__INLINE void chunk_load_list(chunk *restrict c, const spn__spring *restrict hs, const uint32_t *restrict list,
                                    uint32_t n, const spn_vec3 *restrict x, const spn_vec3 *restrict v)
 {
     for (uint32_t j = 0; j < n; j++) {

@@ -111,7 +111,7 @@ typedef struct sweep_args {
 } sweep_args;
 
 /* Move particles [i, end) with complete forces; the particle sums into p. */
-static inline void move(const sweep_args *s, uint32_t i, uint32_t end, double *p)
+SPN__INLINE void move(const sweep_args *s, uint32_t i, uint32_t end, double *p)
 {
     for (; i < end; i++) {
         const spn_vec3 xi = s->x[i], vi = s->v[i];

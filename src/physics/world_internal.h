@@ -289,7 +289,7 @@ double spn__gravity_energy(const spn_world *w, const spn_vec3 *x);
  * (otherwise it reloads every pointer from the world on every particle). */
 /* a s + b, each component one fused multiply-add (the explicit steps'
  * update: v' = v + f dt/m, x' = x + v' dt). */
-static inline spn_vec3 spn__fma_v3(spn_vec3 a, double s, spn_vec3 b)
+SPN__INLINE spn_vec3 spn__fma_v3(spn_vec3 a, double s, spn_vec3 b)
 {
     return spn_v3(fma(a.x, s, b.x), fma(a.y, s, b.y), fma(a.z, s, b.z));
 }
@@ -313,7 +313,7 @@ static inline spn__gather_ctx spn__gather_ctx_of(const spn_world *w)
  * `fused` (the explicit steps: explicit.c, sweep.c; the lattice's explicit
  * rows give the same bits), two roundings otherwise (RK4, the evaluations
  * of the other steppers). */
-static inline spn_vec3 spn__gravity_drag(double m, double dm, spn_vec3 g, spn_vec3 v, bool fused)
+SPN__INLINE spn_vec3 spn__gravity_drag(double m, double dm, spn_vec3 g, spn_vec3 v, bool fused)
 {
     if (fused) return spn_v3(fma(-dm, v.x, m * g.x), fma(-dm, v.y, m * g.y), fma(-dm, v.z, m * g.z));
     return spn_v3(m * g.x - dm * v.x, m * g.y - dm * v.y, m * g.z - dm * v.z);
@@ -323,7 +323,7 @@ static inline spn_vec3 spn__gravity_drag(double m, double dm, spn_vec3 g, spn_ve
  * fused or not), its springs (from fs: first those it is end a of, a
  * contiguous run, then those it is end b of, in internal order) and, when
  * `has_ext`, fext[i]. */
-static inline spn_vec3 spn__force_on(const spn__gather_ctx *c, uint32_t i, spn_vec3 vi, bool has_ext, bool fused)
+SPN__INLINE spn_vec3 spn__force_on(const spn__gather_ctx *c, uint32_t i, spn_vec3 vi, bool has_ext, bool fused)
 {
     const double m = c->mass[i];
     spn_vec3 fi = spn__gravity_drag(m, c->drag * m, c->g, vi, fused);
