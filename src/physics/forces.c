@@ -73,13 +73,57 @@ static const double blend_poly[17] = {
     9.09210488125413742e-10, 2.45590112304863142e-10};
 
 /* blend_poly at t. */
-static double blend(double t)
+SPN__INLINE double blend(double t)
 {
     const double *a = blend_poly, t2 = t * t, t4 = t2 * t2, t8 = t4 * t4;
     double q[8];
     for (int i = 0; i < 8; i++) q[i] = a[2 * i] + a[2 * i + 1] * t;
     const double r0 = q[0] + q[1] * t2, r1 = q[2] + q[3] * t2, r2 = q[4] + q[5] * t2, r3 = q[6] + q[7] * t2;
     return ((r0 + r1 * t4) + (r2 + r3 * t4) * t8) + a[16] * (t8 * t8);
+}
+
+/* ln x for a finite x > 0 (subnormal too), in plain operations and bit
+ * moves that GCC vectorises, each version to the same bits (libm's log is
+ * a call a loop cannot vectorise). x = 2^e m with m in [sqrt(1/2),
+ * sqrt(2)), found from x's bits (e as a double by the 2^52 trick: no
+ * integer conversion, which AVX2 lacks for 64-bit lanes); ln m = 2
+ * atanh(s), s = (m - 1) / (m + 1), |s| < 0.1716, by its series to s^21
+ * (the next term is under 1e-18 of the sum); e ln 2 in two parts, the
+ * first exact. Within 2 ulp of ln x (tests/test_physics_air.c checks it
+ * through Lamb's law against libm's log). */
+SPN__INLINE double ln_pos(double x)
+{
+    const bool sub = x < 0x1p-1022;
+    const double y = sub ? x * 0x1p54 : x;
+    uint64_t b, eb;
+    memcpy(&b, &y, sizeof b);
+    eb = (b >> 52) | UINT64_C(0x4330000000000000); /* 2^52 + the biased exponent */
+    b = (b & UINT64_C(0x000fffffffffffff)) | UINT64_C(0x3ff0000000000000);
+    double m, e2;
+    memcpy(&m, &b, sizeof m), memcpy(&e2, &eb, sizeof e2);
+    const bool big = m > 1.4142135623730951; /* (sqrt 2) */
+    m = big ? 0.5 * m : m;
+    const double e = (e2 - 0x1p52) - (sub ? 1077.0 : 1023.0) + (big ? 1.0 : 0.0);
+    const double f = m - 1, s = f / (m + 1), z = s * s;
+    double p = 1.0 / 21;
+    static const double odd[9] = {1.0 / 19, 1.0 / 17, 1.0 / 15, 1.0 / 13, 1.0 / 11,
+                                  1.0 / 9,  1.0 / 7,  1.0 / 5,  1.0 / 3};
+    for (int i = 0; i < 9; i++) p = odd[i] + z * p;
+    const double two_s = 2 * s, ln_m = two_s + two_s * (z * p);
+    /* (ln 2 = LN2_HI + LN2_LO; LN2_HI has 32 significant bits, so e LN2_HI is exact) */
+    const double LN2_HI = 6.93147180369123816490e-01, LN2_LO = 1.90821492927058770002e-10;
+    return e * LN2_HI + (ln_m + e * LN2_LO);
+}
+
+/* C_d for 0 < re < 2 (spn_cylinder_drag_coefficient): Lamb's law up to
+ * Re 0.5, the blend above. Both are formed and one is selected, so that
+ * air_forces' loop over many segments vectorises. */
+SPN__INLINE double drag_coefficient_low(double re)
+{
+    const double ln_re = ln_pos(re);
+    const double lamb = 8 * SPN_PI / (re * (2.002 - ln_re));
+    const double mid = blend(ln_re / 0.69314718055994530942); /* (ln 2) */
+    return re <= 0.5 ? lamb : mid;
 }
 
 double spn_cylinder_drag_coefficient(double re)
@@ -93,18 +137,17 @@ double spn_cylinder_drag_coefficient(double re)
     if (!(re > 0)) return 0;
     if (re > 2e5) re = 2e5; /* beyond the drag crisis the thread would have snapped */
     if (re >= 2) return 1 + 10 / pow(re, 2.0 / 3.0);
-    const double ln_re = log(re);
-    if (re <= 0.5) return 8 * SPN_PI / (re * (2.002 - ln_re));
-    return blend(ln_re / 0.69314718055994530942); /* (ln 2) */
+    return drag_coefficient_low(re);
 }
 
 /* Air forces on segments [lo, hi) (both ends together) and their linear
  * coefficients c (F = c u_n), at the state (x, v) with air velocity
  * w->wind[s], into w->fair and w->cair: the drag of docs/physics.md on the
  * normal component u_n of the air relative to the segment's midpoint.
- * Three passes over chunks of SPN_CHUNK, so that the first and the last
- * vectorise: the geometry up to the Reynolds number, the drag coefficient
- * (a library logarithm or power, one segment at a time), then the force.
+ * Three passes over chunks of SPN_CHUNK, each vectorised: the geometry up
+ * to the Reynolds number, the drag coefficient (silk's Re under 2 with
+ * ln_pos; libm's power, one segment at a time, for the rare others), then
+ * the force.
  * Each operation is the one-segment code's, in its order, so every
  * version gives its bits; a segment without diameter, broken, of zero
  * length or in still relative air gets exact zeros, selected after. One
@@ -144,8 +187,12 @@ SPN__KERNEL static void air_forces(spn_world *w, uint32_t lo, uint32_t hi, const
             re[j] = on ? rho * sp * d[j] / mu : -1;                                         /* (-1: off) */
             len[j] = l, speed[j] = sp, ux[j] = nx, uy[j] = ny, uz[j] = nz;
         }
+        /* (silk's Re, under 2, in a loop GCC vectorises; any other Re, and
+         * the segments off, after it, one at a time) */
         for (uint32_t j = 0; j < n; j++)
-            cd[j] = re[j] >= 0 ? spn_cylinder_drag_coefficient(re[j]) : 0;
+            cd[j] = drag_coefficient_low(re[j] > 0 && re[j] < 2 ? re[j] : 1);
+        for (uint32_t j = 0; j < n; j++)
+            if (!(re[j] > 0 && re[j] < 2)) cd[j] = re[j] >= 0 ? spn_cylinder_drag_coefficient(re[j]) : 0;
         for (uint32_t j = 0; j < n; j++) {
             const bool on = re[j] >= 0;
             const double cj = 0.5 * rho * cd[j] * d[j] * len[j] * speed[j];
