@@ -295,6 +295,57 @@ static void test_batch_samples_same_bits(void **state)
     spn_air_destroy(air);
 }
 
+/* A slice fills only the grid rows the samples have touched, ROW_MARGIN
+ * more on each side (wind_air.c): the values there are the bits of a
+ * slice filled whole; a point beyond them takes the exact field until the
+ * next spn_air_prepare, which fills its rows too. */
+static void test_slices_fill_the_rows_sampled(void **state)
+{
+    (void)state;
+    spn_air_def d = spn_air_def_default();
+    d.turbulence = 0.3;
+    spn_air_field *lazy, *whole;
+    assert_int_equal(spn_air_create(&d, &lazy), SPN_OK);
+    assert_int_equal(spn_air_create(&d, &whole), SPN_OK);
+    const spn_vec3 lo = spn_v3(-0.3, -0.3, -0.3), hi = spn_v3(0.3, 0.3, 0.3);
+    assert_int_equal(spn_air_set_grid(lazy, lo, hi, 20, 20, 20, 5e-3), SPN_OK);
+    assert_int_equal(spn_air_set_grid(whole, lo, hi, 20, 20, 20, 5e-3), SPN_OK);
+    enum { N = 400 };
+    spn_vec3 p[N], a[N], b[N];
+    spn_rng rng;
+    spn_rng_seed(&rng, 5);
+    for (int i = 0; i < N; i++) /* a sheet: a band of y, a few rows of z */
+        p[i] = spn_v3(spn_rng_range(&rng, -0.3, 0.3), spn_rng_range(&rng, -0.1, 0.1), spn_rng_range(&rng, -0.01, 0.01));
+    /* the first slices whole, then samples on the sheet */
+    assert_int_equal(spn_air_prepare(lazy, 1.0, 1.001), SPN_OK);
+    spn_air_sample_batch(lazy, 1.0, p, a, N);
+    /* ten slices on: new slices, filled for the sheet's rows only */
+    const double t = 1.05;
+    assert_int_equal(spn_air_prepare(lazy, t, t + 1e-3), SPN_OK);
+    assert_int_equal(spn_air_prepare(whole, t, t + 1e-3), SPN_OK);
+    spn_air_sample_batch(lazy, t, p, a, N);
+    spn_air_sample_batch(whole, t, p, b, N);
+    assert_memory_equal(a, b, sizeof a);
+    /* a point far off the sheet: the field itself, in a batch and alone */
+    const spn_vec3 q[2] = {spn_v3(0.1, 0.25, 0.2), spn_v3(-0.2, -0.25, -0.25)};
+    spn_vec3 u[2], w[2];
+    spn_air_sample_batch(lazy, t, q, u, 2);
+    for (int i = 0; i < 2; i++) {
+        const spn_vec3 exact = spn_air_velocity(lazy, t, q[i]), one = spn_air_sample(lazy, t, q[i]);
+        assert_memory_equal(&u[i], &exact, sizeof exact);
+        assert_memory_equal(&one, &exact, sizeof exact);
+    }
+    /* the next prepare fills their rows: interpolated as a whole slice is */
+    assert_int_equal(spn_air_prepare(lazy, t, t + 1e-3), SPN_OK);
+    spn_air_sample_batch(lazy, t, q, u, 2);
+    spn_air_sample_batch(whole, t, q, w, 2);
+    assert_memory_equal(u, w, sizeof u);
+    assert_false(memcmp(&u[0], &(spn_vec3){0, 0, 0}, sizeof u[0]) == 0);
+    printf("# slices filled for the rows sampled: the bits of whole slices; off them the exact field\n");
+    spn_air_destroy(lazy);
+    spn_air_destroy(whole);
+}
+
 /* A web in turbulent air stepped on 1 and 2 threads: the samples of a
  * pure air function (spn_air_attach declares spn_air_sample so) are taken
  * on the world's threads, and the states are the same bits as on one
@@ -382,6 +433,7 @@ int main(void)
         cmocka_unit_test(test_web_billows_with_speed),
         cmocka_unit_test(test_turbulence_statistics),
         cmocka_unit_test(test_batch_samples_same_bits),
+        cmocka_unit_test(test_slices_fill_the_rows_sampled),
         cmocka_unit_test(test_air_on_threads),
         cmocka_unit_test(test_rejects_bad_air),
     };

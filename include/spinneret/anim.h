@@ -85,6 +85,10 @@ SPN_API spn_vec3 spn_air_mean(const spn_air_field *air, double t);
 /// outside are clamped to the box. Then spn_air_prepare(t0, t1) before each
 /// step makes the time slices covering [t0, t1] ready, and spn_air_sample
 /// interpolates (times outside the prepared slices are evaluated exactly).
+/// A slice holds the grid rows (along x) the samples have touched since the
+/// grid was set, and two more on each side, all of them before the first
+/// sample; a point in a row a slice lacks is evaluated exactly until the
+/// next spn_air_prepare, which adds its rows.
 SPN_API spn_status spn_air_set_grid(spn_air_field *air, spn_vec3 lo, spn_vec3 hi, int nx, int ny, int nz,
                                     double slice_dt);
 SPN_API spn_status spn_air_prepare(spn_air_field *air, double t0, double t1);

@@ -23,16 +23,21 @@
  * reads, so the world may sample from several threads. A slice is filled
  * without a cosine per node and mode: on the grid a mode's phase is a sum
  * a_i + b_j + c_k over the three axes, so its cosine is the real part of
- * e^(i a_i) e^(i b_j) e^(i c_k), factors taken once per axis node (fill_slice). */
+ * e^(i a_i) e^(i b_j) e^(i c_k), factors taken once per axis node (fill_rows). */
 #include "anim_internal.h"
 
 #include "core/kernel.h"
 
+#include <limits.h>
 #include <math.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
 #define GUST_SINES 6
+/* Grid rows a slice fills beyond those the samples have touched (see
+ * air_rows). */
+#define ROW_MARGIN 2
 #define MAX_SLICES 8
 
 typedef struct air_mode {
@@ -50,9 +55,16 @@ typedef struct air_time {
     double f;
 } air_time;
 
+/* A rectangle of grid rows (j along y, k along z; a row is every node
+ * along x): j0..j1, k0..k1, inclusive; empty when j0 > j1. */
+typedef struct air_rows {
+    int j0, j1, k0, k1;
+} air_rows;
+
 typedef struct air_slice {
     int64_t index;    /* time = index * slice_dt; INT64_MIN when empty */
     spn_vec3 *u;      /* turbulent velocity at the grid nodes */
+    air_rows have;    /* the rows filled (the others hold nothing) */
 } air_slice;
 
 struct spn_air_field {
@@ -67,13 +79,22 @@ struct spn_air_field {
     int n[3];
     double slice_dt;
     air_slice slices[MAX_SLICES];
-    /* fill_slice's scratch: per mode cos and sin of its phase along each
+    /* fill_rows' scratch: per mode cos and sin of its phase along each
      * axis (axis_stride: n[0] rounded up to eight, zeros past it, then
      * n[1] + n[2]), and a grid row's sums */
     double *axis_cos, *axis_sin, *row;
     /* the times spn_air_prepare was last told of (t0, t1 and their
      * midpoint), at which a step samples every segment */
     air_time times[3];
+    /* The rows the samples have touched (their cells' corners): the lowest
+     * and highest j and k, kept by the samplers (several threads) and read
+     * by spn_air_prepare, which fills those rows, ROW_MARGIN more on each
+     * side, and no others. A web is a sheet in a box grown by half its
+     * size on every side: in 0.3 s of --wind air the README's physical web
+     * touched 390 of its 48 x 48 x 30 grid's 1,440 rows, the Araneus web
+     * in 2 s 108 of its 26 x 14 = 364. Empty (INT_MAX, INT_MIN, ...) until the first
+     * sample; the first slices are filled whole. */
+    atomic_int seen[4];
 };
 
 spn_air_def spn_air_def_default(void)
@@ -232,6 +253,44 @@ spn_vec3 spn_air_velocity(const spn_air_field *air, double t, spn_vec3 p)
  * multiple of eight (slice_row reads eight at a time), then y and z. */
 static size_t axis_stride(int nx, int ny, int nz) { return ((size_t)nx + 7) / 8 * 8 + (size_t)ny + nz; }
 
+static spn_vec3 node_position(const spn_air_field *air, int i, int j, int k)
+{
+    return spn_v3(air->lo.x + (air->hi.x - air->lo.x) * i / (air->n[0] - 1),
+                  air->lo.y + (air->hi.y - air->lo.y) * j / (air->n[1] - 1),
+                  air->lo.z + (air->hi.z - air->lo.z) * k / (air->n[2] - 1));
+}
+
+/* No rows touched yet (air_rows: empty). */
+static void forget_rows(spn_air_field *air)
+{
+    atomic_store_explicit(&air->seen[0], INT_MAX, memory_order_relaxed);
+    atomic_store_explicit(&air->seen[1], INT_MIN, memory_order_relaxed);
+    atomic_store_explicit(&air->seen[2], INT_MAX, memory_order_relaxed);
+    atomic_store_explicit(&air->seen[3], INT_MIN, memory_order_relaxed);
+}
+
+/* Each mode's cosines and sines of its phase along x and y (fill_rows):
+ * they do not depend on time, so they are taken once per grid; along z the
+ * phase holds the time's part too (fill_rows). */
+static void axis_factors_xy(spn_air_field *air)
+{
+    const int nx = air->n[0], ny = air->n[1], nz = air->n[2];
+    const size_t per = axis_stride(nx, ny, nz), y0 = per - ny - nz;
+    for (int n = 0; n < air->nmodes; n++) {
+        const air_mode *m = &air->modes[n];
+        double *c = air->axis_cos + (size_t)n * per, *sn = air->axis_sin + (size_t)n * per;
+        for (int i = 0; i < nx; i++) {
+            const double a = m->k.x * node_position(air, i, 0, 0).x;
+            c[i] = cos(a), sn[i] = sin(a);
+        }
+        for (size_t i = (size_t)nx; i < y0; i++) c[i] = sn[i] = 0; /* padding */
+        for (int j = 0; j < ny; j++) {
+            const double b = m->k.y * node_position(air, 0, j, 0).y;
+            c[y0 + j] = cos(b), sn[y0 + j] = sin(b);
+        }
+    }
+}
+
 spn_status spn_air_set_grid(spn_air_field *air, spn_vec3 lo, spn_vec3 hi, int nx, int ny, int nz, double slice_dt)
 {
     if (nx < 2 || ny < 2 || nz < 2 || (int64_t)nx * ny * nz > 1 << 22)
@@ -247,6 +306,7 @@ spn_status spn_air_set_grid(spn_air_field *air, spn_vec3 lo, spn_vec3 hi, int nx
         ((double *)u)[3 * nodes] = 0;
         air->slices[i].u = u;
         air->slices[i].index = INT64_MIN;
+        air->slices[i].have = (air_rows){0, -1, 0, -1};
     }
     const size_t axes = (size_t)air->nmodes * axis_stride(nx, ny, nz);
     double *c = realloc(air->axis_cos, axes * sizeof *c);
@@ -264,14 +324,9 @@ spn_status spn_air_set_grid(spn_air_field *air, spn_vec3 lo, spn_vec3 hi, int nx
     air->n[1] = ny;
     air->n[2] = nz;
     air->slice_dt = slice_dt;
+    forget_rows(air);
+    axis_factors_xy(air);
     return SPN_OK;
-}
-
-static spn_vec3 node_position(const spn_air_field *air, int i, int j, int k)
-{
-    return spn_v3(air->lo.x + (air->hi.x - air->lo.x) * i / (air->n[0] - 1),
-                  air->lo.y + (air->hi.y - air->lo.y) * j / (air->n[1] - 1),
-                  air->lo.z + (air->hi.z - air->lo.z) * k / (air->n[2] - 1));
 }
 
 /* Eight numbers on one vector (GCC vector extension: AVX-512, AVX pairs,
@@ -280,7 +335,7 @@ static spn_vec3 node_position(const spn_air_field *air, int i, int j, int k)
 typedef double air_v8 __attribute__((vector_size(8 * sizeof(double))));
 
 /* Grid row (j, k) of a slice into `out`: each node's turbulent velocity,
- * the modes added in their order (see fill_slice); `w` is 2 nmodes doubles
+ * the modes added in their order (see fill_rows); `w` is 2 nmodes doubles
  * of scratch. Eight nodes at a time, their sums held in vectors through
  * all the modes (a node's sum is the same sequence of operations as one
  * node at a time; the row's last eight may reach into the x axis'
@@ -317,7 +372,9 @@ SPN__KERNEL static void slice_row(const spn_air_field *air, int j, int k, double
     }
 }
 
-/* Slice `index`: the turbulent velocity at every grid node. Mode n's phase
+/* Slice `index`'s rows r (a slice of another index is emptied first): the
+ * turbulent velocity at their nodes, the rows it has left as they are; r
+ * holds the rows it has (spn_air_prepare). Mode n's phase
  * at node (i, j, k) is k_n . (p - d X(t)) + w_n t + phi_n = A_i + B_j + C_k,
  * with A_i = k_x x_i, B_j = k_y y_j and C_k = k_z z_k plus the constant part.
  * Its cosine is cos A cos(B + C) - sin A sin(B + C), the angle sum B + C
@@ -333,9 +390,15 @@ SPN__KERNEL static void slice_row(const spn_air_field *air, int j, int k, double
  * buffers too). Since the rows are a vectorised kernel (slice_row) a 48^3
  * slice takes 3.3-3.7 ms against 4.2-4.3 in steady use; since slice_row
  * keeps eight nodes' sums in vectors through the modes (forty-ninth
- * session), 1.65 (16^3: 0.184 -> 0.101), with the same bits. */
-static void fill_slice(spn_air_field *air, air_slice *s, int64_t index)
+ * session), 1.65 (16^3: 0.184 -> 0.101), with the same bits. Since the
+ * fifty-second session the x and y factors are taken once per grid and a
+ * slice fills the rows its samples need (air_rows): a value is the same
+ * bits as in a slice filled whole. */
+static void fill_rows(spn_air_field *air, air_slice *s, int64_t index, air_rows r)
 {
+    if (s->index != index) s->index = index, s->have = (air_rows){0, -1, 0, -1};
+    const air_rows h = s->have;
+    if (r.j0 >= h.j0 && r.j1 <= h.j1 && r.k0 >= h.k0 && r.k1 <= h.k1) return; /* (r within h) */
     const double t = (double)index * air->slice_dt, shift = advection(air, t);
     const int nx = air->n[0], ny = air->n[1], nz = air->n[2], nm = air->nmodes;
     const size_t per = axis_stride(nx, ny, nz), y0 = per - ny - nz;
@@ -343,23 +406,16 @@ static void fill_slice(spn_air_field *air, air_slice *s, int64_t index)
         const air_mode *m = &air->modes[n];
         double *c = air->axis_cos + (size_t)n * per, *sn = air->axis_sin + (size_t)n * per;
         const double c0 = m->omega * t + m->phi - shift * spn_v3_dot(m->k, air->dir);
-        for (int i = 0; i < nx; i++) {
-            const double a = m->k.x * node_position(air, i, 0, 0).x;
-            c[i] = cos(a), sn[i] = sin(a);
-        }
-        for (size_t i = (size_t)nx; i < y0; i++) c[i] = sn[i] = 0; /* padding */
-        for (int j = 0; j < ny; j++) {
-            const double b = m->k.y * node_position(air, 0, j, 0).y;
-            c[y0 + j] = cos(b), sn[y0 + j] = sin(b);
-        }
-        for (int k = 0; k < nz; k++) {
+        for (int k = r.k0; k <= r.k1; k++) {
             const double g = m->k.z * node_position(air, 0, 0, k).z + c0;
             c[y0 + ny + k] = cos(g), sn[y0 + ny + k] = sin(g);
         }
     }
-    for (int k = 0; k < nz; k++)
-        for (int j = 0; j < ny; j++) slice_row(air, j, k, air->row, s->u + ((size_t)k * ny + j) * nx);
-    s->index = index;
+    for (int k = r.k0; k <= r.k1; k++)
+        for (int j = r.j0; j <= r.j1; j++)
+            if (!(j >= h.j0 && j <= h.j1 && k >= h.k0 && k <= h.k1))
+                slice_row(air, j, k, air->row, s->u + ((size_t)k * ny + j) * nx);
+    s->have = r;
 }
 
 static const air_slice *find_slice(const spn_air_field *air, int64_t index)
@@ -387,21 +443,44 @@ static void prepare_times(spn_air_field *air, double t0, double t1)
     for (int i = 0; i < 3; i++) air->times[i] = time_of(air, at[i]);
 }
 
+/* The rows a slice is to have: those the samples have touched and
+ * ROW_MARGIN more on each side, or, before the first sample, all. */
+static air_rows rows_wanted(const spn_air_field *air)
+{
+    const int ny = air->n[1], nz = air->n[2];
+    int sj0 = atomic_load_explicit(&air->seen[0], memory_order_relaxed);
+    int sj1 = atomic_load_explicit(&air->seen[1], memory_order_relaxed);
+    int sk0 = atomic_load_explicit(&air->seen[2], memory_order_relaxed);
+    int sk1 = atomic_load_explicit(&air->seen[3], memory_order_relaxed);
+    if (sj0 > sj1 || sk0 > sk1) return (air_rows){0, ny - 1, 0, nz - 1};
+    const int j0 = sj0 - ROW_MARGIN, j1 = sj1 + ROW_MARGIN, k0 = sk0 - ROW_MARGIN, k1 = sk1 + ROW_MARGIN;
+    return (air_rows){j0 > 0 ? j0 : 0, j1 < ny - 1 ? j1 : ny - 1, k0 > 0 ? k0 : 0, k1 < nz - 1 ? k1 : nz - 1};
+}
+
 spn_status spn_air_prepare(spn_air_field *air, double t0, double t1)
 {
     if (!air->grid) return SPN_OK; /* (without a grid a sample is exact: no times kept) */
     int64_t a = (int64_t)floor(t0 / air->slice_dt), b = (int64_t)floor(t1 / air->slice_dt) + 1;
     if (b - a + 1 > MAX_SLICES) b = a + MAX_SLICES - 1;
+    const air_rows want = rows_wanted(air);
     for (int64_t idx = a; idx <= b; idx++) {
-        if (find_slice(air, idx)) continue;
-        /* Evict a slice outside [a, b], the oldest first. */
-        air_slice *victim = NULL;
-        for (int i = 0; i < MAX_SLICES; i++) {
-            air_slice *s = &air->slices[i];
-            if (s->index >= a && s->index <= b) continue;
-            if (!victim || s->index < victim->index) victim = s;
+        air_slice *s = (air_slice *)find_slice(air, idx);
+        if (!s) /* evict a slice outside [a, b], the oldest first */
+            for (int i = 0; i < MAX_SLICES; i++) {
+                air_slice *o = &air->slices[i];
+                if (o->index >= a && o->index <= b) continue;
+                if (!s || o->index < s->index) s = o;
+            }
+        if (!s) continue;
+        /* (the rows wanted and those it has: want only grows, but a slice
+         * filled whole at first has more) */
+        air_rows r = want;
+        if (s->index == idx) {
+            const air_rows h = s->have;
+            r = (air_rows){h.j0 < r.j0 ? h.j0 : r.j0, h.j1 > r.j1 ? h.j1 : r.j1, h.k0 < r.k0 ? h.k0 : r.k0,
+                           h.k1 > r.k1 ? h.k1 : r.k1};
         }
-        if (victim) fill_slice(air, victim, idx);
+        fill_rows(air, s, idx, r);
     }
     prepare_times(air, t0, t1);
     return SPN_OK;
@@ -423,15 +502,36 @@ typedef struct air_points {
     spn_vec3 mean;
     int nx, ny, nz, sy, sz; /* (sy, sz: numbers from a node to the next along y and z) */
     double lx, ly, lz, wx, wy, wz;
+    air_rows rows; /* the rows both slices have: a cell outside is sampled exactly */
+    spn_air_field *air;
+    double t;
 } air_points;
 
 _Static_assert(sizeof(spn_vec3) == 3 * sizeof(double), "sample_cell reads a slice's nodes as numbers");
-static air_points points_of(const spn_air_field *air, const air_time *at)
+static air_points points_of(spn_air_field *air, const air_time *at)
 {
     const int nx = air->n[0], ny = air->n[1];
-    return (air_points){(const double *)at->a->u, (const double *)at->b->u, at->f, at->mean, nx, ny, air->n[2],
-                        3 * nx, 3 * nx * ny, air->lo.x, air->lo.y, air->lo.z, air->hi.x - air->lo.x,
-                        air->hi.y - air->lo.y, air->hi.z - air->lo.z};
+    const air_rows ha = at->a->have, hb = at->b->have;
+    const air_rows both = {ha.j0 > hb.j0 ? ha.j0 : hb.j0, ha.j1 < hb.j1 ? ha.j1 : hb.j1,
+                           ha.k0 > hb.k0 ? ha.k0 : hb.k0, ha.k1 < hb.k1 ? ha.k1 : hb.k1};
+    return (air_points){(const double *)at->a->u,
+                        (const double *)at->b->u,
+                        at->f,
+                        at->mean,
+                        nx,
+                        ny,
+                        air->n[2],
+                        3 * nx,
+                        3 * nx * ny,
+                        air->lo.x,
+                        air->lo.y,
+                        air->lo.z,
+                        air->hi.x - air->lo.x,
+                        air->hi.y - air->lo.y,
+                        air->hi.z - air->lo.z,
+                        both,
+                        air,
+                        at->t};
 }
 
 /* Where *p falls in the grid: its cell's first number `b` in a slice (node
@@ -440,7 +540,7 @@ static air_points points_of(const spn_air_field *air, const air_time *at)
  * are ints: a grid has at most 2^22 nodes (spn_air_set_grid), 3 * 2^22
  * numbers. */
 typedef struct air_cell {
-    int b;
+    int b, j, k; /* (j, k: the cell's low row, iy and iz) */
     double fx, fy, fz;
 } air_cell;
 
@@ -453,7 +553,7 @@ SPN__INLINE air_cell cell_of(const air_points *g, const spn_vec3 *p)
     gx = gx > nx - 1 ? nx - 1 : gx, gy = gy > ny - 1 ? ny - 1 : gy, gz = gz > nz - 1 ? nz - 1 : gz;
     int ix = (int)gx, iy = (int)gy, iz = (int)gz;
     ix = ix > nx - 2 ? nx - 2 : ix, iy = iy > ny - 2 ? ny - 2 : iy, iz = iz > nz - 2 ? nz - 2 : iz;
-    return (air_cell){3 * ix + g->sy * iy + g->sz * iz, gx - ix, gy - iy, gz - iz};
+    return (air_cell){3 * ix + g->sy * iy + g->sz * iz, iy, iz, gx - ix, gy - iy, gz - iz};
 }
 
 /* Four numbers on one vector (AVX, SSE2 pairs; elementwise IEEE
@@ -499,23 +599,59 @@ SPN__INLINE void sample_cell(const air_points *g, const air_cell *c, spn_vec3 *o
     out->x = g->mean.x + u[0], out->y = g->mean.y + u[1], out->z = g->mean.z + u[2];
 }
 
+/* Whether cell c's rows (j and j + 1, k and k + 1) are in r. */
+SPN__INLINE bool cell_in(const air_cell *c, air_rows r)
+{
+    return c->j >= r.j0 && c->j + 1 <= r.j1 && c->k >= r.k0 && c->k + 1 <= r.k1;
+}
+
+/* Rows j0..j1, k0..k1 touched: into the field's record (air->seen), which
+ * several threads may update at once. */
+static void touched(spn_air_field *air, int j0, int j1, int k0, int k1)
+{
+    int v = atomic_load_explicit(&air->seen[0], memory_order_relaxed);
+    while (j0 < v && !atomic_compare_exchange_weak_explicit(&air->seen[0], &v, j0, memory_order_relaxed,
+                                                             memory_order_relaxed)) {}
+    v = atomic_load_explicit(&air->seen[1], memory_order_relaxed);
+    while (j1 > v && !atomic_compare_exchange_weak_explicit(&air->seen[1], &v, j1, memory_order_relaxed,
+                                                             memory_order_relaxed)) {}
+    v = atomic_load_explicit(&air->seen[2], memory_order_relaxed);
+    while (k0 < v && !atomic_compare_exchange_weak_explicit(&air->seen[2], &v, k0, memory_order_relaxed,
+                                                             memory_order_relaxed)) {}
+    v = atomic_load_explicit(&air->seen[3], memory_order_relaxed);
+    while (k1 > v && !atomic_compare_exchange_weak_explicit(&air->seen[3], &v, k1, memory_order_relaxed,
+                                                             memory_order_relaxed)) {}
+}
+
 /* The field at n points: their cells in one loop, which GCC vectorises
  * (the points in its lanes), then each point's interpolation on its own
- * vectors; a batch at a time, its cells on the stack. spn_air_sample takes
- * one point the same way (sample_one), so the two give the same bits. On
- * the Zen 5 (bench_air, random points, alternating runs) a point takes
- * 14.1-14.4 ns on a 48^3 grid and 8.4-8.6 on 16^3; with the points in the
- * lanes of one loop and their 48 numbers gathered (until the fifty-second
- * session) it took 25.5-28.2 and 14.6-20.9 ns. */
+ * vectors; a batch at a time, its cells on the stack. A point whose cell
+ * reaches rows the slices do not have (the web moved more than
+ * ROW_MARGIN rows since the last step) takes the field itself,
+ * spn_air_velocity; the rows every cell touched go into the field's record
+ * for the next spn_air_prepare. spn_air_sample takes one point the same
+ * way (sample_one), so the two give the same bits. On the Zen 5
+ * (bench_air, random points, alternating runs) a point takes 14.1-14.4 ns
+ * on a 48^3 grid and 8.4-8.6 on 16^3; with the points in the lanes of one
+ * loop and their 48 numbers gathered (until the fifty-second session) it
+ * took 25.5-28.2 and 14.6-20.9 ns. */
 #define AIR_CELLS 64
 SPN__KERNEL static void sample_points(air_points g, const spn_vec3 *restrict p, spn_vec3 *restrict out, size_t n)
 {
     air_cell c[AIR_CELLS];
+    int j0 = INT_MAX, j1 = INT_MIN, k0 = INT_MAX, k1 = INT_MIN;
     for (size_t i0 = 0; i0 < n; i0 += AIR_CELLS) {
         const size_t m = n - i0 < AIR_CELLS ? n - i0 : AIR_CELLS;
         for (size_t i = 0; i < m; i++) c[i] = cell_of(&g, p + i0 + i);
-        for (size_t i = 0; i < m; i++) sample_cell(&g, &c[i], out + i0 + i);
+        for (size_t i = 0; i < m; i++) {
+            j0 = c[i].j < j0 ? c[i].j : j0, j1 = c[i].j > j1 ? c[i].j : j1;
+            k0 = c[i].k < k0 ? c[i].k : k0, k1 = c[i].k > k1 ? c[i].k : k1;
+        }
+        for (size_t i = 0; i < m; i++)
+            if (cell_in(&c[i], g.rows)) sample_cell(&g, &c[i], out + i0 + i);
+            else out[i0 + i] = spn_air_velocity(g.air, g.t, p[i0 + i]);
     }
+    if (n) touched(g.air, j0, j1 + 1, k0, k1 + 1);
 }
 
 /* One point, as sample_points takes it (a batch of one costs twice as
@@ -523,12 +659,14 @@ SPN__KERNEL static void sample_points(air_points g, const spn_vec3 *restrict p, 
 SPN__KERNEL static void sample_one(const air_points *g, const spn_vec3 *p, spn_vec3 *out)
 {
     const air_cell c = cell_of(g, p);
-    sample_cell(g, &c, out);
+    if (cell_in(&c, g->rows)) sample_cell(g, &c, out);
+    else *out = spn_air_velocity(g->air, g->t, *p);
+    touched(g->air, c.j, c.j + 1, c.k, c.k + 1);
 }
 
 void spn_air_sample_batch(void *user, double t, const spn_vec3 *p, spn_vec3 *out, size_t n)
 {
-    const spn_air_field *air = user;
+    spn_air_field *air = user;
     const air_time at = air->grid ? sample_time(air, t) : (air_time){0};
     if (!at.a || !at.b) { /* no grid, or its slices not ready: the field itself */
         for (size_t i = 0; i < n; i++) out[i] = spn_air_velocity(air, t, p[i]);
@@ -540,7 +678,7 @@ void spn_air_sample_batch(void *user, double t, const spn_vec3 *p, spn_vec3 *out
 
 spn_vec3 spn_air_sample(void *user, double t, spn_vec3 p)
 {
-    const spn_air_field *air = user;
+    spn_air_field *air = user;
     const air_time at = air->grid ? sample_time(air, t) : (air_time){0};
     if (!at.a || !at.b) return spn_air_velocity(air, t, p);
     const air_points g = points_of(air, &at);
@@ -553,7 +691,7 @@ void spn_air_attach(spn_air_field *air, spn_world *w)
 {
     spn_world_set_air(w, spn_air_sample, air, air->def.rho, air->def.mu);
     spn_world_set_air_batch(w, spn_air_sample_batch);
-    spn_world_set_air_pure(w, true); /* sampling only reads the field */
+    spn_world_set_air_pure(w, true); /* sampling reads the field (its record of the rows touched is atomic) */
     for (uint32_t tag = 0; tag < 64; tag++) {
         double d = spn_thread_diameter(tag);
         if (d > 0) spn_world_set_tag_diameter(w, tag, d);
