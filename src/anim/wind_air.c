@@ -642,14 +642,19 @@ SPN__KERNEL static void sample_points(air_points g, const spn_vec3 *restrict p, 
     int j0 = INT_MAX, j1 = INT_MIN, k0 = INT_MAX, k1 = INT_MIN;
     for (size_t i0 = 0; i0 < n; i0 += AIR_CELLS) {
         const size_t m = n - i0 < AIR_CELLS ? n - i0 : AIR_CELLS;
-        for (size_t i = 0; i < m; i++) c[i] = cell_of(&g, p + i0 + i);
+        int b0 = INT_MAX, b1 = INT_MIN, d0 = INT_MAX, d1 = INT_MIN; /* (the batch's rows) */
         for (size_t i = 0; i < m; i++) {
-            j0 = c[i].j < j0 ? c[i].j : j0, j1 = c[i].j > j1 ? c[i].j : j1;
-            k0 = c[i].k < k0 ? c[i].k : k0, k1 = c[i].k > k1 ? c[i].k : k1;
+            c[i] = cell_of(&g, p + i0 + i);
+            b0 = c[i].j < b0 ? c[i].j : b0, b1 = c[i].j > b1 ? c[i].j : b1;
+            d0 = c[i].k < d0 ? c[i].k : d0, d1 = c[i].k > d1 ? c[i].k : d1;
         }
-        for (size_t i = 0; i < m; i++)
-            if (cell_in(&c[i], g.rows)) sample_cell(&g, &c[i], out + i0 + i);
-            else out[i0 + i] = spn_air_velocity(g.air, g.t, p[i0 + i]);
+        if (b0 >= g.rows.j0 && b1 + 1 <= g.rows.j1 && d0 >= g.rows.k0 && d1 + 1 <= g.rows.k1)
+            for (size_t i = 0; i < m; i++) sample_cell(&g, &c[i], out + i0 + i);
+        else
+            for (size_t i = 0; i < m; i++)
+                if (cell_in(&c[i], g.rows)) sample_cell(&g, &c[i], out + i0 + i);
+                else out[i0 + i] = spn_air_velocity(g.air, g.t, p[i0 + i]);
+        j0 = b0 < j0 ? b0 : j0, j1 = b1 > j1 ? b1 : j1, k0 = d0 < k0 ? d0 : k0, k1 = d1 > k1 ? d1 : k1;
     }
     if (n) touched(g.air, j0, j1 + 1, k0, k1 + 1);
 }
