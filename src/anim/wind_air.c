@@ -514,24 +514,9 @@ static air_points points_of(spn_air_field *air, const air_time *at)
     const air_rows ha = at->a->have, hb = at->b->have;
     const air_rows both = {ha.j0 > hb.j0 ? ha.j0 : hb.j0, ha.j1 < hb.j1 ? ha.j1 : hb.j1,
                            ha.k0 > hb.k0 ? ha.k0 : hb.k0, ha.k1 < hb.k1 ? ha.k1 : hb.k1};
-    return (air_points){(const double *)at->a->u,
-                        (const double *)at->b->u,
-                        at->f,
-                        at->mean,
-                        nx,
-                        ny,
-                        air->n[2],
-                        3 * nx,
-                        3 * nx * ny,
-                        air->lo.x,
-                        air->lo.y,
-                        air->lo.z,
-                        air->hi.x - air->lo.x,
-                        air->hi.y - air->lo.y,
-                        air->hi.z - air->lo.z,
-                        both,
-                        air,
-                        at->t};
+    return (air_points){(const double *)at->a->u, (const double *)at->b->u, at->f, at->mean, nx, ny, air->n[2],
+                        3 * nx, 3 * nx * ny, air->lo.x, air->lo.y, air->lo.z, air->hi.x - air->lo.x,
+                        air->hi.y - air->lo.y, air->hi.z - air->lo.z, both, air, at->t};
 }
 
 /* Where *p falls in the grid: its cell's first number `b` in a slice (node
