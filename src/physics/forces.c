@@ -117,7 +117,7 @@ SPN__INLINE double ln_pos(double x)
 
 /* C_d for 0 < re < 2 (spn_cylinder_drag_coefficient): Lamb's law up to
  * Re 0.5, the blend above. Both are formed and one is selected, so that
- * air_forces' loop over many segments vectorises. */
+ * air_chunk's loop over many segments vectorises. */
 SPN__INLINE double drag_coefficient_low(double re)
 {
     const double ln_re = ln_pos(re);
@@ -140,11 +140,12 @@ double spn_cylinder_drag_coefficient(double re)
     return drag_coefficient_low(re);
 }
 
-/* Air forces on segments [lo, hi) (both ends together) and their linear
- * coefficients c (F = c u_n), at the state (x, v) with air velocity
- * w->wind[s], into w->fair and w->cair: the drag of docs/physics.md on the
- * normal component u_n of the air relative to the segment's midpoint.
- * Three passes over chunks of SPN_CHUNK, each vectorised: the geometry up
+/* Air forces on the n segments of a chunk from segment s0 (loaded with
+ * the ends' velocity sums, chunk_load_ends; both ends together) and their
+ * linear coefficients c (F = c u_n), with air velocity w->wind[s], into
+ * w->fair and w->cair: the drag of docs/physics.md on the normal
+ * component u_n of the air relative to the segment's midpoint. Three
+ * passes over the chunk, each vectorised: the geometry up
  * to the Reynolds number, the drag coefficient (silk's Re under 2 with
  * ln_pos; libm's power, one segment at a time, for the rare others), then
  * the force.
@@ -153,52 +154,51 @@ double spn_cylinder_drag_coefficient(double re)
  * length or in still relative air gets exact zeros, selected after. One
  * segment at a time (forty-ninth session and before) the chain of two
  * square roots, a division and the drag law took some 20 ns a segment. */
-SPN__KERNEL static void air_forces(spn_world *w, uint32_t lo, uint32_t hi, const spn_vec3 *x, const spn_vec3 *v)
+SPN__INLINE void air_chunk(spn_world *w, uint32_t s0, uint32_t n, const chunk *restrict ch)
 {
     double re[SPN_CHUNK], len[SPN_CHUNK], speed[SPN_CHUNK], cd[SPN_CHUNK];
     double ux[SPN_CHUNK], uy[SPN_CHUNK], uz[SPN_CHUNK];
-    const spn__spring *restrict hs = w->hs;
-    const double *restrict sdiam = w->sdiam;
-    const uint8_t *restrict hflags = w->hflags;
-    /* (as numbers, indexed: GCC vectorises the gathers of indexed numbers,
-     * not of a struct's members) */
-    const double *restrict X = (const double *)x, *restrict V = (const double *)v;
-    const double *restrict U = (const double *)w->wind;
-    double *restrict F = (double *)w->fair, *restrict cair = w->cair;
     const double rho = w->air_rho, mu = w->air_mu;
+    /* (the chunk's arrays from its first segment, so that j indexes them) */
+    const double *restrict d = w->sdiam + s0, *restrict u = (const double *)w->wind + 3 * (size_t)s0;
+    const uint8_t *restrict fl = w->hflags + s0;
+    double *restrict f = (double *)w->fair + 3 * (size_t)s0, *restrict c = w->cair + s0;
+    for (uint32_t j = 0; j < n; j++) {
+        const double lx = ch->lx[j], ly = ch->ly[j], lz = ch->lz[j];
+        const double l = sqrt(lx * lx + ly * ly + lz * lz), inv = 1 / l;
+        const double tx = lx * inv, ty = ly * inv, tz = lz * inv;
+        const double vx = ch->wx[j] * 0.5, vy = ch->wy[j] * 0.5, vz = ch->wz[j] * 0.5;
+        const double wx = u[3 * j] - vx, wy = u[3 * j + 1] - vy, wz = u[3 * j + 2] - vz;
+        const double along = tx * wx + ty * wy + tz * wz;
+        const double nx = wx - tx * along, ny = wy - ty * along, nz = wz - tz * along;
+        const double sp = sqrt(nx * nx + ny * ny + nz * nz);
+        const bool on = (d[j] > 0) & !(fl[j] & SPN_SPRING_BROKEN) & (l > 0) & (sp > 0); /* (no branches) */
+        re[j] = on ? rho * sp * d[j] / mu : -1;                                         /* (-1: off) */
+        len[j] = l, speed[j] = sp, ux[j] = nx, uy[j] = ny, uz[j] = nz;
+    }
+    /* (silk's Re, under 2, in a loop GCC vectorises; any other Re, and
+     * the segments off, after it, one at a time) */
+    for (uint32_t j = 0; j < n; j++)
+        cd[j] = drag_coefficient_low(re[j] > 0 && re[j] < 2 ? re[j] : 1);
+    for (uint32_t j = 0; j < n; j++)
+        if (!(re[j] > 0 && re[j] < 2)) cd[j] = re[j] >= 0 ? spn_cylinder_drag_coefficient(re[j]) : 0;
+    for (uint32_t j = 0; j < n; j++) {
+        const bool on = re[j] >= 0;
+        const double cj = 0.5 * rho * cd[j] * d[j] * len[j] * speed[j];
+        c[j] = on ? cj : 0;
+        f[3 * j] = on ? ux[j] * cj : 0, f[3 * j + 1] = on ? uy[j] * cj : 0, f[3 * j + 2] = on ? uz[j] * cj : 0;
+    }
+}
+
+/* air_chunk over segments [lo, hi), a chunk at a time (spn_world_air_power;
+ * a step's spring pass does it in spring_range). */
+SPN__KERNEL static void air_forces(spn_world *w, uint32_t lo, uint32_t hi, const spn_vec3 *x, const spn_vec3 *v)
+{
+    chunk c;
     for (uint32_t s0 = lo; s0 < hi; s0 += SPN_CHUNK) {
         const uint32_t n = hi - s0 < SPN_CHUNK ? hi - s0 : SPN_CHUNK;
-        /* (the chunk's arrays from its first segment, so that j indexes them) */
-        const spn__spring *restrict h = hs + s0;
-        const double *restrict d = sdiam + s0, *restrict u = U + 3 * (size_t)s0;
-        const uint8_t *restrict fl = hflags + s0;
-        double *restrict f = F + 3 * (size_t)s0, *restrict c = cair + s0;
-        for (uint32_t j = 0; j < n; j++) {
-            const size_t a = 3 * (size_t)h[j].a, b = 3 * (size_t)spn__end_b(h[j]);
-            const double lx = X[a] - X[b], ly = X[a + 1] - X[b + 1], lz = X[a + 2] - X[b + 2];
-            const double l = sqrt(lx * lx + ly * ly + lz * lz), inv = 1 / l;
-            const double tx = lx * inv, ty = ly * inv, tz = lz * inv;
-            const double vx = (V[a] + V[b]) * 0.5, vy = (V[a + 1] + V[b + 1]) * 0.5, vz = (V[a + 2] + V[b + 2]) * 0.5;
-            const double wx = u[3 * j] - vx, wy = u[3 * j + 1] - vy, wz = u[3 * j + 2] - vz;
-            const double along = tx * wx + ty * wy + tz * wz;
-            const double nx = wx - tx * along, ny = wy - ty * along, nz = wz - tz * along;
-            const double sp = sqrt(nx * nx + ny * ny + nz * nz);
-            const bool on = (d[j] > 0) & !(fl[j] & SPN_SPRING_BROKEN) & (l > 0) & (sp > 0); /* (no branches) */
-            re[j] = on ? rho * sp * d[j] / mu : -1;                                         /* (-1: off) */
-            len[j] = l, speed[j] = sp, ux[j] = nx, uy[j] = ny, uz[j] = nz;
-        }
-        /* (silk's Re, under 2, in a loop GCC vectorises; any other Re, and
-         * the segments off, after it, one at a time) */
-        for (uint32_t j = 0; j < n; j++)
-            cd[j] = drag_coefficient_low(re[j] > 0 && re[j] < 2 ? re[j] : 1);
-        for (uint32_t j = 0; j < n; j++)
-            if (!(re[j] > 0 && re[j] < 2)) cd[j] = re[j] >= 0 ? spn_cylinder_drag_coefficient(re[j]) : 0;
-        for (uint32_t j = 0; j < n; j++) {
-            const bool on = re[j] >= 0;
-            const double cj = 0.5 * rho * cd[j] * d[j] * len[j] * speed[j];
-            c[j] = on ? cj : 0;
-            f[3 * j] = on ? ux[j] * cj : 0, f[3 * j + 1] = on ? uy[j] * cj : 0, f[3 * j + 2] = on ? uz[j] * cj : 0;
-        }
+        chunk_load_ends(&c, w->hs + s0, n, x, v, UINT32_MAX, true);
+        air_chunk(w, s0, n, &c);
     }
 }
 
@@ -246,18 +246,24 @@ static void sample_air(spn_world *w, double t, const spn_vec3 *x, int threads)
         if (w->sdiam[s] > 0) w->wind[s] = w->air_fn(w->air_user, t, midpoint(w, x, s));
 }
 
-/* Springs [lo, hi): forces into fs, sums added to sums[0..2]. Compiled for
- * AVX2 too where the compiler can pick at load time (same bits: no FMA). */
-SPN__KERNEL static void spring_range(const spn__spring *restrict hs, uint32_t lo, uint32_t hi,
-                                      const spn_vec3 *restrict x, const spn_vec3 *restrict v,
-                                      spn_vec3 *restrict fs, double *sums)
+/* Springs [lo, hi): forces into fs, sums added to sums[0..2], and with
+ * `air` the air's forces on them (air_chunk), from the same chunk: the
+ * ends' positions and velocities are gathered once for both (fifty-second
+ * session; before, the air gathered them again). Compiled for AVX2 too
+ * where the compiler can pick at load time (same bits: no FMA). */
+SPN__KERNEL static void spring_range(spn_world *w, uint32_t lo, uint32_t hi, const spn_vec3 *restrict x,
+                                      const spn_vec3 *restrict v, double *sums, bool air)
 {
     chunk c;
+    const spn__spring *restrict hs = w->hs;
+    spn_vec3 *restrict fs = w->fs;
     for (uint32_t s0 = lo; s0 < hi; s0 += SPN_CHUNK) {
         const uint32_t n = hi - s0 < SPN_CHUNK ? hi - s0 : SPN_CHUNK;
-        chunk_load(&c, hs + s0, n, x, v, UINT32_MAX);
+        if (air) chunk_load_ends(&c, hs + s0, n, x, v, UINT32_MAX, true);
+        else chunk_load(&c, hs + s0, n, x, v, UINT32_MAX);
         chunk_forces(&c, n, fs + s0);
         chunk_sums(&c, n, sums);
+        if (air) air_chunk(w, s0, n, &c);
     }
 }
 
@@ -271,17 +277,13 @@ void spn__spring_pass(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 
      * segments; see docs/physics.md, "Air drag on threads") */
     const int threads = spn__threads(w, ns);
     if (air) sample_air(w, t, x, threads);
-    spn_vec3 *restrict fs = w->fs;
-    const spn__spring *restrict hs = w->hs;
     double *partial = w->partial;
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (uint32_t blk = 0; blk < nb; blk++) {
         const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < ns ? lo + SPN_BLOCK : ns;
         double sums[2] = {0, 0};
-        spring_range(hs, lo, hi, x, v, fs, sums);
+        spring_range(w, lo, hi, x, v, sums, air);
         const double energy = sums[0], power = sums[1];
-        if (air)
-            air_forces(w, lo, hi, x, v);
         partial[(size_t)blk * SPN_NSUMS + 0] = energy;
         partial[(size_t)blk * SPN_NSUMS + 1] = power;
     }
