@@ -61,6 +61,26 @@ typedef struct air_rows {
     int j0, j1, k0, k1;
 } air_rows;
 
+/* Whether r holds every row of s (a non-empty s). */
+static inline bool rows_hold(air_rows r, air_rows s)
+{
+    return s.j0 >= r.j0 && s.j1 <= r.j1 && s.k0 >= r.k0 && s.k1 <= r.k1;
+}
+
+/* The smallest rectangle holding the rows of both (rows_span), and the rows
+ * both hold (rows_meet). */
+static inline air_rows rows_span(air_rows a, air_rows b)
+{
+    return (air_rows){a.j0 < b.j0 ? a.j0 : b.j0, a.j1 > b.j1 ? a.j1 : b.j1, a.k0 < b.k0 ? a.k0 : b.k0,
+                      a.k1 > b.k1 ? a.k1 : b.k1};
+}
+
+static inline air_rows rows_meet(air_rows a, air_rows b)
+{
+    return (air_rows){a.j0 > b.j0 ? a.j0 : b.j0, a.j1 < b.j1 ? a.j1 : b.j1, a.k0 > b.k0 ? a.k0 : b.k0,
+                      a.k1 < b.k1 ? a.k1 : b.k1};
+}
+
 typedef struct air_slice {
     int64_t index;    /* time = index * slice_dt; INT64_MIN when empty */
     spn_vec3 *u;      /* turbulent velocity at the grid nodes */
@@ -398,7 +418,7 @@ static void fill_rows(spn_air_field *air, air_slice *s, int64_t index, air_rows 
 {
     if (s->index != index) s->index = index, s->have = (air_rows){0, -1, 0, -1};
     const air_rows h = s->have;
-    if (r.j0 >= h.j0 && r.j1 <= h.j1 && r.k0 >= h.k0 && r.k1 <= h.k1) return; /* (r within h) */
+    if (rows_hold(h, r)) return;
     const double t = (double)index * air->slice_dt, shift = advection(air, t);
     const int nx = air->n[0], ny = air->n[1], nz = air->n[2], nm = air->nmodes;
     const size_t per = axis_stride(nx, ny, nz), y0 = per - ny - nz;
@@ -413,7 +433,7 @@ static void fill_rows(spn_air_field *air, air_slice *s, int64_t index, air_rows 
     }
     for (int k = r.k0; k <= r.k1; k++)
         for (int j = r.j0; j <= r.j1; j++)
-            if (!(j >= h.j0 && j <= h.j1 && k >= h.k0 && k <= h.k1))
+            if (!rows_hold(h, (air_rows){j, j, k, k}))
                 slice_row(air, j, k, air->row, s->u + ((size_t)k * ny + j) * nx);
     s->have = r;
 }
@@ -474,13 +494,7 @@ spn_status spn_air_prepare(spn_air_field *air, double t0, double t1)
         if (!s) continue;
         /* (the rows wanted and those it has: want only grows, but a slice
          * filled whole at first has more) */
-        air_rows r = want;
-        if (s->index == idx) {
-            const air_rows h = s->have;
-            r = (air_rows){h.j0 < r.j0 ? h.j0 : r.j0, h.j1 > r.j1 ? h.j1 : r.j1, h.k0 < r.k0 ? h.k0 : r.k0,
-                           h.k1 > r.k1 ? h.k1 : r.k1};
-        }
-        fill_rows(air, s, idx, r);
+        fill_rows(air, s, idx, s->index == idx ? rows_span(want, s->have) : want);
     }
     prepare_times(air, t0, t1);
     return SPN_OK;
@@ -511,9 +525,7 @@ _Static_assert(sizeof(spn_vec3) == 3 * sizeof(double), "sample_cell reads a slic
 static air_points points_of(spn_air_field *air, const air_time *at)
 {
     const int nx = air->n[0], ny = air->n[1];
-    const air_rows ha = at->a->have, hb = at->b->have;
-    const air_rows both = {ha.j0 > hb.j0 ? ha.j0 : hb.j0, ha.j1 < hb.j1 ? ha.j1 : hb.j1,
-                           ha.k0 > hb.k0 ? ha.k0 : hb.k0, ha.k1 < hb.k1 ? ha.k1 : hb.k1};
+    const air_rows both = rows_meet(at->a->have, at->b->have);
     return (air_points){(const double *)at->a->u, (const double *)at->b->u, at->f, at->mean, nx, ny, air->n[2],
                         3 * nx, 3 * nx * ny, air->lo.x, air->lo.y, air->lo.z, air->hi.x - air->lo.x,
                         air->hi.y - air->lo.y, air->hi.z - air->lo.z, both, air, at->t};
@@ -587,25 +599,28 @@ SPN__INLINE void sample_cell(const air_points *g, const air_cell *c, spn_vec3 *o
 /* Whether cell c's rows (j and j + 1, k and k + 1) are in r. */
 SPN__INLINE bool cell_in(const air_cell *c, air_rows r)
 {
-    return c->j >= r.j0 && c->j + 1 <= r.j1 && c->k >= r.k0 && c->k + 1 <= r.k1;
+    return rows_hold(r, (air_rows){c->j, c->j + 1, c->k, c->k + 1});
 }
 
-/* Rows j0..j1, k0..k1 touched: into the field's record (air->seen), which
- * several threads may update at once. */
+/* *a lowered to v, or raised to v, where v is past it (several threads may
+ * update *a at once). */
+static void lower_to(atomic_int *a, int v)
+{
+    int o = atomic_load_explicit(a, memory_order_relaxed);
+    while (v < o && !atomic_compare_exchange_weak_explicit(a, &o, v, memory_order_relaxed, memory_order_relaxed)) {}
+}
+
+static void raise_to(atomic_int *a, int v)
+{
+    int o = atomic_load_explicit(a, memory_order_relaxed);
+    while (v > o && !atomic_compare_exchange_weak_explicit(a, &o, v, memory_order_relaxed, memory_order_relaxed)) {}
+}
+
+/* Rows j0..j1, k0..k1 touched: into the field's record (air->seen). */
 static void touched(spn_air_field *air, int j0, int j1, int k0, int k1)
 {
-    int v = atomic_load_explicit(&air->seen[0], memory_order_relaxed);
-    while (j0 < v && !atomic_compare_exchange_weak_explicit(&air->seen[0], &v, j0, memory_order_relaxed,
-                                                             memory_order_relaxed)) {}
-    v = atomic_load_explicit(&air->seen[1], memory_order_relaxed);
-    while (j1 > v && !atomic_compare_exchange_weak_explicit(&air->seen[1], &v, j1, memory_order_relaxed,
-                                                             memory_order_relaxed)) {}
-    v = atomic_load_explicit(&air->seen[2], memory_order_relaxed);
-    while (k0 < v && !atomic_compare_exchange_weak_explicit(&air->seen[2], &v, k0, memory_order_relaxed,
-                                                             memory_order_relaxed)) {}
-    v = atomic_load_explicit(&air->seen[3], memory_order_relaxed);
-    while (k1 > v && !atomic_compare_exchange_weak_explicit(&air->seen[3], &v, k1, memory_order_relaxed,
-                                                             memory_order_relaxed)) {}
+    lower_to(&air->seen[0], j0), raise_to(&air->seen[1], j1);
+    lower_to(&air->seen[2], k0), raise_to(&air->seen[3], k1);
 }
 
 /* The field at n points: their cells in one loop, which GCC vectorises
@@ -633,7 +648,7 @@ SPN__KERNEL static void sample_points(air_points g, const spn_vec3 *restrict p, 
             b0 = c[i].j < b0 ? c[i].j : b0, b1 = c[i].j > b1 ? c[i].j : b1;
             d0 = c[i].k < d0 ? c[i].k : d0, d1 = c[i].k > d1 ? c[i].k : d1;
         }
-        if (b0 >= g.rows.j0 && b1 + 1 <= g.rows.j1 && d0 >= g.rows.k0 && d1 + 1 <= g.rows.k1)
+        if (rows_hold(g.rows, (air_rows){b0, b1 + 1, d0, d1 + 1}))
             for (size_t i = 0; i < m; i++) sample_cell(&g, &c[i], out + i0 + i);
         else
             for (size_t i = 0; i < m; i++)

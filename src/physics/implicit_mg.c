@@ -274,14 +274,6 @@ static void assemble(spn__imp_mg *m, const spn_world *w, double h)
     if (m->chol_on && w->ncontacts) contact_offd(m, w, h);
 }
 
-/* The prey's rows and columns of A kept exact on top of the factor F. A
- * prey's body has no springs, so the system (level 0) leaves it out, and
- * its contacts couple it to the web: with B the web's rows of the prey's
- * columns (h^2 k w_e n n^T at each contact's segment ends) and C the prey's
- * own blocks, M = [F B; B^T C] is applied through its Schur complement
- * S = C - B^T F^-1 B, three rows a prey (spn__imp_mg_apply). CG otherwise
- * builds these couplings an iteration at a time. Needs 3 solves a prey
- * each time the factor or the contacts change (prepare, refactor). */
 /* The slot of prey particle p among the first np of m->prey (np: none). */
 static uint32_t prey_slot(const spn__imp_mg *m, uint32_t np, uint32_t p)
 {
@@ -290,6 +282,14 @@ static uint32_t prey_slot(const spn__imp_mg *m, uint32_t np, uint32_t p)
     return q;
 }
 
+/* The prey's rows and columns of A kept exact on top of the factor F. A
+ * prey's body has no springs, so the system (level 0) leaves it out, and
+ * its contacts couple it to the web: with B the web's rows of the prey's
+ * columns (h^2 k w_e n n^T at each contact's segment ends) and C the prey's
+ * own blocks, M = [F B; B^T C] is applied through its Schur complement
+ * S = C - B^T F^-1 B, three rows a prey (spn__imp_mg_apply). CG otherwise
+ * builds these couplings an iteration at a time. Needs 3 solves a prey
+ * each time the factor or the contacts change (prepare, refactor). */
 static void prey_rows(spn__imp_mg *m, const spn_world *w, double h)
 {
     const spn__eq *e = &m->e;
