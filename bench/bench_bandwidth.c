@@ -5,13 +5,19 @@
  * not counted). Best of several repetitions, for 1 thread and for all.
  * One JSON line per figure; first the sizes of the caches a pass may stay in
  * (Linux: the L2 of one core and the last level, as sysfs gives them; what a
- * figure measures depends on whether its pass fits). */
+ * figure measures depends on whether its pass fits). A guest without sysfs's
+ * cache directory (the Zen 5 VM) gets its L2 from sysconf, which glibc reads
+ * from the processor; its L3 stays unknown (0), because what the processor
+ * says there can be the whole socket's (that guest: 508 MiB, where one core
+ * reaches its CCD's 32), and a pass would be counted as fitting that does
+ * not. */
 #include "common/bench_common.h"
 
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -30,7 +36,8 @@ static bool cache_field(int index, const char *field, char *buf, int size)
     return ok;
 }
 
-/* KiB of cpu0's unified cache of `level` ("1024K" in sysfs), or 0 when unknown. */
+/* KiB of cpu0's unified cache of `level` ("1024K" in sysfs), or 0 when unknown;
+ * without sysfs the L2 from sysconf (above). */
 static long cache_kib(int level)
 {
     char lv[16], type[32], size[32];
@@ -38,6 +45,12 @@ static long cache_kib(int level)
         if (atoi(lv) == level && cache_field(i, "type", type, sizeof type) && strncmp(type, "Unified", 7) == 0 &&
             cache_field(i, "size", size, sizeof size))
             return atol(size);
+#ifdef _SC_LEVEL2_CACHE_SIZE
+    if (level == 2) {
+        long bytes = sysconf(_SC_LEVEL2_CACHE_SIZE);
+        return bytes > 0 ? bytes / 1024 : 0;
+    }
+#endif
     return 0;
 }
 

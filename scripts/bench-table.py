@@ -190,7 +190,8 @@ def bandwidth_table(rows):
     per second of wall time, against bench_bandwidth's triad on as many
     threads in the same run, and where one pass fits (bench_bandwidth's
     cache sizes: a thread's share of the pass in its core's L2, the pass in
-    the L3, or neither): a pass that fits in a cache streams from it, and its
+    the L3, or neither; a size the machine did not give, 0, decides
+    nothing): a pass that fits in a cache streams from it, and its
     share of the memory's triad only says how little memory it needs."""
     triad = {r["threads"]: r["gb_per_s"] for r in rows
              if r.get("bench") == "bandwidth" and r.get("kernel") == "triad"}
@@ -205,7 +206,9 @@ def bandwidth_table(rows):
             return "L2"
         if caches.get("l3_kib") and kib <= caches["l3_kib"]:
             return "L3"
-        return "memory" if caches else "?"
+        if not caches.get("l2_kib_per_core"):
+            return "?"
+        return "memory" if caches.get("l3_kib") else "beyond L2"
     out = ["**The share of the machine's memory bandwidth the lattice steps reach (bench/bench_step.c; "
            "the traffic a model, docs/physics-lattice.md)**", "",
            "| integrator | particles | threads | bytes per spring-step | one pass, MiB | pass fits in | GB/s "
