@@ -103,6 +103,11 @@ static void test_renumbered_world_steps_the_same(void **state)
 {
     (void)state;
     spn_world *a = busy_web(), *b = busy_web(), *c = busy_web();
+    /* CG to the round-off of the forces (not busy_web's 1e-9), so that the
+     * numberings differ by rounding only, not by where CG stopped: at 1e-9
+     * the kinetic energies differed by up to 3.5e-9 of themselves */
+    spn_world *all[3] = {a, b, c};
+    for (int k = 0; k < 3; k++) assert_int_equal(spn_world_set_solver_tolerance(all[k], 1e-13, 400), SPN_OK);
     const uint32_t np = spn_world_particle_count(a);
     uint32_t *order = scrambled(np), *back = malloc(np * sizeof *back);
     assert_non_null(back);
@@ -132,11 +137,11 @@ static void test_renumbered_world_steps_the_same(void **state)
     }
     print_message("largest gap %.3g m (a particle moves up to %.3g m in the run)\n", gap, moved);
     assert_true(moved > 0);
-    /* implicit steps: CG stops at the world's tolerance, and a different sum
-     * order changes its iterates by rounding only */
-    assert_true(gap <= 1e-9 * moved);
+    /* implicit steps: a different sum order changes CG's iterates by
+     * rounding only (measured: 8e-16 m, and 4e-12 of the kinetic energy) */
+    assert_true(gap <= 1e-11 * moved);
     spn_energy ea = spn_world_energy(a), eb = spn_world_energy(b);
-    assert_true(fabs(ea.kinetic - eb.kinetic) <= 1e-9 * fabs(ea.kinetic) + 1e-18);
+    assert_true(fabs(ea.kinetic - eb.kinetic) <= 1e-10 * fabs(ea.kinetic) + 1e-18);
     spn_world_destroy(a), spn_world_destroy(b), spn_world_destroy(c);
     free(order), free(back);
 }

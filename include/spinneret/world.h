@@ -273,8 +273,9 @@ SPN_API void spn_world_set_force_callback(spn_world *w, spn_force_fn fn, void *u
 SPN_API spn_force_fn spn_world_force_callback(const spn_world *w, void **user);
 
 /// Air velocity at a point and time [m/s], for aerodynamic drag on threads.
-/// Called from one thread, once per tagged segment (at its midpoint) per
-/// force evaluation, in a fixed order, so it may keep state.
+/// Called from one thread, once per particle that ends a tagged segment (at
+/// its position) per force evaluation, in a fixed order, so it may keep state.
+/// A segment feels the mean of its two ends' air relative to them.
 typedef spn_vec3 (*spn_air_fn)(void *user, double t, spn_vec3 position);
 /// Air and its properties: segments whose tag has a diameter (below) feel drag
 /// from the air velocity relative to them, normal component only, with a drag
@@ -293,9 +294,9 @@ typedef void (*spn_air_batch_fn)(void *user, double t, const spn_vec3 *position,
 /// Optional, beside the air function (same user pointer): one that samples
 /// many points in a call, giving at each what the air function gives there,
 /// bit for bit (spn_air_sample_batch is spn_air_sample's, and spn_air_attach
-/// sets it). The world then takes its samples through it, a run of tagged
-/// segments at a time (from several threads when pure). NULL: one call per
-/// segment. spn_world_set_air clears it.
+/// sets it). The world then takes its samples through it, a run of particles
+/// at a time (from several threads when pure). NULL: one call per particle.
+/// spn_world_set_air clears it.
 SPN_API void spn_world_set_air_batch(spn_world *w, spn_air_batch_fn fn);
 /// The air function (NULL: still air); its user pointer, rho and mu into the
 /// arguments that are not NULL (rho 1.204, mu 1.81e-5 until set).

@@ -104,7 +104,7 @@ struct spn_air_field {
      * n[1] + n[2]), and a grid row's sums */
     double *axis_cos, *axis_sin, *row;
     /* the times spn_air_prepare was last told of (t0, t1 and their
-     * midpoint), at which a step samples every segment */
+     * midpoint), at which a step samples the air at its particles */
     air_time times[3];
     /* The rows the samples have touched (their cells' corners): the lowest
      * and highest j and k, kept by the samplers (several threads) and read

@@ -24,17 +24,20 @@ typedef struct chunk {
     double ux[SPN_CHUNK], uy[SPN_CHUNK], uz[SPN_CHUNK];
     double k[SPN_CHUNK], kd[SPN_CHUNK], rest[SPN_CHUNK], tonly[SPN_CHUNK];
     double s[SPN_CHUNK], e[SPN_CHUNK], p[SPN_CHUNK];
-    /* v_a + v_b, where chunk_load_ends is asked for them (the air's drag
-     * on the segment's midpoint, forces.c) */
+    /* (u_a - v_a) + (u_b - v_b), u the air velocity at each end, where
+     * chunk_load_ends is given the air (twice the air's velocity relative
+     * to the segment, forces.c) */
     double wx[SPN_CHUNK], wy[SPN_CHUNK], wz[SPN_CHUNK];
 } chunk;
 
-/* Springs hs[0..n) into the chunk, and with `vsum` (a constant in each
- * call) their ends' velocity sums. A spring whose end b is at or past
- * b_limit is loaded as if both ends were a (no force; the caller has its
- * force from elsewhere and must not read b: another thread may be moving it). */
+/* Springs hs[0..n) into the chunk, and with `air` (per particle; NULL in
+ * each call or in none) their ends' air velocities relative to them,
+ * summed. A spring whose end b is at or past b_limit is loaded as if both
+ * ends were a (no force; the caller has its force from elsewhere and must
+ * not read b: another thread may be moving it). */
 SPN__INLINE void chunk_load_ends(chunk *restrict c, const spn__spring *restrict hs, uint32_t n,
-                                 const spn_vec3 *restrict x, const spn_vec3 *restrict v, uint32_t b_limit, bool vsum)
+                                 const spn_vec3 *restrict x, const spn_vec3 *restrict v, uint32_t b_limit,
+                                 const spn_vec3 *restrict air)
 {
     for (uint32_t j = 0; j < n; j++) {
         const spn__spring sp = hs[j];
@@ -42,17 +45,22 @@ SPN__INLINE void chunk_load_ends(chunk *restrict c, const spn__spring *restrict 
         const spn_vec3 xa = x[a], xb = x[b], va = v[a], vb = v[b];
         c->lx[j] = xa.x - xb.x, c->ly[j] = xa.y - xb.y, c->lz[j] = xa.z - xb.z;
         c->ux[j] = va.x - vb.x, c->uy[j] = va.y - vb.y, c->uz[j] = va.z - vb.z;
-        if (vsum) c->wx[j] = va.x + vb.x, c->wy[j] = va.y + vb.y, c->wz[j] = va.z + vb.z;
+        if (air) {
+            const spn_vec3 wa = air[a], wb = air[b];
+            c->wx[j] = (wa.x - va.x) + (wb.x - vb.x);
+            c->wy[j] = (wa.y - va.y) + (wb.y - vb.y);
+            c->wz[j] = (wa.z - va.z) + (wb.z - vb.z);
+        }
         c->k[j] = sp.k, c->kd[j] = sp.kd, c->rest[j] = sp.rest;
         c->tonly[j] = (double)spn__tension_only(sp);
     }
 }
 
-/* chunk_load_ends without the velocity sums. */
+/* chunk_load_ends without the air. */
 SPN__INLINE void chunk_load(chunk *restrict c, const spn__spring *restrict hs, uint32_t n,
                             const spn_vec3 *restrict x, const spn_vec3 *restrict v, uint32_t b_limit)
 {
-    chunk_load_ends(c, hs, n, x, v, b_limit, false);
+    chunk_load_ends(c, hs, n, x, v, b_limit, NULL);
 }
 
 /* Force on end a of each spring of the chunk, into fs; the elastic energy,

@@ -32,6 +32,7 @@ void spn__free_compiled(spn_world *w)
     for (int i = 0; i < SPN_TMP_COUNT; i++) free(w->tmp[i]);
     free(w->fair);
     free(w->wind);
+    free(w->air_runs);
     free(w->cair);
     free(w->jac);
     free(w->pinv);
@@ -48,6 +49,8 @@ void spn__forget_compiled(spn_world *w)
     w->fs = w->f = w->fext = w->x0 = w->v0 = w->fair = w->wind = NULL;
     w->sdiam = w->cair = w->partial = w->pinv = NULL;
     w->jac = NULL;
+    w->air_runs = NULL;
+    w->nair_runs = 0;
     w->imp_mg = NULL;
     w->npartial = 0;
     w->sweep_block = 0;
@@ -99,6 +102,32 @@ static bool alloc_compiled(spn_world *w)
     return w->adj_start && w->adj && w->a_start && w->b_start && w->b_adj && w->hs && w->hflags && w->perm && w->iperm && w->fs && w->sdiam && w->f && w->fext && w->x0 && w->v0 && w->partial;
 }
 
+/* The runs of particles that end a segment with a diameter (the air is
+ * sampled at those), none longer than SPN__AIR_RUN nor crossing a multiple
+ * of it, into w->air_runs as (first, last + 1) pairs; `need` has np zeros. */
+static bool air_runs(spn_world *w, uint8_t *need)
+{
+    for (uint32_t s = 0; s < w->ns; s++)
+        if (w->sdiam[s] > 0) need[w->hs[s].a] = need[spn__end_b(w->hs[s])] = 1;
+    uint32_t n = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        n = 0;
+        for (uint32_t i = 0; i < w->np;) {
+            if (!need[i]) {
+                i++;
+                continue;
+            }
+            const uint32_t lo = i, edge = (lo / SPN__AIR_RUN + 1) * SPN__AIR_RUN;
+            while (i < w->np && i < edge && need[i]) i++;
+            if (pass) w->air_runs[2 * n] = lo, w->air_runs[2 * n + 1] = i;
+            n++;
+        }
+        if (!pass && !(w->air_runs = malloc(2 * (size_t)(n ? n : 1) * sizeof *w->air_runs))) return false;
+    }
+    w->nair_runs = n;
+    return true;
+}
+
 /* Air buffers, only for worlds with threads that have a diameter. */
 static bool alloc_air(spn_world *w)
 {
@@ -109,9 +138,12 @@ static bool alloc_air(spn_world *w)
     }
     if (!w->any_diam) return true;
     w->fair = calloc(w->ns, sizeof *w->fair);
-    w->wind = calloc(w->ns, sizeof *w->wind);
+    w->wind = calloc(w->np, sizeof *w->wind);
     w->cair = calloc(w->ns, sizeof *w->cair);
-    return w->fair && w->wind && w->cair;
+    uint8_t *need = calloc(w->np, 1);
+    const bool ok = w->fair && w->wind && w->cair && need && air_runs(w, need);
+    free(need);
+    return ok;
 }
 
 /* The internal spring order: by lower particle id, ties in public order

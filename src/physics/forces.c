@@ -10,10 +10,12 @@
  *
  * Air drag on a tagged segment (independence principle for a yawed cylinder):
  * only the air velocity normal to the segment counts,
- *   u = w(midpoint) - (v_a + v_b) / 2,  u_n = u - t (t . u),
+ *   u = ((w(x_a) - v_a) + (w(x_b) - v_b)) / 2,  u_n = u - t (t . u),
  *   F = 1/2 rho C_d(Re) d L |u_n| u_n,   Re = rho |u_n| d / mu,
- * half of F on each end. The air callback is called serially in a fixed
- * order, so it may keep state (a seeded gust generator, say). */
+ * half of F on each end: the air relative to the segment, taken as its
+ * velocity is, as the mean of its ends'. The air callback is called
+ * serially in a fixed order, once per particle that ends a tagged segment,
+ * so it may keep state (a seeded gust generator, say). */
 #include "world_internal.h"
 #include "chunk.h"
 #include "core/kernel.h"
@@ -141,11 +143,10 @@ double spn_cylinder_drag_coefficient(double re)
 }
 
 /* Air forces on the n segments of a chunk from segment s0 (loaded with
- * the ends' velocity sums, chunk_load_ends; both ends together) and their
- * linear coefficients c (F = c u_n), with air velocity w->wind[s], into
- * w->fair and w->cair: the drag of docs/physics.md on the normal
- * component u_n of the air relative to the segment's midpoint. Three
- * passes over the chunk, each vectorised: the geometry up
+ * the ends' air relative to them, chunk_load_ends; both ends together) and
+ * their linear coefficients c (F = c u_n), into w->fair and w->cair: the
+ * drag of docs/physics.md on the normal component u_n of the air relative
+ * to the segment. Three passes over the chunk, each vectorised: the geometry up
  * to the Reynolds number, the drag coefficient (silk's Re under 2 with
  * ln_pos; libm's power, one segment at a time, for the rare others), then
  * the force.
@@ -160,15 +161,14 @@ SPN__INLINE void air_chunk(spn_world *w, uint32_t s0, uint32_t n, const chunk *r
     double ux[SPN_CHUNK], uy[SPN_CHUNK], uz[SPN_CHUNK];
     const double rho = w->air_rho, mu = w->air_mu;
     /* (the chunk's arrays from its first segment, so that j indexes them) */
-    const double *restrict d = w->sdiam + s0, *restrict u = (const double *)w->wind + 3 * (size_t)s0;
+    const double *restrict d = w->sdiam + s0;
     const uint8_t *restrict fl = w->hflags + s0;
     double *restrict f = (double *)w->fair + 3 * (size_t)s0, *restrict c = w->cair + s0;
     for (uint32_t j = 0; j < n; j++) {
         const double lx = ch->lx[j], ly = ch->ly[j], lz = ch->lz[j];
         const double l = sqrt(lx * lx + ly * ly + lz * lz), inv = 1 / l;
         const double tx = lx * inv, ty = ly * inv, tz = lz * inv;
-        const double vx = ch->wx[j] * 0.5, vy = ch->wy[j] * 0.5, vz = ch->wz[j] * 0.5;
-        const double wx = u[3 * j] - vx, wy = u[3 * j + 1] - vy, wz = u[3 * j + 2] - vz;
+        const double wx = ch->wx[j] * 0.5, wy = ch->wy[j] * 0.5, wz = ch->wz[j] * 0.5;
         const double along = tx * wx + ty * wy + tz * wz;
         const double nx = wx - tx * along, ny = wy - ty * along, nz = wz - tz * along;
         const double sp = sqrt(nx * nx + ny * ny + nz * nz);
@@ -197,53 +197,29 @@ SPN__KERNEL static void air_forces(spn_world *w, uint32_t lo, uint32_t hi, const
     chunk c;
     for (uint32_t s0 = lo; s0 < hi; s0 += SPN_CHUNK) {
         const uint32_t n = hi - s0 < SPN_CHUNK ? hi - s0 : SPN_CHUNK;
-        chunk_load_ends(&c, w->hs + s0, n, x, v, UINT32_MAX, true);
+        chunk_load_ends(&c, w->hs + s0, n, x, v, UINT32_MAX, w->wind);
         air_chunk(w, s0, n, &c);
     }
 }
 
-/* The midpoint of segment s. */
-static spn_vec3 midpoint(const spn_world *w, const spn_vec3 *x, uint32_t s)
-{
-    return spn_v3_scale(spn_v3_add(x[w->hs[s].a], x[spn__end_b(w->hs[s])]), 0.5);
-}
-
-/* Segments a batch air function samples in one call at most (a share of
- * the threads' work, and the length of a run of midpoints in the cache). */
-#define SPN__AIR_RUN 512u
-
-/* Air velocity at each tagged segment's midpoint: serially in the internal
- * spring order, or, with a pure air function (spn_world_set_air_pure), on
- * `threads` threads (each segment's sample its own, so the same values).
- * With a batch function (spn_world_set_air_batch), each run of tagged
- * segments in a piece of SPN__AIR_RUN in one call, its midpoints first. */
+/* Air velocity at each particle that ends a tagged segment (w->air_runs):
+ * serially in particle order, or, with a pure air function
+ * (spn_world_set_air_pure), on `threads` threads (each particle's sample
+ * its own, so the same values). With a batch function
+ * (spn_world_set_air_batch), a run in one call. Until the fifty-third
+ * session the air was sampled at each segment's midpoint: on an orb web
+ * about 1.8 samples a particle, and a pass to form the midpoints. */
 static void sample_air(spn_world *w, double t, const spn_vec3 *x, int threads)
 {
     (void)threads; /* (used by the OpenMP pragmas only) */
-    const uint32_t ns = w->ns;
-    if (w->air_batch) {
-        const uint32_t pieces = (ns + SPN__AIR_RUN - 1) / SPN__AIR_RUN;
+    const uint32_t nr = w->nair_runs, *runs = w->air_runs;
 #pragma omp parallel for schedule(static) num_threads(threads) if (w->air_pure && threads > 1)
-        for (uint32_t piece = 0; piece < pieces; piece++) {
-            const uint32_t end = piece * SPN__AIR_RUN + SPN__AIR_RUN < ns ? piece * SPN__AIR_RUN + SPN__AIR_RUN : ns;
-            spn_vec3 mid[SPN__AIR_RUN]; /* (a run's midpoints: 12 KiB of the thread's stack) */
-            for (uint32_t lo = piece * SPN__AIR_RUN; lo < end;) {
-                if (!(w->sdiam[lo] > 0)) {
-                    lo++;
-                    continue;
-                }
-                uint32_t hi = lo;
-                for (; hi < end && w->sdiam[hi] > 0; hi++)
-                    mid[hi - lo] = midpoint(w, x, hi);
-                w->air_batch(w->air_user, t, mid, w->wind + lo, hi - lo);
-                lo = hi;
-            }
-        }
-        return;
+    for (uint32_t r = 0; r < nr; r++) {
+        const uint32_t lo = runs[2 * r], hi = runs[2 * r + 1];
+        if (w->air_batch) w->air_batch(w->air_user, t, x + lo, w->wind + lo, hi - lo);
+        else
+            for (uint32_t i = lo; i < hi; i++) w->wind[i] = w->air_fn(w->air_user, t, x[i]);
     }
-#pragma omp parallel for schedule(static) num_threads(threads) if (w->air_pure && threads > 1)
-    for (uint32_t s = 0; s < ns; s++)
-        if (w->sdiam[s] > 0) w->wind[s] = w->air_fn(w->air_user, t, midpoint(w, x, s));
 }
 
 /* Springs [lo, hi): forces into fs, sums added to sums[0..2], and with
@@ -259,7 +235,7 @@ SPN__KERNEL static void spring_range(spn_world *w, uint32_t lo, uint32_t hi, con
     spn_vec3 *restrict fs = w->fs;
     for (uint32_t s0 = lo; s0 < hi; s0 += SPN_CHUNK) {
         const uint32_t n = hi - s0 < SPN_CHUNK ? hi - s0 : SPN_CHUNK;
-        if (air) chunk_load_ends(&c, hs + s0, n, x, v, UINT32_MAX, true);
+        if (air) chunk_load_ends(&c, hs + s0, n, x, v, UINT32_MAX, w->wind);
         else chunk_load(&c, hs + s0, n, x, v, UINT32_MAX);
         chunk_forces(&c, n, fs + s0);
         chunk_sums(&c, n, sums);

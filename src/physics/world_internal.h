@@ -47,6 +47,9 @@ static inline int spn__thread_count(void)
 /* Items per reduction block; fixed so sums do not depend on the thread count. */
 #define SPN_BLOCK 1024u
 /* Partial sums kept per block. */
+/* Particles a batch air function samples in one call at most (forces.c):
+ * a share of the threads' work. */
+#define SPN__AIR_RUN 512u
 #define SPN_NSUMS 6
 
 /* Per-particle scratch buffers, allocated on first use (see spn__scratch). */
@@ -175,7 +178,9 @@ struct spn_world {
     uint8_t precision;               /* spn_precision: float32 lattice steps when set */
     spn_vec3 *tmp[SPN_TMP_COUNT]; /* per-particle scratch, allocated on demand */
     spn_vec3 *fair;       /* per-spring air force (on demand) */
-    spn_vec3 *wind;       /* per-spring air velocity at the midpoint (on demand) */
+    spn_vec3 *wind;       /* air velocity at each particle that ends a segment with a diameter (on demand) */
+    uint32_t *air_runs;   /* those particles: runs (first, last + 1), in pieces of SPN__AIR_RUN */
+    uint32_t nair_runs;
     double *cair;         /* per-spring linear air-drag coefficient (on demand) */
     spn__jac *jac;        /* implicit: per-spring Jacobian (on demand) */
     double *pinv;         /* implicit: per-particle inverse 3x3 block, 6 each (on demand) */
