@@ -53,12 +53,21 @@ static inline __attribute__((always_inline)) void explicit_block(
     p[S_KE_NEW] = 0.5 * ke_new;
 }
 
-/* One block of the particle pass, compiled in clones like the spring kernels. */
+/* One block of the particle pass, compiled in clones like the spring kernels.
+ * The flags' common cases get copies of their own: spn_world_advance's
+ * steps (no backup) and spn_world_step's, which `spinneret animate` takes,
+ * with and without external forces (a force callback, air). With the flags
+ * as variables the loop kept their tests: the README's physical web, 0.3 s
+ * of animation on one thread (spn_animate, alternating runs, Zen 5), still
+ * air 0.361-0.376 -> 0.331-0.362 s, in --wind air 1.040-1.093 -> 1.021-1.070
+ * (fifty-third session; the same bits). */
 SPN__KERNEL static void explicit_range(const spn__gather_ctx *c, uint32_t lo, uint32_t hi, double dt, bool symplectic,
                                        bool ext, bool backup, spn_vec3 *x, spn_vec3 *v, spn_vec3 *x0, spn_vec3 *v0,
                                        double *p)
 {
     if (symplectic && !ext && !backup) explicit_block(c, lo, hi, dt, true, false, false, x, v, x0, v0, p);
+    else if (symplectic && !ext && backup) explicit_block(c, lo, hi, dt, true, false, true, x, v, x0, v0, p);
+    else if (symplectic && ext && backup) explicit_block(c, lo, hi, dt, true, true, true, x, v, x0, v0, p);
     else explicit_block(c, lo, hi, dt, symplectic, ext, backup, x, v, x0, v0, p);
 }
 
