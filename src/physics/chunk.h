@@ -1,4 +1,4 @@
-/* Chunks of springs for the force loops (forces.c, sweep.c): a scalar loop
+/* Chunks of springs for the force loops (forces.c, sweep.c): a loop
  * gathers each spring's end differences and constants into small arrays,
  * a branch-free loop over them computes the forces (vectorised), a third sums
  * the energy terms in a fixed order. Header-only so both users inline it. */
@@ -8,6 +8,7 @@
 #include "world_internal.h"
 
 #include <math.h>
+#include <string.h>
 
 /* The spring pass works on chunks of SPN_CHUNK springs in three loops: a
  * gather of each spring's end differences (l = x_a - x_b, u = v_a - v_b) and
@@ -30,37 +31,101 @@ typedef struct chunk {
     double wx[SPN_CHUNK], wy[SPN_CHUNK], wz[SPN_CHUNK];
 } chunk;
 
+/* Four numbers on one vector (AVX; SSE2 pairs in the default version),
+ * elementwise IEEE operations; passed by pointer (the default version has
+ * no AVX registers to pass them in, -Wpsabi). */
+typedef double chunk_v4 __attribute__((vector_size(4 * sizeof(double))));
+typedef long long chunk_m4 __attribute__((vector_size(4 * sizeof(long long))));
+
+/* The x, y, z of the four vectors q[0..3] (a particle's three numbers and
+ * one after them each) into ox, oy, oz [0..3]: a transpose in shuffles. */
+SPN__INLINE void chunk_v4_columns(const chunk_v4 q[4], double *restrict ox, double *restrict oy,
+                                  double *restrict oz)
+{
+    const chunk_v4 t0 = __builtin_shuffle(q[0], q[1], (chunk_m4){0, 4, 2, 6});
+    const chunk_v4 t1 = __builtin_shuffle(q[0], q[1], (chunk_m4){1, 5, 3, 7});
+    const chunk_v4 t2 = __builtin_shuffle(q[2], q[3], (chunk_m4){0, 4, 2, 6});
+    const chunk_v4 t3 = __builtin_shuffle(q[2], q[3], (chunk_m4){1, 5, 3, 7});
+    const chunk_v4 cx = __builtin_shuffle(t0, t2, (chunk_m4){0, 1, 4, 5});
+    const chunk_v4 cz = __builtin_shuffle(t0, t2, (chunk_m4){2, 3, 6, 7});
+    const chunk_v4 cy = __builtin_shuffle(t1, t3, (chunk_m4){0, 1, 4, 5});
+    memcpy(ox, &cx, sizeof cx), memcpy(oy, &cy, sizeof cy), memcpy(oz, &cz, sizeof cz);
+}
+
+/* Spring sp into slot j of the chunk, its ends' numbers one at a time
+ * (chunk_load_ends). */
+SPN__INLINE void chunk_load_one(chunk *restrict c, uint32_t j, spn__spring sp, const spn_vec3 *restrict x,
+                                const spn_vec3 *restrict v, uint32_t b_limit, const spn_vec3 *restrict air)
+{
+    const uint32_t a = sp.a, b0 = spn__end_b(sp), b = b0 < b_limit ? b0 : a;
+    const spn_vec3 xa = x[a], xb = x[b], va = v[a], vb = v[b];
+    c->lx[j] = xa.x - xb.x, c->ly[j] = xa.y - xb.y, c->lz[j] = xa.z - xb.z;
+    c->ux[j] = va.x - vb.x, c->uy[j] = va.y - vb.y, c->uz[j] = va.z - vb.z;
+    if (air) {
+        const spn_vec3 wa = air[a], wb = air[b];
+        c->wx[j] = (wa.x - va.x) + (wb.x - vb.x);
+        c->wy[j] = (wa.y - va.y) + (wb.y - vb.y);
+        c->wz[j] = (wa.z - va.z) + (wb.z - vb.z);
+    }
+    c->k[j] = sp.k, c->kd[j] = sp.kd, c->rest[j] = sp.rest;
+    c->tonly[j] = (double)spn__tension_only(sp);
+}
+
 /* Springs hs[0..n) into the chunk, and with `air` (per particle; NULL in
  * each call or in none) their ends' air velocities relative to them,
  * summed. A spring whose end b is at or past b_limit is loaded as if both
  * ends were a (no force; the caller has its force from elsewhere and must
- * not read b: another thread may be moving it). */
+ * not read b: another thread may be moving it). Four springs at a time
+ * read each end's x, v (and air) as one 4-wide load, which takes the number
+ * after it too: only where that is below `end` (np, or the first particle
+ * another thread may write); other springs one at a time. The same
+ * operations either way, so the same bits. */
 SPN__INLINE void chunk_load_ends(chunk *restrict c, const spn__spring *restrict hs, uint32_t n,
                                  const spn_vec3 *restrict x, const spn_vec3 *restrict v, uint32_t b_limit,
-                                 const spn_vec3 *restrict air)
+                                 const spn_vec3 *restrict air, uint32_t end)
 {
-    for (uint32_t j = 0; j < n; j++) {
-        const spn__spring sp = hs[j];
-        const uint32_t a = sp.a, b0 = spn__end_b(sp), b = b0 < b_limit ? b0 : a;
-        const spn_vec3 xa = x[a], xb = x[b], va = v[a], vb = v[b];
-        c->lx[j] = xa.x - xb.x, c->ly[j] = xa.y - xb.y, c->lz[j] = xa.z - xb.z;
-        c->ux[j] = va.x - vb.x, c->uy[j] = va.y - vb.y, c->uz[j] = va.z - vb.z;
-        if (air) {
-            const spn_vec3 wa = air[a], wb = air[b];
-            c->wx[j] = (wa.x - va.x) + (wb.x - vb.x);
-            c->wy[j] = (wa.y - va.y) + (wb.y - vb.y);
-            c->wz[j] = (wa.z - va.z) + (wb.z - vb.z);
+    uint32_t j = 0;
+    for (; j + 4 <= n; j += 4) {
+        uint32_t a[4], b[4], top = 0;
+        for (int q = 0; q < 4; q++) {
+            const spn__spring sp = hs[j + q];
+            const uint32_t b0 = spn__end_b(sp);
+            a[q] = sp.a, b[q] = b0 < b_limit ? b0 : sp.a;
+            top = a[q] > top ? a[q] : top;
+            top = b[q] > top ? b[q] : top;
         }
-        c->k[j] = sp.k, c->kd[j] = sp.kd, c->rest[j] = sp.rest;
-        c->tonly[j] = (double)spn__tension_only(sp);
+        if (top + 1 >= end) {
+            for (uint32_t q = 0; q < 4; q++) chunk_load_one(c, j + q, hs[j + q], x, v, b_limit, air);
+            continue;
+        }
+        chunk_v4 l[4], u[4], w[4];
+        for (int q = 0; q < 4; q++) {
+            chunk_v4 xa, xb, va, vb, wa, wb;
+            memcpy(&xa, x + a[q], sizeof xa), memcpy(&xb, x + b[q], sizeof xb);
+            memcpy(&va, v + a[q], sizeof va), memcpy(&vb, v + b[q], sizeof vb);
+            l[q] = xa - xb, u[q] = va - vb;
+            if (air) {
+                memcpy(&wa, air + a[q], sizeof wa), memcpy(&wb, air + b[q], sizeof wb);
+                w[q] = (wa - va) + (wb - vb);
+            }
+        }
+        chunk_v4_columns(l, c->lx + j, c->ly + j, c->lz + j);
+        chunk_v4_columns(u, c->ux + j, c->uy + j, c->uz + j);
+        if (air) chunk_v4_columns(w, c->wx + j, c->wy + j, c->wz + j);
+        for (int q = 0; q < 4; q++) {
+            const spn__spring sp = hs[j + q];
+            c->k[j + q] = sp.k, c->kd[j + q] = sp.kd, c->rest[j + q] = sp.rest;
+            c->tonly[j + q] = (double)spn__tension_only(sp);
+        }
     }
+    for (; j < n; j++) chunk_load_one(c, j, hs[j], x, v, b_limit, air);
 }
 
 /* chunk_load_ends without the air. */
 SPN__INLINE void chunk_load(chunk *restrict c, const spn__spring *restrict hs, uint32_t n,
-                            const spn_vec3 *restrict x, const spn_vec3 *restrict v, uint32_t b_limit)
+                            const spn_vec3 *restrict x, const spn_vec3 *restrict v, uint32_t b_limit, uint32_t end)
 {
-    chunk_load_ends(c, hs, n, x, v, b_limit, NULL);
+    chunk_load_ends(c, hs, n, x, v, b_limit, NULL, end);
 }
 
 /* Force on end a of each spring of the chunk, into fs; the elastic energy,

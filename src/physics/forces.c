@@ -197,7 +197,7 @@ SPN__KERNEL static void air_forces(spn_world *w, uint32_t lo, uint32_t hi, const
     chunk c;
     for (uint32_t s0 = lo; s0 < hi; s0 += SPN_CHUNK) {
         const uint32_t n = hi - s0 < SPN_CHUNK ? hi - s0 : SPN_CHUNK;
-        chunk_load_ends(&c, w->hs + s0, n, x, v, UINT32_MAX, w->wind);
+        chunk_load_ends(&c, w->hs + s0, n, x, v, UINT32_MAX, w->wind, w->np);
         air_chunk(w, s0, n, &c);
     }
 }
@@ -235,8 +235,8 @@ SPN__KERNEL static void spring_range(spn_world *w, uint32_t lo, uint32_t hi, con
     spn_vec3 *restrict fs = w->fs;
     for (uint32_t s0 = lo; s0 < hi; s0 += SPN_CHUNK) {
         const uint32_t n = hi - s0 < SPN_CHUNK ? hi - s0 : SPN_CHUNK;
-        if (air) chunk_load_ends(&c, hs + s0, n, x, v, UINT32_MAX, w->wind);
-        else chunk_load(&c, hs + s0, n, x, v, UINT32_MAX);
+        if (air) chunk_load_ends(&c, hs + s0, n, x, v, UINT32_MAX, w->wind, w->np);
+        else chunk_load(&c, hs + s0, n, x, v, UINT32_MAX, w->np);
         chunk_forces(&c, n, fs + s0);
         chunk_sums(&c, n, sums);
         if (air) air_chunk(w, s0, n, &c);

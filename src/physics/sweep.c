@@ -149,7 +149,7 @@ SPN__KERNEL static void sweep_block(const spn_world *w, const sweep_args *s, uin
     const uint32_t s_lo = s->a_start[lo], s_hi = s->a_start[hi];
     for (uint32_t s0 = s_lo; s0 < s_hi; s0 += SPN_CHUNK) {
         const uint32_t n = s_hi - s0 < SPN_CHUNK ? s_hi - s0 : SPN_CHUNK;
-        chunk_load(&c, s->hs + s0, n, s->x, s->v, hi);
+        chunk_load(&c, s->hs + s0, n, s->x, s->v, hi, hi);
         chunk_forces(&c, n, buf);
         chunk_sums(&c, n, sums);
         /* End a's forces are summed in a register while a stays the same
