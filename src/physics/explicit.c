@@ -27,8 +27,9 @@ enum { S_KE_OLD, S_GAIN, S_DAMP, S_WORK, S_KE_NEW };
  * into p[]. Inlined with constant flags below, so the common case (symplectic,
  * no external force, no backup) has no tests in its loop. */
 static inline __attribute__((always_inline)) void explicit_block(
-    const spn__gather_ctx *restrict c, uint32_t lo, uint32_t hi, double dt, bool symplectic, bool ext, bool backup,
-    spn_vec3 *restrict x, spn_vec3 *restrict v, spn_vec3 *restrict x0, spn_vec3 *restrict v0, double *p)
+    const spn__gather_ctx *restrict c, uint32_t lo, uint32_t hi, double dt, bool symplectic, bool ext, bool air,
+    bool backup, spn_vec3 *restrict x, spn_vec3 *restrict v, spn_vec3 *restrict x0, spn_vec3 *restrict v0,
+    double *p)
 {
     const spn_vec3 g = c->g;
     double ke_old = 0, gain = 0, work = 0, ke_new = 0;
@@ -37,7 +38,9 @@ static inline __attribute__((always_inline)) void explicit_block(
         if (backup) x0[i] = xi, v0[i] = vi;
         const double im = c->inv_mass[i];
         if (im == 0) continue;
-        const spn_vec3 fi = spn__force_on(c, i, vi, ext, true);
+        /* (external: fext[i], in air with its segments' air forces added here) */
+        const spn_vec3 fe = ext ? (air ? spn__air_on(c, i, c->fext[i]) : c->fext[i]) : spn_v3(0, 0, 0);
+        const spn_vec3 fs = spn__force_on(c, i, vi, false, true), fi = ext ? spn_v3_add(fs, fe) : fs;
         const spn_vec3 vn = spn__fma_v3(fi, dt * im, vi), vm = symplectic ? vn : vi;
         const spn_vec3 dx = spn_v3_scale(vm, dt);
         x[i] = spn__fma_v3(vm, dt, xi);
@@ -46,7 +49,7 @@ static inline __attribute__((always_inline)) void explicit_block(
         ke_old += m * spn_v3_dot(vi, vi);
         ke_new += m * spn_v3_dot(vn, vn);
         gain += m * (0.5 * spn_v3_dot(spn_v3_sub(vn, vi), spn_v3_add(vn, vi)) - spn_v3_dot(g, dx));
-        if (ext) work += spn_v3_dot(c->fext[i], dx);
+        if (ext) work += spn_v3_dot(fe, dx);
     }
     /* sum m v^2 is twice the kinetic energy, and drag dissipates drag m v^2 */
     p[S_KE_OLD] = 0.5 * ke_old, p[S_GAIN] = gain, p[S_DAMP] = c->drag * ke_old, p[S_WORK] = work,
@@ -56,19 +59,21 @@ static inline __attribute__((always_inline)) void explicit_block(
 /* One block of the particle pass, compiled in clones like the spring kernels.
  * The flags' common cases get copies of their own: spn_world_advance's
  * steps (no backup) and spn_world_step's, which `spinneret animate` takes,
- * with and without external forces (a force callback, air). With the flags
+ * in still air and in air (`air`: the segments' air forces gathered here,
+ * not written to fext by spn__external first; the same operations, 2-3%
+ * off a step in air, fifty-third session). With the flags
  * as variables the loop kept their tests: the README's physical web, 0.3 s
  * of animation on one thread (spn_animate, alternating runs, Zen 5), still
  * air 0.361-0.376 -> 0.331-0.362 s, in --wind air 1.040-1.093 -> 1.021-1.070
  * (fifty-third session; the same bits). */
 SPN__KERNEL static void explicit_range(const spn__gather_ctx *c, uint32_t lo, uint32_t hi, double dt, bool symplectic,
-                                       bool ext, bool backup, spn_vec3 *x, spn_vec3 *v, spn_vec3 *x0, spn_vec3 *v0,
-                                       double *p)
+                                       bool ext, bool air, bool backup, spn_vec3 *x, spn_vec3 *v, spn_vec3 *x0,
+                                       spn_vec3 *v0, double *p)
 {
-    if (symplectic && !ext && !backup) explicit_block(c, lo, hi, dt, true, false, false, x, v, x0, v0, p);
-    else if (symplectic && !ext && backup) explicit_block(c, lo, hi, dt, true, false, true, x, v, x0, v0, p);
-    else if (symplectic && ext && backup) explicit_block(c, lo, hi, dt, true, true, true, x, v, x0, v0, p);
-    else explicit_block(c, lo, hi, dt, symplectic, ext, backup, x, v, x0, v0, p);
+    if (symplectic && !ext && !backup) explicit_block(c, lo, hi, dt, true, false, false, false, x, v, x0, v0, p);
+    else if (symplectic && !ext && backup) explicit_block(c, lo, hi, dt, true, false, false, true, x, v, x0, v0, p);
+    else if (symplectic && air && backup) explicit_block(c, lo, hi, dt, true, true, true, true, x, v, x0, v0, p);
+    else explicit_block(c, lo, hi, dt, symplectic, ext, air, backup, x, v, x0, v0, p);
 }
 
 void spn__step_explicit(spn_world *w, double dt, bool symplectic, spn__step_result *r)
@@ -77,7 +82,9 @@ void spn__step_explicit(spn_world *w, double dt, bool symplectic, spn__step_resu
     if (!w->force_fn && !spn__air_active(w) && spn__step_sweep(w, dt, symplectic, r)) return;
     spn__eval e;
     spn__spring_pass(w, w->t, w->x, w->v, &e);
-    const bool ext = spn__external(w, w->t, w->x, w->v);
+    /* (the air's half forces on the ends added in the particle pass, not
+     * written to fext first) */
+    const bool ext = spn__external_user(w, w->t, w->x, w->v), air = spn__air_active(w);
     const uint32_t np = w->np, nb = spn__blocks(np);
     spn_vec3 *restrict x = w->x, *restrict v = w->v, *restrict x0 = w->x0, *restrict v0 = w->v0;
     double *partial = w->partial;
@@ -88,7 +95,7 @@ void spn__step_explicit(spn_world *w, double dt, bool symplectic, spn__step_resu
         const uint32_t lo = blk * SPN_BLOCK, hi = lo + SPN_BLOCK < np ? lo + SPN_BLOCK : np;
         const spn__gather_ctx c = ctx;
         double *p = partial + (size_t)blk * SPN_NSUMS;
-        explicit_range(&c, lo, hi, dt, symplectic, ext, backup, x, v, x0, v0, p);
+        explicit_range(&c, lo, hi, dt, symplectic, ext, air, backup, x, v, x0, v0, p);
     }
     double sum[SPN_NSUMS];
     spn__sum_partials(w, nb, sum);

@@ -276,12 +276,9 @@ void spn__spring_pass(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 
 
 bool spn__external(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v)
 {
-    const bool air = spn__air_active(w);
-    if (!w->force_fn && !air) return false;
+    if (!spn__external_user(w, t, x, v)) return false;
+    if (!spn__air_active(w)) return true;
     const uint32_t np = w->np;
-    memset(w->fext, 0, np * sizeof *w->fext);
-    if (w->force_fn) w->force_fn(w->force_user, w, t, x, v, w->fext);
-    if (!air) return true;
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
     for (uint32_t i = 0; i < np; i++) {
         spn_vec3 fi = w->fext[i];
@@ -319,6 +316,14 @@ double spn_world_air_power(spn_world *w)
     double power = 0;
     for (uint32_t blk = 0; blk < nb; blk++) power += partial[(size_t)blk * SPN_NSUMS];
     return power;
+}
+
+bool spn__external_user(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v)
+{
+    if (!w->force_fn && !spn__air_active(w)) return false;
+    memset(w->fext, 0, w->np * sizeof *w->fext);
+    if (w->force_fn) w->force_fn(w->force_user, w, t, x, v, w->fext);
+    return true;
 }
 
 void spn__gather(spn_world *w, const spn_vec3 *x, const spn_vec3 *v, bool has_ext, spn_vec3 *f, spn__eval *e)

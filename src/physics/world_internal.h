@@ -278,6 +278,10 @@ void spn__spring_pass(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 
 /* The external forces at (x, v) into w->fext: the user callback, then air
  * (the air part needs spn__spring_pass first). False when there are none. */
 bool spn__external(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v);
+/* spn__external without the air's half forces on the ends: w->fext holds
+ * the force callback's (zeros without one); the caller adds the air's
+ * (spn__air_on) in spn__external's order. */
+bool spn__external_user(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v);
 /* Gather the total force on every particle into f: gravity, viscous drag,
  * springs (w->fs), w->fext when `has_ext`. Adds kinetic energy, drag power and
  * external power of the state to `e`. */
@@ -305,12 +309,25 @@ typedef struct spn__gather_ctx {
     const double *restrict mass, *restrict inv_mass;
     spn_vec3 g;
     double drag;
+    /* the air's forces on the segments and the signed adjacency (spn__air_on) */
+    const uint32_t *restrict adj_start, *restrict adj;
+    const spn_vec3 *restrict fair;
 } spn__gather_ctx;
 
 static inline spn__gather_ctx spn__gather_ctx_of(const spn_world *w)
 {
-    spn__gather_ctx c = {w->a_start, w->b_start, w->b_adj, w->fs, w->fext, w->mass, w->inv_mass, w->def.gravity, w->def.drag};
+    spn__gather_ctx c = {w->a_start, w->b_start, w->b_adj, w->fs,       w->fext,   w->mass,
+                         w->inv_mass, w->def.gravity, w->def.drag, w->adj_start, w->adj, w->fair};
     return c;
+}
+
+/* fe plus half of each of particle i's segments' air forces, in adjacency
+ * order: what spn__external adds to fext[i], the same operations. */
+SPN__INLINE spn_vec3 spn__air_on(const spn__gather_ctx *c, uint32_t i, spn_vec3 fe)
+{
+    for (uint32_t j = c->adj_start[i]; j < c->adj_start[i + 1]; j++)
+        fe = spn_v3_add(fe, spn_v3_scale(c->fair[c->adj[j] >> 1], 0.5));
+    return fe;
 }
 
 /* Gravity and viscous drag on a particle of mass m at velocity v,
