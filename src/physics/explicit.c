@@ -59,13 +59,13 @@ static inline __attribute__((always_inline)) void explicit_block(
 /* One block of the particle pass, compiled in clones like the spring kernels.
  * The flags' common cases get copies of their own: spn_world_advance's
  * steps (no backup) and spn_world_step's, which `spinneret animate` takes,
- * in still air and in air (`air`: the segments' air forces gathered here,
- * not written to fext by spn__external first; the same operations, 2-3%
- * off a step in air, fifty-third session). With the flags
- * as variables the loop kept their tests: the README's physical web, 0.3 s
- * of animation on one thread (spn_animate, alternating runs, Zen 5), still
- * air 0.361-0.376 -> 0.331-0.362 s, in --wind air 1.040-1.093 -> 1.021-1.070
- * (fifty-third session; the same bits). */
+ * in still air and in air. With the flags as variables the loop kept their
+ * tests: the README's physical web, 0.3 s of animation on one thread
+ * (spn_animate, alternating runs, Zen 5), still air 0.361-0.376 ->
+ * 0.331-0.362 s, in --wind air 1.040-1.093 -> 1.021-1.070. With `air` the
+ * segments' air forces are gathered here (spn__air_on) instead of written
+ * to fext by spn__external first: 2-3% off a step in air. Both the same
+ * bits (fifty-third session). */
 SPN__KERNEL static void explicit_range(const spn__gather_ctx *c, uint32_t lo, uint32_t hi, double dt, bool symplectic,
                                        bool ext, bool air, bool backup, spn_vec3 *x, spn_vec3 *v, spn_vec3 *x0,
                                        spn_vec3 *v0, double *p)
