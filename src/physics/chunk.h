@@ -35,20 +35,20 @@ typedef struct chunk {
  * elementwise IEEE operations; passed by pointer (the default version has
  * no AVX registers to pass them in, -Wpsabi). */
 typedef double chunk_v4 __attribute__((vector_size(4 * sizeof(double))));
-typedef long long chunk_m4 __attribute__((vector_size(4 * sizeof(long long))));
 
 /* The x, y, z of the four vectors q[0..3] (a particle's three numbers and
- * one after them each) into ox, oy, oz [0..3]: a transpose in shuffles. */
+ * one after them each) into ox, oy, oz [0..3]: a transpose in shuffles
+ * (__builtin_shufflevector: GCC from 12 and clang, which the fuzzers use). */
 SPN__INLINE void chunk_v4_columns(const chunk_v4 q[4], double *restrict ox, double *restrict oy,
                                   double *restrict oz)
 {
-    const chunk_v4 t0 = __builtin_shuffle(q[0], q[1], (chunk_m4){0, 4, 2, 6});
-    const chunk_v4 t1 = __builtin_shuffle(q[0], q[1], (chunk_m4){1, 5, 3, 7});
-    const chunk_v4 t2 = __builtin_shuffle(q[2], q[3], (chunk_m4){0, 4, 2, 6});
-    const chunk_v4 t3 = __builtin_shuffle(q[2], q[3], (chunk_m4){1, 5, 3, 7});
-    const chunk_v4 cx = __builtin_shuffle(t0, t2, (chunk_m4){0, 1, 4, 5});
-    const chunk_v4 cz = __builtin_shuffle(t0, t2, (chunk_m4){2, 3, 6, 7});
-    const chunk_v4 cy = __builtin_shuffle(t1, t3, (chunk_m4){0, 1, 4, 5});
+    const chunk_v4 t0 = __builtin_shufflevector(q[0], q[1], 0, 4, 2, 6);
+    const chunk_v4 t1 = __builtin_shufflevector(q[0], q[1], 1, 5, 3, 7);
+    const chunk_v4 t2 = __builtin_shufflevector(q[2], q[3], 0, 4, 2, 6);
+    const chunk_v4 t3 = __builtin_shufflevector(q[2], q[3], 1, 5, 3, 7);
+    const chunk_v4 cx = __builtin_shufflevector(t0, t2, 0, 1, 4, 5);
+    const chunk_v4 cz = __builtin_shufflevector(t0, t2, 2, 3, 6, 7);
+    const chunk_v4 cy = __builtin_shufflevector(t1, t3, 0, 1, 4, 5);
     memcpy(ox, &cx, sizeof cx), memcpy(oy, &cy, sizeof cy), memcpy(oz, &cz, sizeof cz);
 }
 
