@@ -64,23 +64,35 @@ static spn_vec3 steady(void *user, double t, spn_vec3 p)
     return *(const spn_vec3 *)user;
 }
 
+/* n particles of mass m, len apart along x, without gravity, joined in a
+ * row by springs of k 1 at rest, tagged 7 (the last `plain` tagged 8). */
+static spn_world *row_of_segments(int n, double len, double m, int plain)
+{
+    spn_world_def def = spn_world_def_default();
+    def.gravity = spn_v3(0, 0, 0);
+    spn_world *w = spn_world_create(&def);
+    spn_particle_def p = spn_particle_def_default();
+    p.mass = m;
+    for (int i = 0; i < n; i++) {
+        p.position = spn_v3(i * len, 0, 0);
+        assert_int_equal(spn_world_add_particle(w, &p, NULL), SPN_OK);
+    }
+    spn_spring_def s = spn_spring_def_default();
+    s.k = 1;
+    for (int i = 0; i + 1 < n; i++) {
+        s.a = (uint32_t)i, s.b = (uint32_t)i + 1, s.tag = i + 1 < n - plain ? 7 : 8;
+        assert_int_equal(spn_world_add_spring(w, &s, NULL), SPN_OK);
+    }
+    return w;
+}
+
 static void test_segment_force(void **state)
 {
     (void)state;
     const double d = 3e-6, rho = 1.2, mu = 1.8e-5, len = 0.01, m = 1e-7, dt = 1e-9;
     spn_vec3 winds[2] = {spn_v3(0, 0, 2), spn_v3(2, 0, 0)};
     for (int c = 0; c < 2; c++) {
-        spn_world_def def = spn_world_def_default();
-        def.gravity = spn_v3(0, 0, 0);
-        spn_world *w = spn_world_create(&def);
-        spn_particle_def p = spn_particle_def_default();
-        p.mass = m;
-        spn_world_add_particle(w, &p, NULL);
-        p.position = spn_v3(len, 0, 0);
-        spn_world_add_particle(w, &p, NULL);
-        spn_spring_def s = spn_spring_def_default();
-        s.a = 0, s.b = 1, s.k = 1, s.tag = 7;
-        spn_world_add_spring(w, &s, NULL);
+        spn_world *w = row_of_segments(2, len, m, 0);
         spn_world_set_air(w, steady, &winds[c], rho, mu);
         spn_world_set_tag_diameter(w, 7, d);
         assert_int_equal(spn_world_step(w, dt), SPN_OK);
@@ -122,21 +134,8 @@ static void test_air_at_the_ends(void **state)
 {
     (void)state;
     const double d = 3e-6, rho = 1.2, mu = 1.8e-5, len = 0.01, m = 1e-7, dt = 1e-9;
-    spn_world_def def = spn_world_def_default();
-    def.gravity = spn_v3(0, 0, 0);
-    def.integrator = SPN_INTEGRATOR_SYMPLECTIC;
-    spn_world *w = spn_world_create(&def);
-    spn_particle_def p = spn_particle_def_default();
-    p.mass = m;
-    for (int i = 0; i < 3; i++) {
-        p.position = spn_v3(i * len, 0, 0);
-        spn_world_add_particle(w, &p, NULL);
-    }
-    spn_spring_def s = spn_spring_def_default();
-    s.a = 0, s.b = 1, s.k = 1, s.tag = 7;
-    spn_world_add_spring(w, &s, NULL);
-    s.a = 1, s.b = 2, s.tag = 8; /* (no diameter) */
-    spn_world_add_spring(w, &s, NULL);
+    spn_world *w = row_of_segments(3, len, m, 1); /* (the second segment, tag 8, has no diameter) */
+    spn_world_set_integrator(w, SPN_INTEGRATOR_SYMPLECTIC);
     asked a = {0};
     spn_world_set_air(w, curved, &a, rho, mu);
     spn_world_set_tag_diameter(w, 7, d);

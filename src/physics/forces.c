@@ -279,13 +279,9 @@ bool spn__external(spn_world *w, double t, const spn_vec3 *x, const spn_vec3 *v)
     if (!spn__external_user(w, t, x, v)) return false;
     if (!spn__air_active(w)) return true;
     const uint32_t np = w->np;
+    const spn__gather_ctx c = spn__gather_ctx_of(w);
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
-    for (uint32_t i = 0; i < np; i++) {
-        spn_vec3 fi = w->fext[i];
-        for (uint32_t j = w->adj_start[i]; j < w->adj_start[i + 1]; j++)
-            fi = spn_v3_add(fi, spn_v3_scale(w->fair[w->adj[j] >> 1], 0.5));
-        w->fext[i] = fi;
-    }
+    for (uint32_t i = 0; i < np; i++) w->fext[i] = spn__air_on(&c, i, w->fext[i]);
     return true;
 }
 

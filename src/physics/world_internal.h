@@ -47,10 +47,10 @@ static inline int spn__thread_count(void)
 /* Items per reduction block; fixed so sums do not depend on the thread count. */
 #define SPN_BLOCK 1024u
 /* Partial sums kept per block. */
+#define SPN_NSUMS 6
 /* Particles a batch air function samples in one call at most (forces.c):
  * a share of the threads' work. */
 #define SPN__AIR_RUN 512u
-#define SPN_NSUMS 6
 
 /* Per-particle scratch buffers, allocated on first use (see spn__scratch). */
 enum {
@@ -322,7 +322,7 @@ static inline spn__gather_ctx spn__gather_ctx_of(const spn_world *w)
 }
 
 /* fe plus half of each of particle i's segments' air forces, in adjacency
- * order: what spn__external adds to fext[i], the same operations. */
+ * order (spn__external into fext, the explicit step in its particle pass). */
 SPN__INLINE spn_vec3 spn__air_on(const spn__gather_ctx *c, uint32_t i, spn_vec3 fe)
 {
     for (uint32_t j = c->adj_start[i]; j < c->adj_start[i + 1]; j++)
