@@ -153,6 +153,118 @@ static void test_air_at_the_ends(void **state)
     spn_world_destroy(w);
 }
 
+/* An air function linear in time and in x, that keeps where and when it
+ * was asked: w_z = 2 + 100 t + 10 x. */
+typedef struct asked_when {
+    int n;
+    spn_vec3 at[16];
+    double t[16];
+} asked_when;
+
+static spn_vec3 linear(void *user, double t, spn_vec3 p)
+{
+    asked_when *a = user;
+    if (a->n < 16) a->at[a->n] = p, a->t[a->n] = t;
+    a->n++;
+    return spn_v3(0, 0, 2 + 100 * t + 10 * p.x);
+}
+
+/* Calls k to k + n - 1 were at time t, at the centres of the cells (of 3
+ * mm) cx[0..n) along x, the first along y and z. */
+static void asked_at(const asked_when *a, int k, int n, double t, const double *cx)
+{
+    for (int i = 0; i < n; i++) {
+        assert_true(a->t[k + i] == t);
+        assert_true(fabs(a->at[k + i].x - (cx[i] + 0.5) * 3e-3) < 1e-15);
+        assert_true(fabs(a->at[k + i].y - 1.5e-3) < 1e-15 && fabs(a->at[k + i].z - 1.5e-3) < 1e-15);
+    }
+}
+
+/* Under spn_world_set_air_resolution (5 ms, 3 mm) a particle's air is taken
+ * at the centre of its 3 mm cell at the two ends of the 5 ms interval the
+ * step is in, and blended between them: for air linear in time, the air at
+ * the cell's centre at the step's time. It is taken again only when the
+ * interval changes (the next one: only its end, the start being the end
+ * held) or a particle changes cell (that particle alone), and what a
+ * particle feels is a function of its position and the time: a copy of the
+ * world, which holds nothing, steps to the same bits. */
+static void test_air_resolution(void **state)
+{
+    (void)state;
+    const double d = 3e-6, rho = 1.2, mu = 1.8e-5, len = 0.01, m = 1e-7, dt = 1e-9;
+    spn_world *w = row_of_segments(2, len, m, 0);
+    spn_world_set_integrator(w, SPN_INTEGRATOR_SYMPLECTIC);
+    asked_when a = {0};
+    spn_world_set_air(w, linear, &a, rho, mu);
+    spn_world_set_tag_diameter(w, 7, d);
+    assert_int_equal(spn_world_set_air_resolution(w, 5e-3, 3e-3), SPN_OK);
+    spn_world_set_time(w, 0.0123);
+    assert_int_equal(spn_world_step(w, dt), SPN_OK);
+    assert_int_equal(a.n, 4); /* both ends of interval 2 at both particles */
+    const double cells[2] = {0, 3}, moved[1] = {4};
+    asked_at(&a, 0, 2, 2 * 5e-3, cells);
+    asked_at(&a, 2, 2, 3 * 5e-3, cells);
+    const double u = 2 + 100 * 0.0123 + 10 * (0.5 * (0.5 + 3.5) * 3e-3); /* the ends' mean */
+    const double half = 0.25 * rho * spn_cylinder_drag_coefficient(rho * u * d / mu) * d * len * u * u;
+    for (uint32_t i = 0; i < 2; i++) {
+        const spn_vec3 f = spn_v3_scale(spn_world_velocity(w, i), m / dt);
+        assert_true(fabs(f.z - half) <= 1e-6 * half);
+    }
+    assert_int_equal(spn_world_step(w, dt), SPN_OK);
+    assert_int_equal(a.n, 4); /* the same cells and interval: nothing asked */
+    spn_world_set_time(w, 0.0151);
+    assert_int_equal(spn_world_step(w, dt), SPN_OK);
+    assert_int_equal(a.n, 6); /* the next interval: its end */
+    asked_at(&a, 4, 2, 4 * 5e-3, cells);
+    assert_int_equal(spn_world_set_position(w, 1, spn_v3(0.0125, 0, 0)), SPN_OK);
+    assert_int_equal(spn_world_step(w, dt), SPN_OK);
+    assert_int_equal(a.n, 8); /* particle 1 in a new cell: both ends there */
+    asked_at(&a, 6, 1, 3 * 5e-3, moved);
+    asked_at(&a, 7, 1, 4 * 5e-3, moved);
+    spn_world *copy = spn_world_clone(w);
+    assert_non_null(copy);
+    for (int i = 0; i < 3; i++) {
+        assert_int_equal(spn_world_step(w, dt), SPN_OK);
+        assert_int_equal(spn_world_step(copy, dt), SPN_OK);
+    }
+    for (uint32_t i = 0; i < 2; i++) {
+        const spn_vec3 xa = spn_world_position(w, i), xb = spn_world_position(copy, i);
+        const spn_vec3 va = spn_world_velocity(w, i), vb = spn_world_velocity(copy, i);
+        assert_memory_equal(&xa, &xb, sizeof xa);
+        assert_memory_equal(&va, &vb, sizeof va);
+    }
+    spn_world_set_time(w, 0.05);
+    const int before = a.n;
+    assert_int_equal(spn_world_step(w, dt), SPN_OK);
+    assert_int_equal(a.n - before, 4); /* an interval further on: everything */
+    spn_world_destroy(copy);
+    spn_world_destroy(w);
+}
+
+/* The resolution takes two positive finite numbers or two zeros, and
+ * spn_world_set_air clears it. */
+static void test_air_resolution_rejects(void **state)
+{
+    (void)state;
+    spn_world *w = row_of_segments(2, 0.01, 1e-7, 0);
+    const double bad[][2] = {{-1, 1e-3}, {5e-3, 0}, {0, 3e-3}, {NAN, 1e-3}, {5e-3, INFINITY}, {5e-3, -2e-3}};
+    assert_int_equal(spn_world_set_air_resolution(w, 5e-3, 3e-3), SPN_OK);
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        assert_int_equal(spn_world_set_air_resolution(w, bad[i][0], bad[i][1]), SPN_ERR_INVALID);
+        assert_non_null(strstr(spn_last_error(), "air resolution"));
+        double dt, h;
+        spn_world_air_resolution(w, &dt, &h);
+        assert_true(dt == 5e-3 && h == 3e-3); /* unchanged */
+    }
+    asked_when a = {0};
+    spn_world_set_air(w, linear, &a, 1.2, 1.8e-5);
+    double dt = 1, h = 1;
+    spn_world_air_resolution(w, &dt, &h);
+    assert_true(dt == 0 && h == 0);
+    assert_int_equal(spn_world_set_air_resolution(w, 0, 0), SPN_OK);
+    spn_world_destroy(w);
+}
+
 /* A taut 20-segment silk-like thread across a 2 m/s wind. */
 static spn_world *thread_in_wind(spn_integrator integ, spn_vec3 *wind)
 {
@@ -225,6 +337,8 @@ int main(void)
         cmocka_unit_test(test_drag_coefficient),
         cmocka_unit_test(test_segment_force),
         cmocka_unit_test(test_air_at_the_ends),
+        cmocka_unit_test(test_air_resolution),
+        cmocka_unit_test(test_air_resolution_rejects),
         cmocka_unit_test(test_thread_in_wind),
         cmocka_unit_test(test_provot),
     };

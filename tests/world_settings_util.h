@@ -55,6 +55,7 @@ static void util_set_everything(spn_world *w, spn_collide_fn collide, const char
     spn_world_set_break_callback(w, util_on_break, &util_break_user);
     spn_world_set_collide_callback(w, collide, &util_collide_user);
     spn_world_set_air(w, util_breeze, &util_air_user, 1.1, 1.9e-5);
+    assert_int_equal(spn_world_set_air_resolution(w, 4e-3, 2e-3), SPN_OK);
     spn_world_set_tag_diameter(w, SPN_THREAD_CAPTURE, 1e-5);
     spn_world_set_tag_diameter(w, SPN_THREAD_RADIUS, 3e-6);
     assert_int_equal(spn_world_set_tag_hysteresis(w, SPN_THREAD_RADIUS, 0.6, 2e-3), SPN_OK);
@@ -87,6 +88,9 @@ static void util_same_settings(const spn_world *a, const spn_world *b)
     assert_ptr_equal(spn_world_air(a, &ua, &rho_a, &mu_a), spn_world_air(b, &ub, &rho_b, &mu_b));
     assert_ptr_equal(ua, ub);
     assert_true(rho_a == rho_b && mu_a == mu_b);
+    double ia, ib, sa, sb;
+    spn_world_air_resolution(a, &ia, &sa), spn_world_air_resolution(b, &ib, &sb);
+    assert_true(ia == ib && sa == sb);
     for (uint32_t tag = 0; tag <= SPN_THREAD_SHOT; tag++) {
         double ra, rb;
         assert_true(spn_world_tag_diameter(a, tag) == spn_world_tag_diameter(b, tag));

@@ -274,7 +274,8 @@ SPN_API spn_force_fn spn_world_force_callback(const spn_world *w, void **user);
 
 /// Air velocity at a point and time [m/s], for aerodynamic drag on threads.
 /// Called from one thread, once per particle that ends a tagged segment (at
-/// its position) per force evaluation, in a fixed order, so it may keep state.
+/// its position) per force evaluation, in a fixed order, so it may keep state
+/// (with spn_world_set_air_resolution set: at cell centres, only as it says).
 /// A segment feels the mean of its two ends' air relative to them.
 typedef spn_vec3 (*spn_air_fn)(void *user, double t, spn_vec3 position);
 /// Air and its properties: segments whose tag has a diameter (below) feel drag
@@ -298,6 +299,22 @@ typedef void (*spn_air_batch_fn)(void *user, double t, const spn_vec3 *position,
 /// at a time (from several threads when pure). NULL: one call per particle.
 /// spn_world_set_air clears it.
 SPN_API void spn_world_set_air_batch(spn_world *w, spn_air_batch_fn fn);
+/// Sample the air coarser than every force evaluation, for an air function
+/// that is itself interpolated (spn_air_attach sets this for a field on a
+/// grid: spn_air_resolution). A particle's air is then taken at the centre
+/// of its cell of `spacing` [m], (floor(x / spacing) + 1/2) spacing in each
+/// coordinate, at the two times k interval and (k + 1) interval [s] around
+/// the evaluation's time t, and interpolated linearly between them in t.
+/// The world keeps the two samples (as float) and takes them again only when
+/// the cell or k changes, so a web swaying slowly samples its air once an
+/// interval, not once a step. What a particle feels is a function of its position and the
+/// time alone: the same on any thread count, after a copy and in a replayed
+/// step. Both 0 (the default, and what spn_world_set_air sets): the air at
+/// the particle itself at t, every evaluation. SPN_ERR_INVALID for anything but
+/// two positive finite numbers or two zeros.
+SPN_API spn_status spn_world_set_air_resolution(spn_world *w, double interval, double spacing);
+/// The interval and spacing of spn_world_set_air_resolution (0, 0: exact).
+SPN_API void spn_world_air_resolution(const spn_world *w, double *interval, double *spacing);
 /// The air function (NULL: still air); its user pointer, rho and mu into the
 /// arguments that are not NULL (rho 1.204, mu 1.81e-5 until set).
 SPN_API spn_air_fn spn_world_air(const spn_world *w, void **user, double *rho, double *mu);

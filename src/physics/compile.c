@@ -33,6 +33,7 @@ void spn__free_compiled(spn_world *w)
     free(w->fair);
     free(w->wind);
     free(w->air_runs);
+    free(w->air_held);
     free(w->cair);
     free(w->jac);
     free(w->pinv);
@@ -51,6 +52,8 @@ void spn__forget_compiled(spn_world *w)
     w->jac = NULL;
     w->air_runs = NULL;
     w->nair_runs = 0;
+    w->air_held = NULL;
+    w->air_held_k = NAN;
     w->imp_mg = NULL;
     w->npartial = 0;
     w->sweep_block = 0;
@@ -140,8 +143,10 @@ static bool alloc_air(spn_world *w)
     w->fair = calloc(w->ns, sizeof *w->fair);
     w->wind = calloc(w->np, sizeof *w->wind);
     w->cair = calloc(w->ns, sizeof *w->cair);
+    if (w->air_interval > 0) w->air_held = malloc(9 * (size_t)w->np * sizeof *w->air_held);
+    w->air_held_k = NAN; /* (nothing held yet) */
     uint8_t *need = calloc(w->np, 1);
-    const bool ok = w->fair && w->wind && w->cair && need && air_runs(w, need);
+    const bool ok = w->fair && w->wind && w->cair && (w->air_interval == 0 || w->air_held) && need && air_runs(w, need);
     free(need);
     return ok;
 }

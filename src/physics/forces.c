@@ -202,23 +202,110 @@ SPN__KERNEL static void air_forces(spn_world *w, uint32_t lo, uint32_t hi, const
     }
 }
 
+/* The air at n points at time t: a batch call, or a call a point. */
+static void air_at(const spn_world *w, double t, const spn_vec3 *p, spn_vec3 *out, uint32_t n)
+{
+    if (w->air_batch) w->air_batch(w->air_user, t, p, out, n);
+    else
+        for (uint32_t i = 0; i < n; i++) out[i] = w->air_fn(w->air_user, t, p[i]);
+}
+
+/* What sample_held takes again besides the particles that changed cell:
+ * nothing (the interval held), the end of the interval after the one held
+ * (its start is the end held), or everything. */
+enum { HELD_SAME, HELD_NEXT, HELD_ALL };
+
+/* The run [lo, hi) at a time in interval k, a fraction f into it, under
+ * spn_world_set_air_resolution: each particle's samples held in
+ * w->air_held, taken again where its cell of the spacing changed and as
+ * `take` says, then blended in time. A particle's samples are at its
+ * cell's centre, (q + 1/2) spacing, at k interval and (k + 1) interval,
+ * so its air is a function of its position and the time, whatever was held
+ * before. (floor, not the nearest whole number: the clones inline it, where
+ * nearbyint was a call a coordinate; exact, so every version finds the
+ * same cells.) The numbers go as flat arrays, 3 a particle, in loops that
+ * vectorise. */
+SPN__KERNEL static void sample_held(spn_world *w, uint32_t lo, uint32_t hi, double k, double f, int take,
+                                    const spn_vec3 *x)
+{
+    const double s = w->air_spacing, inv = 1 / s;
+    const uint32_t n = hi - lo;
+    const size_t n3 = 3 * (size_t)n, np3 = 3 * (size_t)w->np, o = 3 * (size_t)lo;
+    float *restrict q = w->air_held + o, *restrict a = q + np3, *restrict b = a + np3;
+    const double *restrict xd = (const double *)(x + lo);
+    double *restrict wind = (double *)(w->wind + lo);
+    double c[3 * SPN__AIR_RUN];
+    uint8_t same[3 * SPN__AIR_RUN];
+    for (size_t j = 0; j < n3; j++) {
+        c[j] = floor(xd[j] * inv);
+        /* (a cell past 2^24, where a float no longer tells cells apart, or
+         * a NaN, never matches: taken again at every step) */
+        same[j] = ((float)c[j] == q[j]) & (fabs(c[j]) < 0x1p24);
+    }
+    /* the particles that changed cell (all of them with HELD_ALL), listed
+     * without a branch a particle */
+    uint32_t moved[SPN__AIR_RUN], nm = 0;
+    const uint8_t all = take == HELD_ALL;
+    for (uint32_t i = 0; i < n; i++) {
+        moved[nm] = i;
+        nm += all | !(same[3 * i] & same[3 * i + 1] & same[3 * i + 2]);
+    }
+    if (take == HELD_NEXT) /* the interval's start is the end held (the moved ones' taken below) */
+        for (size_t j = 0; j < n3; j++) a[j] = b[j];
+    spn_vec3 p[SPN__AIR_RUN], u[SPN__AIR_RUN];
+    for (uint32_t j = 0; j < nm; j++) {
+        const size_t e = 3 * (size_t)moved[j];
+        q[e] = (float)c[e], q[e + 1] = (float)c[e + 1], q[e + 2] = (float)c[e + 2];
+        p[j] = spn_v3((c[e] + 0.5) * s, (c[e + 1] + 0.5) * s, (c[e + 2] + 0.5) * s);
+    }
+    if (nm) { /* the moved ones' start, and with HELD_SAME their end */
+        air_at(w, k * w->air_interval, p, u, nm);
+        for (uint32_t j = 0; j < nm; j++) {
+            const size_t e = 3 * (size_t)moved[j];
+            a[e] = (float)u[j].x, a[e + 1] = (float)u[j].y, a[e + 2] = (float)u[j].z;
+        }
+        if (take == HELD_SAME) {
+            air_at(w, (k + 1) * w->air_interval, p, u, nm);
+            for (uint32_t j = 0; j < nm; j++) {
+                const size_t e = 3 * (size_t)moved[j];
+                b[e] = (float)u[j].x, b[e + 1] = (float)u[j].y, b[e + 2] = (float)u[j].z;
+            }
+        }
+    }
+    if (take != HELD_SAME) { /* every end */
+        double *restrict pd = (double *)p;
+        for (size_t j = 0; j < n3; j++) pd[j] = (c[j] + 0.5) * s;
+        air_at(w, (k + 1) * w->air_interval, p, u, n);
+        const double *restrict ud = (const double *)u;
+        for (size_t j = 0; j < n3; j++) b[j] = (float)ud[j];
+    }
+    for (size_t j = 0; j < n3; j++) {
+        const double aj = a[j];
+        wind[j] = aj + ((double)b[j] - aj) * f;
+    }
+}
+
 /* Air velocity at each particle that ends a tagged segment (w->air_runs):
  * serially in particle order, or, with a pure air function
  * (spn_world_set_air_pure), on `threads` threads (each particle's sample
  * its own, so the same values). With a batch function
  * (spn_world_set_air_batch), a run in one call. Until the fifty-third
  * session the air was sampled at each segment's midpoint: on an orb web
- * about 1.8 samples a particle, and a pass to form the midpoints. */
+ * about 1.8 samples a particle, and a pass to form the midpoints. With a
+ * resolution (spn_world_set_air_resolution), from the held samples. */
 static void sample_air(spn_world *w, double t, const spn_vec3 *x, int threads)
 {
     (void)threads; /* (used by the OpenMP pragmas only) */
     const uint32_t nr = w->nair_runs, *runs = w->air_runs;
+    const bool held = w->air_interval > 0 && w->air_held;
+    const double g = held ? t / w->air_interval : 0, k = floor(g), f = g - k;
+    const int take = k == w->air_held_k ? HELD_SAME : k == w->air_held_k + 1 ? HELD_NEXT : HELD_ALL;
+    if (held) w->air_held_k = k;
 #pragma omp parallel for schedule(static) num_threads(threads) if (w->air_pure && threads > 1)
     for (uint32_t r = 0; r < nr; r++) {
         const uint32_t lo = runs[2 * r], hi = runs[2 * r + 1];
-        if (w->air_batch) w->air_batch(w->air_user, t, x + lo, w->wind + lo, hi - lo);
-        else
-            for (uint32_t i = lo; i < hi; i++) w->wind[i] = w->air_fn(w->air_user, t, x[i]);
+        if (held) sample_held(w, lo, hi, k, f, take, x);
+        else air_at(w, t, x + lo, w->wind + lo, hi - lo);
     }
 }
 

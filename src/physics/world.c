@@ -547,6 +547,28 @@ void spn_world_set_air(spn_world *w, spn_air_fn fn, void *user, double rho, doub
     w->air_rho = rho;
     w->air_mu = mu;
     w->air_pure = false;
+    w->air_interval = w->air_spacing = 0;
+    w->air_held_k = NAN; /* (another function's samples) */
+}
+
+spn_status spn_world_set_air_resolution(spn_world *w, double interval, double spacing)
+{
+    const bool off = interval == 0 && spacing == 0;
+    if (!off && !(interval > 0 && interval < INFINITY && spacing > 0 && spacing < INFINITY))
+        return spn_error(SPN_ERR_INVALID,
+                         "air resolution: interval and spacing both positive and finite, or both 0 (exact samples); "
+                         "not interval %g s, spacing %g m",
+                         interval, spacing);
+    if (!off && !w->air_held) w->compiled = false; /* (its buffer comes with the air's, spn__compile) */
+    w->air_interval = interval, w->air_spacing = spacing;
+    w->air_held_k = NAN;
+    return SPN_OK;
+}
+
+void spn_world_air_resolution(const spn_world *w, double *interval, double *spacing)
+{
+    if (interval) *interval = w->air_interval;
+    if (spacing) *spacing = w->air_spacing;
 }
 
 void spn_world_set_air_pure(spn_world *w, bool pure) { w->air_pure = pure; }

@@ -181,6 +181,10 @@ struct spn_world {
     spn_vec3 *wind;       /* air velocity at each particle that ends a segment with a diameter (on demand) */
     uint32_t *air_runs;   /* those particles: runs (first, last + 1), in pieces of SPN__AIR_RUN */
     uint32_t nair_runs;
+    float *air_held;         /* spn_world_set_air_resolution: the particles' cells q, 3 np numbers (the
+                              * air taken at (q + 1/2) spacing), the air there at the interval's start
+                              * a and at its end b, 3 np each (on demand) */
+    double air_held_k;       /* the interval (t / air_interval, floored) air_held's samples are of; NAN: none */
     double *cair;         /* per-spring linear air-drag coefficient (on demand) */
     spn__jac *jac;        /* implicit: per-spring Jacobian (on demand) */
     double *pinv;         /* implicit: per-particle inverse 3x3 block, 6 each (on demand) */
@@ -214,6 +218,7 @@ struct spn_world {
     void *air_user;
     double air_rho, air_mu;
     bool air_pure;      /* air_fn may be called from several threads (spn_world_set_air_pure) */
+    double air_interval, air_spacing; /* spn_world_set_air_resolution (0: every sample exact) */
     spn_tag_diameter *diam;
     uint32_t ndiam;
 
