@@ -39,7 +39,7 @@ void view_wind_update(view_state *v)
 
 void view_wind_prepare(view_state *v, double t0, double t1)
 {
-    if (v->air) spn_air_prepare(v->air, t0, t1);
+    if (v->air) spn_air_prepare_held(v->air, t0, t1);
 }
 
 void view_wind_release(view_state *v) { detach(v); }

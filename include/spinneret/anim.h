@@ -97,9 +97,17 @@ SPN_API spn_vec3 spn_air_sample(void *user, double t, spn_vec3 p);
 /// A spn_air_batch_fn: spn_air_sample at each of p[0..n), the same bits,
 /// with the points in vector lanes (several times faster on a grid).
 SPN_API void spn_air_sample_batch(void *user, double t, const spn_vec3 *p, spn_vec3 *out, size_t n);
+/// The resolution a world samples this field at (spn_world_set_air_resolution):
+/// the slices' interval and a sixteenth of the grid's smallest cell. false,
+/// and zeros, without a grid (the field is then exact at every sample).
+SPN_API bool spn_air_resolution(const spn_air_field *air, double *interval, double *spacing);
+/// spn_air_prepare for the steps [t0, t1] of a world that samples the field
+/// at its resolution: the slices of the whole intervals the steps fall in.
+SPN_API spn_status spn_air_prepare_held(spn_air_field *air, double t0, double t1);
 /// Attach the field to a world: spn_world_set_air with its rho and mu (declared
-/// pure: spn_world_set_air_pure), and the thread diameters of
-/// spn_thread_diameter for every thread kind.
+/// pure: spn_world_set_air_pure), its batch sampler, its resolution on a grid
+/// (spn_air_resolution; then prepare steps with spn_air_prepare_held), and the
+/// thread diameters of spn_thread_diameter for every thread kind.
 SPN_API void spn_air_attach(spn_air_field *air, spn_world *w);
 
 /// Diameter [m] used for aerodynamic drag on a thread kind (spring tag):

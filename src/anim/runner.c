@@ -144,7 +144,9 @@ static spn_status make_air(runner *r, spn_world *w)
     spn_world_set_air(w, runner_air, r, ad.rho, ad.mu);
     spn_world_set_air_batch(w, runner_air_batch);
     spn_world_set_air_pure(w, true); /* as spn_air_sample */
-    return SPN_OK;
+    double dt, h; /* (spn_world_set_air cleared what spn_air_attach set) */
+    if (spn_air_resolution(r->air, &dt, &h)) st = spn_world_set_air_resolution(w, dt, h);
+    return st;
 }
 
 static spn_status setup(runner *r, spn_world **w)
@@ -180,7 +182,7 @@ static void teardown(runner *r, spn_world *w)
 static spn_status one_step(runner *r, spn_world *w, double dt, uint64_t *steps)
 {
     double t = spn_world_time(w);
-    if (r->air) spn_air_prepare(r->air, t, t + dt);
+    if (r->air) spn_air_prepare_held(r->air, t, t + dt);
     spn_status st = r->impact ? spn_impact_before_step(r->impact, w, dt) : SPN_OK;
     if (st == SPN_OK) st = spn_world_step(w, dt);
     if (st != SPN_OK) return st;

@@ -452,8 +452,8 @@ static air_time time_of(const spn_air_field *air, double t)
     if (!air->grid) return at;
     const double g = t / air->slice_dt;
     const int64_t idx = (int64_t)floor(g);
-    at.a = find_slice(air, idx), at.b = find_slice(air, idx + 1);
     at.f = g - (double)idx;
+    at.a = find_slice(air, idx), at.b = at.f == 0 ? at.a : find_slice(air, idx + 1); /* (f 0: sample_cell reads a) */
     return at;
 }
 
@@ -587,12 +587,19 @@ SPN__INLINE void in_slice(const air_points *g, const double *S, const air_cell *
 /* The field at cell c into *out: the two slices interpolated in it, then
  * linearly between them by f, and the mean wind added. A point's 48
  * numbers are 16 runs of four (each node's three components and the next
- * number), read as vectors: a point's components are the lanes. */
+ * number), read as vectors: a point's components are the lanes. At a
+ * slice's own time (f 0: the times a world at the field's resolution
+ * samples, spn_world_set_air_resolution) the first slice alone, the same
+ * numbers but for the sign of a zero. */
 SPN__INLINE void sample_cell(const air_points *g, const air_cell *c, spn_vec3 *out)
 {
-    air_v4 ua, ub;
-    in_slice(g, g->a, c, &ua), in_slice(g, g->b, c, &ub);
-    const air_v4 u = AIR_LERP4(ua, ub, g->f);
+    air_v4 u;
+    in_slice(g, g->a, c, &u);
+    if (g->f != 0) {
+        air_v4 ub;
+        in_slice(g, g->b, c, &ub);
+        u = AIR_LERP4(u, ub, g->f);
+    }
     out->x = g->mean.x + u[0], out->y = g->mean.y + u[1], out->z = g->mean.z + u[2];
 }
 
@@ -692,11 +699,39 @@ spn_vec3 spn_air_sample(void *user, double t, spn_vec3 p)
     return u;
 }
 
+/* A sixteenth of the grid's smallest cell: a sample there is off the
+ * point's own by at most a thirty-second of a cell in each coordinate,
+ * beside the trilinear interpolation's own error across the cell
+ * (docs/physics.md, "Air drag on threads", has the measurements). */
+#define HELD_CELL_PART 16
+
+bool spn_air_resolution(const spn_air_field *air, double *interval, double *spacing)
+{
+    double dt = 0, h = 0;
+    if (air->grid) {
+        const double cx = (air->hi.x - air->lo.x) / (air->n[0] - 1), cy = (air->hi.y - air->lo.y) / (air->n[1] - 1),
+                     cz = (air->hi.z - air->lo.z) / (air->n[2] - 1);
+        dt = air->slice_dt, h = fmin(cx, fmin(cy, cz)) / HELD_CELL_PART;
+    }
+    if (interval) *interval = dt;
+    if (spacing) *spacing = h;
+    return air->grid;
+}
+
+spn_status spn_air_prepare_held(spn_air_field *air, double t0, double t1)
+{
+    if (!air->grid) return SPN_OK;
+    const double dt = air->slice_dt;
+    return spn_air_prepare(air, floor(t0 / dt) * dt, (floor(t1 / dt) + 1) * dt);
+}
+
 void spn_air_attach(spn_air_field *air, spn_world *w)
 {
     spn_world_set_air(w, spn_air_sample, air, air->def.rho, air->def.mu);
     spn_world_set_air_batch(w, spn_air_sample_batch);
     spn_world_set_air_pure(w, true); /* sampling reads the field (its record of the rows touched is atomic) */
+    double dt, h;
+    if (spn_air_resolution(air, &dt, &h)) spn_world_set_air_resolution(w, dt, h);
     for (uint32_t tag = 0; tag < 64; tag++) {
         double d = spn_thread_diameter(tag);
         if (d > 0) spn_world_set_tag_diameter(w, tag, d);
