@@ -446,20 +446,29 @@ void spn__imp_mg_apply(const spn_world *w, const spn_vec3 *r, spn_vec3 *z)
     const spn__eq *e = &m->e;
     const uint32_t n = e->n, np = w->np;
     const double *pinv = w->pinv;
+    const int32_t *local = m->local;
+    /* (a factorisation that failed mid-solve, spn__imp_mg_refactor: block
+     * Jacobi for all) */
+    const bool bj_only = m->chol_on && !m->chol_ready;
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
-    for (uint32_t i = 0; i < np; i++) { /* block Jacobi for all; the V-cycle overwrites its own */
+    for (uint32_t i = 0; i < np; i++) { /* block Jacobi for the particles outside the system */
+        if (!bj_only && (uint32_t)local[i] < n) continue; /* (-1: none) */
         const double *q = pinv + 6 * (size_t)i;
         const spn_vec3 ri = r[i];
         z[i] = spn_v3(q[0] * ri.x + q[3] * ri.y + q[4] * ri.z, q[3] * ri.x + q[1] * ri.y + q[5] * ri.z,
                       q[4] * ri.x + q[5] * ri.y + q[2] * ri.z);
     }
-    if (m->chol_on && !m->chol_ready) return; /* a factorisation failed mid-solve (spn__imp_mg_refactor) */
+    if (bj_only) return;
+    const uint32_t d = 3 * m->nprey; /* (0 unless the factor preconditions: prey_rows) */
+    if (m->chol_on && !d) { /* straight from the world's order to the factor's and back */
+        spn__chol_solve_at(m->chol, e->world_id, (const double *)r, (double *)z);
+        return;
+    }
     for (uint32_t i = 0; i < n; i++) memcpy(m->r + 3 * (size_t)i, &r[e->world_id[i]], 3 * sizeof(double));
     if (m->chol_on) spn__chol_solve(m->chol, m->r, m->z);
     else if (m->cyc) spn__cyc_apply(m->cyc, e, m->r, m->z);
     else spn__mg_apply(m->mg, e, m->r, m->z);
     double t[3 * SPN__PREY_ROWS_MAX];
-    const uint32_t d = 3 * m->nprey; /* (0 unless the factor preconditions: prey_rows) */
     if (d) { /* the prey's rows (prey_rows): t = S^-1 (r_p - B^T y), then y -= X t */
         const size_t len = 3 * (size_t)n;
         for (uint32_t i = 0; i < d; i++) {

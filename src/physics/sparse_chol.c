@@ -524,17 +524,21 @@ SPN__KERNEL static void solve_particles(const spn__chol *c, double *y)
     }
 }
 
-void spn__chol_solve(const spn__chol *c, const double *b, double *out)
+void spn__chol_solve_at(const spn__chol *c, const uint32_t *ids, const double *b, double *out)
 {
     double *y = c->x;
-    for (uint32_t k = 0; k < c->n; k++)
-        for (int a = 0; a < 3; a++)
-            y[3 * k + a] = b[3 * (size_t)c->perm[k] + a];
+    for (uint32_t k = 0; k < c->n; k++) {
+        const size_t at = 3 * (size_t)(ids ? ids[c->perm[k]] : c->perm[k]);
+        y[3 * k] = b[at], y[3 * k + 1] = b[at + 1], y[3 * k + 2] = b[at + 2];
+    }
     solve_particles(c, y);
-    for (uint32_t k = 0; k < c->n; k++)
-        for (int a = 0; a < 3; a++)
-            out[3 * (size_t)c->perm[k] + a] = y[3 * k + a];
+    for (uint32_t k = 0; k < c->n; k++) {
+        const size_t at = 3 * (size_t)(ids ? ids[c->perm[k]] : c->perm[k]);
+        out[at] = y[3 * k], out[at + 1] = y[3 * k + 1], out[at + 2] = y[3 * k + 2];
+    }
 }
+
+void spn__chol_solve(const spn__chol *c, const double *b, double *out) { spn__chol_solve_at(c, NULL, b, out); }
 
 size_t spn__chol_entries(const spn__chol *c) { return 6 * (size_t)c->n + 9 * c->bp[c->n]; }
 

@@ -30,6 +30,10 @@ spn__chol *spn__chol_analyze(uint32_t n, const uint32_t *start, const int32_t *a
 bool spn__chol_factor(spn__chol *c, const double *diag, const double *offd);
 /* x = A^-1 b (3 n each; x may be b). */
 void spn__chol_solve(const spn__chol *c, const double *b, double *x);
+/* The same with particle i's three numbers of b and x at ids[i] (3 ids[i]
+ * on): a solve for the rows of a larger vector, without copying them out
+ * and back (x may be b). */
+void spn__chol_solve_at(const spn__chol *c, const uint32_t *ids, const double *b, double *x);
 /* Numbers in L (its diagonal included). */
 size_t spn__chol_entries(const spn__chol *c);
 void spn__chol_free(spn__chol *c);
