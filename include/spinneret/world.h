@@ -307,11 +307,11 @@ SPN_API void spn_world_set_air_batch(spn_world *w, spn_air_batch_fn fn);
 /// the evaluation's time t, and interpolated linearly between them in t.
 /// The world keeps the two samples (as float) and takes them again only when
 /// the cell or k changes, so a web swaying slowly samples its air once an
-/// interval, not once a step. What a particle feels is a function of its position and the
-/// time alone: the same on any thread count, after a copy and in a replayed
-/// step. Both 0 (the default, and what spn_world_set_air sets): the air at
-/// the particle itself at t, every evaluation. SPN_ERR_INVALID for anything but
-/// two positive finite numbers or two zeros.
+/// interval, not once a step. What a particle feels is a function of its
+/// position and the time alone: the same on any thread count, after a copy
+/// and in a replayed step. Both 0 (the default, and what spn_world_set_air
+/// sets): the air at the particle itself at t, every evaluation.
+/// SPN_ERR_INVALID for anything but two positive finite numbers or two zeros.
 SPN_API spn_status spn_world_set_air_resolution(spn_world *w, double interval, double spacing);
 /// The interval and spacing of spn_world_set_air_resolution (0, 0: exact).
 SPN_API void spn_world_air_resolution(const spn_world *w, double *interval, double *spacing);
