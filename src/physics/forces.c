@@ -215,6 +215,16 @@ static void air_at(const spn_world *w, double t, const spn_vec3 *p, spn_vec3 *ou
  * (its start is the end held), or everything. */
 enum { HELD_SAME, HELD_NEXT, HELD_ALL };
 
+/* Samples u[0..nm) as floats into held numbers `dst` (3 a particle) at the
+ * particles moved[0..nm). */
+SPN__INLINE void held_put(float *restrict dst, const uint32_t *moved, const spn_vec3 *u, uint32_t nm)
+{
+    for (uint32_t j = 0; j < nm; j++) {
+        float *d = dst + 3 * (size_t)moved[j];
+        d[0] = (float)u[j].x, d[1] = (float)u[j].y, d[2] = (float)u[j].z;
+    }
+}
+
 /* The run [lo, hi) at a time in interval k, a fraction f into it, under
  * spn_world_set_air_resolution: each particle's samples held in
  * w->air_held, taken again where its cell of the spacing changed and as
@@ -260,16 +270,10 @@ SPN__KERNEL static void sample_held(spn_world *w, uint32_t lo, uint32_t hi, doub
     }
     if (nm) { /* the moved ones' start, and with HELD_SAME their end */
         air_at(w, k * w->air_interval, p, u, nm);
-        for (uint32_t j = 0; j < nm; j++) {
-            const size_t e = 3 * (size_t)moved[j];
-            a[e] = (float)u[j].x, a[e + 1] = (float)u[j].y, a[e + 2] = (float)u[j].z;
-        }
+        held_put(a, moved, u, nm);
         if (take == HELD_SAME) {
             air_at(w, (k + 1) * w->air_interval, p, u, nm);
-            for (uint32_t j = 0; j < nm; j++) {
-                const size_t e = 3 * (size_t)moved[j];
-                b[e] = (float)u[j].x, b[e + 1] = (float)u[j].y, b[e + 2] = (float)u[j].z;
-            }
+            held_put(b, moved, u, nm);
         }
     }
     if (take != HELD_SAME) { /* every end */
