@@ -487,6 +487,59 @@ static void test_air_at_the_resolution(void **state)
     free(held), free(grid), free(exact), free(still);
 }
 
+/* spn_air_def.stop: from that time on the air is still (the mean, the
+ * field and its samples, on a grid or not, alone or in a batch, are zero);
+ * before it, a field that stops gives the bits of one that never does. */
+static bool is_zero(spn_vec3 u) { return u.x == 0 && u.y == 0 && u.z == 0; }
+
+static void test_air_stops(void **state)
+{
+    (void)state;
+    spn_air_def d = spn_air_def_default();
+    d.speed = 2;
+    d.turbulence = 0.3;
+    spn_air_field *goes, *stops;
+    assert_int_equal(spn_air_create(&d, &goes), SPN_OK);
+    d.stop = 1.0;
+    assert_int_equal(spn_air_create(&d, &stops), SPN_OK);
+    enum { N = 200 };
+    spn_vec3 p[N], a[N], b[N];
+    spn_rng rng;
+    spn_rng_seed(&rng, 3);
+    for (int i = 0; i < N; i++)
+        p[i] = spn_v3(spn_rng_range(&rng, -0.3, 0.3), spn_rng_range(&rng, -0.3, 0.3), spn_rng_range(&rng, -0.1, 0.1));
+    const spn_vec3 lo = spn_v3(-0.3, -0.3, -0.1), hi = spn_v3(0.3, 0.3, 0.1);
+    for (int grid = 0; grid < 2; grid++) {
+        if (grid) {
+            assert_int_equal(spn_air_set_grid(goes, lo, hi, 13, 13, 5, 5e-3), SPN_OK);
+            assert_int_equal(spn_air_set_grid(stops, lo, hi, 13, 13, 5, 5e-3), SPN_OK);
+        }
+        const double times[5] = {0.99, 0.998, 1.0, 1.002, 30.0};
+        for (int k = 0; k < 5; k++) {
+            const double t = times[k];
+            assert_int_equal(spn_air_prepare(goes, t, t + 1e-3), SPN_OK);
+            assert_int_equal(spn_air_prepare(stops, t, t + 1e-3), SPN_OK);
+            spn_air_sample_batch(goes, t, p, a, N);
+            spn_air_sample_batch(stops, t, p, b, N);
+            if (t < 1.0) {
+                assert_memory_equal(a, b, sizeof a);
+                assert_true(spn_v3_len(a[0]) > 0.5);
+                continue;
+            }
+            assert_true(spn_v3_len(a[0]) > 0.5); /* (the other field still blows) */
+            assert_true(is_zero(spn_air_mean(stops, t)));
+            for (int i = 0; i < N; i++) {
+                assert_true(is_zero(b[i]));
+                assert_true(is_zero(spn_air_sample(stops, t, p[i])));
+                assert_true(is_zero(spn_air_velocity(stops, t, p[i])));
+            }
+        }
+    }
+    printf("# a field that stops at 1 s: its bits before, still air from then on, on a grid and without\n");
+    spn_air_destroy(goes);
+    spn_air_destroy(stops);
+}
+
 static void test_rejects_bad_air(void **state)
 {
     (void)state;
@@ -501,6 +554,10 @@ static void test_rejects_bad_air(void **state)
     d = spn_air_def_default();
     d.small_scale = 2;
     assert_int_equal(spn_air_create(&d, &air), SPN_ERR_INVALID);
+    d = spn_air_def_default();
+    d.stop = NAN;
+    assert_int_equal(spn_air_create(&d, &air), SPN_ERR_INVALID);
+    assert_non_null(strstr(spn_last_error(), "stop"));
     assert_null(air);
 }
 
@@ -515,6 +572,7 @@ int main(void)
         cmocka_unit_test(test_slices_fill_the_rows_sampled),
         cmocka_unit_test(test_air_on_threads),
         cmocka_unit_test(test_air_at_the_resolution),
+        cmocka_unit_test(test_air_stops),
         cmocka_unit_test(test_rejects_bad_air),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

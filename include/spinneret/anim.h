@@ -70,6 +70,7 @@ typedef struct spn_air_def {
     double rho;            ///< air density [kg/m^3], default 1.204
     double mu;             ///< air viscosity [Pa s], default 1.81e-5
     uint64_t seed;         ///< default 1
+    double stop;           ///< the air is still from this time on [s], default INFINITY (never)
 } spn_air_def;
 
 typedef struct spn_air_field spn_air_field;
@@ -273,7 +274,7 @@ typedef struct spn_anim_def {
     spn_wind_kind wind;
     spn_thesis_wind_def thesis;
     spn_air_def air;
-    double wind_stop;          ///< air: the wind stops at this time [s]; <0 (default): never
+    double wind_stop;          ///< air: the wind stops at this time [s] (air.stop, the earlier); <0 (default): never
     const spn_prey_def *prey;  ///< prey to throw, may be NULL
     int nprey;
     spn_impact_def impact;

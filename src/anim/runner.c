@@ -71,27 +71,6 @@ static void thesis_only(void *user, const spn_world *w, double t, const spn_vec3
     spn_thesis_wind_force(r->thesis, w, t, x, v, f);
 }
 
-/* Whether the wind has stopped by time t (--wind-stop): still air then. */
-static bool wind_stopped(const runner *r, double t) { return r->def.wind_stop >= 0 && t >= r->def.wind_stop; }
-
-static spn_vec3 runner_air(void *user, double t, spn_vec3 p)
-{
-    runner *r = user;
-    if (wind_stopped(r, t)) return spn_v3(0, 0, 0);
-    return spn_air_sample(r->air, t, p);
-}
-
-static void runner_air_batch(void *user, double t, const spn_vec3 *p, spn_vec3 *out, size_t n)
-{
-    runner *r = user;
-    if (wind_stopped(r, t)) {
-        for (size_t i = 0; i < n; i++)
-            out[i] = spn_v3(0, 0, 0);
-        return;
-    }
-    spn_air_sample_batch(r->air, t, p, out, n);
-}
-
 static spn_status check_def(const spn_anim_def *d)
 {
     if (!(d->duration >= 0) || !(d->duration <= 1e5)) return spn_error(SPN_ERR_INVALID, "duration must be in [0, 1e5] s");
@@ -131,6 +110,7 @@ static spn_status make_air(runner *r, spn_world *w)
 {
     spn_air_def ad = r->def.air;
     ad.seed = r->def.seed;
+    if (r->def.wind_stop >= 0) ad.stop = fmin(ad.stop, r->def.wind_stop);
     if (r->def.wind != SPN_WIND_AIR) { /* still air for the prey */
         ad.speed = 0;
         ad.turbulence = 0;
@@ -141,12 +121,7 @@ static spn_status make_air(runner *r, spn_world *w)
     if (ad.turbulence > 0) st = spn__air_grid_over_web(r->air, w, ad.small_scale);
     if (st != SPN_OK) return st;
     spn_air_attach(r->air, w);
-    spn_world_set_air(w, runner_air, r, ad.rho, ad.mu);
-    spn_world_set_air_batch(w, runner_air_batch);
-    spn_world_set_air_pure(w, true); /* as spn_air_sample */
-    double dt, h; /* (spn_world_set_air cleared what spn_air_attach set) */
-    if (spn_air_resolution(r->air, &dt, &h)) st = spn_world_set_air_resolution(w, dt, h);
-    return st;
+    return SPN_OK;
 }
 
 static spn_status setup(runner *r, spn_world **w)

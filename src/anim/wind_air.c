@@ -131,6 +131,7 @@ spn_air_def spn_air_def_default(void)
     d.rho = 1.204;
     d.mu = 1.81e-5;
     d.seed = 1;
+    d.stop = INFINITY;
     return d;
 }
 
@@ -149,6 +150,7 @@ static spn_status check_def(const spn_air_def *d)
     if (d->modes < 1 || d->modes > 4096) return spn_error(SPN_ERR_INVALID, "air: modes must be in [1, 4096]");
     if (!(d->rho > 0) || !(d->mu > 0) || !isfinite(d->rho) || !isfinite(d->mu))
         return spn_error(SPN_ERR_INVALID, "air: density and viscosity must be > 0");
+    if (isnan(d->stop)) return spn_error(SPN_ERR_INVALID, "air: stop time must be a number");
     return SPN_OK;
 }
 
@@ -246,8 +248,12 @@ static double advection(const spn_air_field *air, double t)
     return air->def.speed * x;
 }
 
+/* Whether the air is still at time t (spn_air_def.stop). */
+static bool stopped(const spn_air_field *air, double t) { return t >= air->def.stop; }
+
 spn_vec3 spn_air_mean(const spn_air_field *air, double t)
 {
+    if (stopped(air, t)) return spn_v3(0, 0, 0);
     return spn_v3_scale(air->dir, air->def.speed * gust_factor(air, t));
 }
 
@@ -265,7 +271,7 @@ static spn_vec3 turbulence_at(const spn_air_field *air, double t, double shift, 
 spn_vec3 spn_air_velocity(const spn_air_field *air, double t, spn_vec3 p)
 {
     spn_vec3 mean = spn_air_mean(air, t);
-    if (air->def.turbulence == 0 || air->def.speed == 0) return mean;
+    if (air->def.turbulence == 0 || air->def.speed == 0 || stopped(air, t)) return mean;
     return spn_v3_add(mean, turbulence_at(air, t, advection(air, t), p));
 }
 
@@ -479,7 +485,8 @@ static air_rows rows_wanted(const spn_air_field *air)
 
 spn_status spn_air_prepare(spn_air_field *air, double t0, double t1)
 {
-    if (!air->grid) return SPN_OK; /* (without a grid a sample is exact: no times kept) */
+    /* (without a grid a sample is exact, and still air is zero: no slices) */
+    if (!air->grid || stopped(air, t0)) return SPN_OK;
     int64_t a = (int64_t)floor(t0 / air->slice_dt), b = (int64_t)floor(t1 / air->slice_dt) + 1;
     if (b - a + 1 > MAX_SLICES) b = a + MAX_SLICES - 1;
     const air_rows want = rows_wanted(air);
@@ -679,8 +686,8 @@ SPN__KERNEL static void sample_one(const air_points *g, const spn_vec3 *p, spn_v
 void spn_air_sample_batch(void *user, double t, const spn_vec3 *p, spn_vec3 *out, size_t n)
 {
     spn_air_field *air = user;
-    const air_time at = air->grid ? sample_time(air, t) : (air_time){0};
-    if (!at.a || !at.b) { /* no grid, or its slices not ready: the field itself */
+    const air_time at = air->grid && !stopped(air, t) ? sample_time(air, t) : (air_time){0};
+    if (!at.a || !at.b) { /* no grid, its slices not ready, or still air: the field itself */
         for (size_t i = 0; i < n; i++) out[i] = spn_air_velocity(air, t, p[i]);
         return;
     }
@@ -691,7 +698,7 @@ void spn_air_sample_batch(void *user, double t, const spn_vec3 *p, spn_vec3 *out
 spn_vec3 spn_air_sample(void *user, double t, spn_vec3 p)
 {
     spn_air_field *air = user;
-    const air_time at = air->grid ? sample_time(air, t) : (air_time){0};
+    const air_time at = air->grid && !stopped(air, t) ? sample_time(air, t) : (air_time){0};
     if (!at.a || !at.b) return spn_air_velocity(air, t, p);
     const air_points g = points_of(air, &at);
     spn_vec3 u;
