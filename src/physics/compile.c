@@ -36,6 +36,7 @@ void spn__free_compiled(spn_world *w)
     free(w->air_held);
     free(w->cair);
     free(w->jac);
+    free(w->pblock);
     free(w->pinv);
     spn__imp_mg_free(w->imp_mg);
     free(w->partial);
@@ -48,7 +49,7 @@ void spn__forget_compiled(spn_world *w)
     w->hs = NULL;
     w->hflags = NULL;
     w->fs = w->f = w->fext = w->x0 = w->v0 = w->fair = w->wind = NULL;
-    w->sdiam = w->cair = w->partial = w->pinv = NULL;
+    w->sdiam = w->cair = w->partial = w->pblock = w->pinv = NULL;
     w->jac = NULL;
     w->air_runs = NULL;
     w->nair_runs = 0;

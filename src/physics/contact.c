@@ -63,9 +63,9 @@ static void spread(const spn_world *w, const spn_contact *c, double s, spn_vec3 
 static bool involved(const spn_contact *c, uint32_t i) { return c->p == i || c->a == i || c->b == i; }
 
 /* Particle i's block: its springs' part, plus h^2 k w_i^2 n n^T per active contact. */
-static void contact_block(const spn_world *w, uint32_t i, double h, double *pinv)
+static void contact_block(const spn_world *w, uint32_t i, double h, double *pblock)
 {
-    double d[6];
+    double *d = pblock + 6 * (size_t)i;
     spn__implicit_block(w, i, h, d);
     for (uint32_t k = 0; k < w->ncontacts; k++) {
         const spn_contact *c = &w->contacts[k];
@@ -76,7 +76,6 @@ static void contact_block(const spn_world *w, uint32_t i, double h, double *pinv
         d[0] += s * n.x * n.x, d[1] += s * n.y * n.y, d[2] += s * n.z * n.z;
         d[3] += s * n.x * n.y, d[4] += s * n.x * n.z, d[5] += s * n.y * n.z;
     }
-    spn__invert_sym3(d, pinv + 6 * (size_t)i);
 }
 
 void spn__contact_begin(spn_world *w)
@@ -84,7 +83,7 @@ void spn__contact_begin(spn_world *w)
     for (uint32_t k = 0; k < w->ncontacts; k++) w->contacts[k].active = true;
 }
 
-void spn__contact_system(spn_world *w, double h, spn_vec3 *b, double *pinv)
+void spn__contact_system(spn_world *w, double h, spn_vec3 *b, double *pblock)
 {
     for (uint32_t k = 0; k < w->ncontacts; k++) {
         const spn_contact *c = &w->contacts[k];
@@ -100,7 +99,7 @@ void spn__contact_system(spn_world *w, double h, spn_vec3 *b, double *pinv)
             bool seen = false;
             for (uint32_t q = 0; q < k && !seen; q++) seen = involved(&w->contacts[q], i);
             for (int q = 0; q < j && !seen; q++) seen = id[q] == i;
-            if (!seen) contact_block(w, i, h, pinv);
+            if (!seen) contact_block(w, i, h, pblock);
         }
     }
 }

@@ -104,34 +104,48 @@ void spn__implicit_block(const spn_world *w, uint32_t i, double h, double d[6])
     block_of(w, i, 1 + h * w->def.drag, d);
 }
 
-/* Right-hand side b = h f + h^2 K v, and the inverse of each particle's 3x3
- * diagonal block of A (block Jacobi: a strand's node is stiff along the
- * thread and soft across it, which a scalar diagonal cannot see). */
+/* Right-hand side b = h f + h^2 K v, and each particle's 3x3 diagonal block
+ * of A (block Jacobi's: a strand's node is stiff along the thread and soft
+ * across it, which a scalar diagonal cannot see; inverted where wanted,
+ * spn__implicit_invert, after the solve has chosen its preconditioner). */
 static void build_rhs(spn_world *w, double h)
 {
     const uint32_t np = w->np;
     spn_vec3 *b = w->tmp[T_B];
-    double *minv = w->pinv;
+    double *blocks = w->pblock;
     const double m_scale = 1 + h * w->def.drag;
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
     for (uint32_t i = 0; i < np; i++) {
-        double *mi = minv + 6 * (size_t)i;
+        double *d = blocks + 6 * (size_t)i;
         if (w->inv_mass[i] == 0) {
             b[i] = spn_v3(0, 0, 0);
-            for (int c = 0; c < 6; c++) mi[c] = 0;
+            for (int c = 0; c < 6; c++) d[c] = 0;
             continue;
         }
         spn_vec3 bi = spn_v3_scale(w->f[i], h);
-        double d[6];
         block_of(w, i, m_scale, d);
         for (uint32_t k = w->adj_start[i]; k < w->adj_start[i + 1]; k++) {
             const uint32_t e = w->adj[k], s = e >> 1;
             bi = (e & 1u) ? spn_v3_sub(bi, w->fs[s]) : spn_v3_add(bi, w->fs[s]);
         }
         b[i] = bi;
-        spn__invert_sym3(d, mi);
     }
-    if (w->ncontacts) spn__contact_system(w, h, b, minv);
+    if (w->ncontacts) spn__contact_system(w, h, b, blocks);
+}
+
+void spn__implicit_invert(spn_world *w, const int32_t *local, uint32_t n)
+{
+    const uint32_t np = w->np;
+    const double *blocks = w->pblock;
+    double *minv = w->pinv;
+#pragma omp parallel for schedule(static) num_threads(spn__threads(w, np))
+    for (uint32_t i = 0; i < np; i++) {
+        if (local && (uint32_t)local[i] < n) continue; /* (-1: none) */
+        double *mi = minv + 6 * (size_t)i;
+        if (w->inv_mass[i] == 0)
+            for (int c = 0; c < 6; c++) mi[c] = 0;
+        else spn__invert_sym3(blocks + 6 * (size_t)i, mi);
+    }
 }
 
 /* Per-spring product into fs (and fair with air): the force of the spring's
@@ -298,6 +312,7 @@ static bool bj_took_long(spn_world *w, double h)
 static int solve(spn_world *w, double h, double scale, bool *unfinished)
 {
     bool mg = spn__imp_mg_prepare(w, h);
+    if (!mg) spn__implicit_invert(w, NULL, 0); /* block Jacobi: every block (a switch to mg keeps them) */
     int mg_from = 0; /* the iteration at which prepare's preconditioner took over */
     const uint32_t np = w->np;
     spn_vec3 *dv = w->tmp[T_DV], *r = w->tmp[T_R], *z = w->tmp[T_Z], *p = w->tmp[T_P];
@@ -492,6 +507,8 @@ spn_status spn__step_implicit(spn_world *w, double h, spn__step_result *r)
 {
     spn_status st = spn__scratch(w, 6);
     if (st != SPN_OK) return st;
+    if (!w->pblock && !(w->pblock = malloc((w->np ? w->np : 1) * 6 * sizeof *w->pblock)))
+        return spn_error(SPN_ERR_NOMEM, "out of memory for the implicit solver (%u particles)", w->np);
     if (!w->pinv && !(w->pinv = malloc((w->np ? w->np : 1) * 6 * sizeof *w->pinv)))
         return spn_error(SPN_ERR_NOMEM, "out of memory for the implicit solver (%u particles)", w->np);
     if (!w->jac && !(w->jac = malloc((w->ns ? w->ns : 1) * sizeof *w->jac)))

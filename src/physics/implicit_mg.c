@@ -212,15 +212,6 @@ static spn__imp_mg *create(const spn_world *w)
     return m;
 }
 
-static bool in_contact(const spn_world *w, uint32_t i)
-{
-    for (uint32_t k = 0; k < w->ncontacts; k++) {
-        const spn_contact *c = &w->contacts[k];
-        if (c->active && (c->p == i || c->a == i || c->b == i)) return true;
-    }
-    return false;
-}
-
 /* Each active contact's coupling of its segment's ends, h^2 k (1 - u) u n n^T
  * (contact.c), into the off-diagonal blocks of their spring's entries, for
  * the factor (prey_rows); their diagonal parts are in level 0 already. */
@@ -246,7 +237,8 @@ static void contact_offd(spn__imp_mg *m, const spn_world *w, double h)
     }
 }
 
-/* Level 0 from the step's Jacobian (w->jac) and block inverses (w->pinv). */
+/* Level 0 from the step's Jacobian (w->jac) and diagonal blocks (w->pblock,
+ * contacts included). */
 static void assemble(spn__imp_mg *m, const spn_world *w, double h)
 {
     spn__eq *e = &m->e;
@@ -254,10 +246,7 @@ static void assemble(spn__imp_mg *m, const spn_world *w, double h)
 #pragma omp parallel for schedule(static) num_threads(spn__threads(w, n))
     for (uint32_t i = 0; i < n; i++) {
         const uint32_t wid = e->world_id[i];
-        double *d = e->diag + 6 * (size_t)i;
-        memcpy(m->inv0 + 6 * (size_t)i, w->pinv + 6 * (size_t)wid, 6 * sizeof *d);
-        if (w->ncontacts && in_contact(w, wid)) spn__invert_sym3(w->pinv + 6 * (size_t)wid, d);
-        else spn__implicit_block(w, wid, h, d);
+        memcpy(e->diag + 6 * (size_t)i, w->pblock + 6 * (size_t)wid, 6 * sizeof *e->diag);
         for (uint32_t j = e->adj_start[i]; j < e->adj_start[i + 1]; j++) {
             double *o = e->offd + 6 * (size_t)j;
             if (e->adj_other[j] < 0) {
@@ -336,8 +325,7 @@ static void prey_rows(spn__imp_mg *m, const spn_world *w, double h)
             S[i * d + j] = -dot;
         }
     for (uint32_t q = 0; q < np; q++) {
-        double cq[6]; /* the prey's block: its block Jacobi inverse inverted back */
-        spn__invert_sym3(w->pinv + 6 * (size_t)m->prey[q], cq);
+        const double *cq = w->pblock + 6 * (size_t)m->prey[q]; /* the prey's block */
         static const uint8_t sym[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
         for (int a = 0; a < 3; a++)
             for (int b = 0; b <= a; b++) S[(3 * q + a) * d + 3 * q + b] += cq[sym[a][b]];
@@ -367,7 +355,8 @@ static bool refused(spn_world *w, unsigned which)
     return true;
 }
 
-bool spn__imp_mg_prepare(spn_world *w, double h)
+/* spn__imp_mg_prepare's choice and set-up, the inverses aside. */
+static bool prepare(spn_world *w, double h)
 {
     /* auto: where the multigrid pays (the cyclic preconditioner instead on a
      * lattice web); on a big lattice web (w->lat: numbered as the cyclic
@@ -431,12 +420,22 @@ bool spn__imp_mg_prepare(spn_world *w, double h)
         spn__cyc_free(m->cyc); /* not definite: the multigrid from here on */
         m->cyc = NULL;
     }
+    const uint32_t n = m->e.n; /* the V-cycle's smoother: level 0's inverted blocks */
+#pragma omp parallel for schedule(static) num_threads(spn__threads(w, n))
+    for (uint32_t i = 0; i < n; i++) spn__invert_sym3(m->e.diag + 6 * (size_t)i, m->inv0 + 6 * (size_t)i);
     if (spn__mg_setup(&m->mg, &m->e, m->inv0) != SPN_OK || refused(w, SPN__REFUSE_VCYCLE)) {
         spn__mg_free(m->mg);
         m->mg = NULL;
         m->failed = true;
         return false;
     }
+    return true;
+}
+
+bool spn__imp_mg_prepare(spn_world *w, double h)
+{
+    if (!prepare(w, h)) return false;
+    spn__implicit_invert(w, w->imp_mg->local, w->imp_mg->e.n); /* the particles outside the system */
     return true;
 }
 
@@ -494,6 +493,7 @@ bool spn__imp_mg_refactor(spn_world *w)
      * fails too */
     m->chol_ready = factorise(w, m);
     m->chol_fresh = true;
+    if (!m->chol_ready) spn__implicit_invert(w, NULL, 0);
     prey_rows(m, w, m->h);
     /* A factor that one step has outrun says the next will outrun this one
      * too: the next steps factorise at their start, 1, 2, 4 ... 16 of them

@@ -187,7 +187,8 @@ struct spn_world {
     double air_held_k;       /* the interval (t / air_interval, floored) air_held's samples are of; NAN: none */
     double *cair;         /* per-spring linear air-drag coefficient (on demand) */
     spn__jac *jac;        /* implicit: per-spring Jacobian (on demand) */
-    double *pinv;         /* implicit: per-particle inverse 3x3 block, 6 each (on demand) */
+    double *pblock;       /* implicit: per-particle diagonal 3x3 block of A, 6 each (on demand) */
+    double *pinv;         /* implicit: their inverses where block Jacobi is wanted (spn__implicit_invert) */
     struct spn__imp_mg *imp_mg; /* implicit: the multigrid preconditioner (implicit_mg.c, on demand) */
     uint32_t imp_refuse;  /* spn__imp_mg_refuse (tests) */
     uint8_t imp_refuse_pc; /* spn__imp_mg_refuse_setup (tests) */
@@ -470,6 +471,10 @@ bool spn__silk_clone(spn_world *c, const spn_world *w);
  * its springs, mass and drag (xx, yy, zz, xy, xz, yz), and its inverse. */
 void spn__implicit_block(const spn_world *w, uint32_t i, double h, double d[6]);
 void spn__invert_sym3(const double a[6], double out[6]);
+/* Block Jacobi's inverses (w->pblock into w->pinv; a fixed particle's 0):
+ * of every particle (local NULL), or of those whose local[i] is not below n
+ * (outside a preconditioner's system). */
+void spn__implicit_invert(spn_world *w, const int32_t *local, uint32_t n);
 /* The multigrid preconditioner of the implicit step (implicit_mg.c). Auto
  * uses it from this many particles and this step [s]: below, a step needs too
  * few block-Jacobi iterations for the cycle's cost to pay (measured on the
@@ -498,8 +503,9 @@ void spn__invert_sym3(const double a[6], double out[6]);
 #define SPN__IMPLICIT_HOLD_MAX 16u
 typedef struct spn__imp_mg spn__imp_mg;
 void spn__imp_mg_free(spn__imp_mg *m);
-/* After w->jac and w->pinv are built for step h: (re)build or refresh the
- * hierarchy; false when the step should use block Jacobi. */
+/* After w->jac and w->pblock are built for step h: (re)build or refresh the
+ * hierarchy, and invert the blocks of the particles outside it; false when
+ * the step should use block Jacobi (whose inverses are then still to form). */
 bool spn__imp_mg_prepare(spn_world *w, double h);
 /* z = M^-1 r over all particles (fixed rows 0). */
 void spn__imp_mg_apply(const spn_world *w, const spn_vec3 *r, spn_vec3 *z);
@@ -529,9 +535,9 @@ void spn__imp_mg_refuse_setup(spn_world *w, unsigned which);
 /* Every contact active, before a step's first solve. */
 void spn__contact_begin(spn_world *w);
 /* The active contacts' part of the implicit system: their forces and
- * h^2 K v0 into the right-hand side b, their blocks into the inverted
- * diagonal blocks pinv. */
-void spn__contact_system(spn_world *w, double h, spn_vec3 *b, double *pinv);
+ * h^2 K v0 into the right-hand side b, their blocks into the diagonal
+ * blocks pblock. */
+void spn__contact_system(spn_world *w, double h, spn_vec3 *b, double *pblock);
 /* ap += A_contacts p; returns p . A_contacts p. */
 double spn__contact_apply(const spn_world *w, double h, const spn_vec3 *p, spn_vec3 *ap);
 /* After a solve for dv: drop the contacts that end on the wrong side; true
