@@ -397,11 +397,15 @@ static bool prepare(spn_world *w, double h)
     if (contacts && !m->chol_tried) analyse(m);
     if (contacts && !m->chol) return false;
     m->chol_on = m->chol && (!m->cyc || contacts);
-    assemble(m, w, h);
+    /* level 0 for a factorisation, the cyclic preconditioner or the
+     * V-cycle: not when a kept factor serves (spn__imp_mg_refactor
+     * assembles it if the step then wants a factor of its own) */
+    if (!m->chol_on) assemble(m, w, h);
     if (m->chol_on) {
         m->chol_fresh = !m->chol_ready || m->chol_stale || h != m->chol_h || m->hold > 0;
         if (m->hold) m->hold--;
         if (m->chol_fresh) {
+            assemble(m, w, h);
             m->chol_ready = factorise(w, m);
             m->chol_h = h;
         }
@@ -487,7 +491,7 @@ bool spn__imp_mg_refactor(spn_world *w)
 {
     spn__imp_mg *m = w->imp_mg;
     if (!m || !m->chol_on || m->chol_fresh) return false;
-    /* level 0 still holds this step's matrix (assemble) */
+    assemble(m, w, m->h); /* (prepare did not: the kept factor served) */
     /* not definite: block Jacobi for the rest of this solve (apply), and the
      * next step's prepare factorises again, and drops the factor if that
      * fails too */
