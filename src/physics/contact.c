@@ -62,11 +62,11 @@ static void spread(const spn_world *w, const spn_contact *c, double s, spn_vec3 
 
 static bool involved(const spn_contact *c, uint32_t i) { return c->p == i || c->a == i || c->b == i; }
 
-/* Particle i's block: its springs' part, plus h^2 k w_i^2 n n^T per active contact. */
+/* h^2 k w_i^2 n n^T per active contact added to particle i's block (its
+ * springs' part, which build_rhs put there). */
 static void contact_block(const spn_world *w, uint32_t i, double h, double *pblock)
 {
     double *d = pblock + 6 * (size_t)i;
-    spn__implicit_block(w, i, h, d);
     for (uint32_t k = 0; k < w->ncontacts; k++) {
         const spn_contact *c = &w->contacts[k];
         if (!c->active || !involved(c, i)) continue;

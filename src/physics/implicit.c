@@ -99,11 +99,6 @@ static void block_of(const spn_world *w, uint32_t i, double m_scale, double d[6]
     }
 }
 
-void spn__implicit_block(const spn_world *w, uint32_t i, double h, double d[6])
-{
-    block_of(w, i, 1 + h * w->def.drag, d);
-}
-
 /* Right-hand side b = h f + h^2 K v, and each particle's 3x3 diagonal block
  * of A (block Jacobi's: a strand's node is stiff along the thread and soft
  * across it, which a scalar diagonal cannot see; inverted where wanted,

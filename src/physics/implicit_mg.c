@@ -400,7 +400,6 @@ static bool prepare(spn_world *w, double h)
     /* level 0 for a factorisation, the cyclic preconditioner or the
      * V-cycle: not when a kept factor serves (spn__imp_mg_refactor
      * assembles it if the step then wants a factor of its own) */
-    if (!m->chol_on) assemble(m, w, h);
     if (m->chol_on) {
         m->chol_fresh = !m->chol_ready || m->chol_stale || h != m->chol_h || m->hold > 0;
         if (m->hold) m->hold--;
@@ -418,7 +417,7 @@ static bool prepare(spn_world *w, double h)
         m->chol = NULL;
         m->chol_on = false;
         if (contacts) return false;
-    }
+    } else assemble(m, w, h);
     if (m->cyc) {
         if (spn__cyc_factor(m->cyc, &m->e) && !refused(w, SPN__REFUSE_CYCLIC)) return true;
         spn__cyc_free(m->cyc); /* not definite: the multigrid from here on */

@@ -467,9 +467,8 @@ void spn__hysteresis_prepare(spn_world *w, double dt);
 /* Free / duplicate (into a fresh clone) the hysteresis table and contacts. */
 void spn__silk_free(spn_world *w);
 bool spn__silk_clone(spn_world *c, const spn_world *w);
-/* Implicit solver (implicit.c): particle i's 3x3 diagonal block of A from
- * its springs, mass and drag (xx, yy, zz, xy, xz, yz), and its inverse. */
-void spn__implicit_block(const spn_world *w, uint32_t i, double h, double d[6]);
+/* Implicit solver (implicit.c): the inverse of a symmetric 3x3 block (xx,
+ * yy, zz, xy, xz, yz). */
 void spn__invert_sym3(const double a[6], double out[6]);
 /* Block Jacobi's inverses (w->pblock into w->pinv; a fixed particle's 0):
  * of every particle (local NULL), or of those whose local[i] is not below n
@@ -535,8 +534,8 @@ void spn__imp_mg_refuse_setup(spn_world *w, unsigned which);
 /* Every contact active, before a step's first solve. */
 void spn__contact_begin(spn_world *w);
 /* The active contacts' part of the implicit system: their forces and
- * h^2 K v0 into the right-hand side b, their blocks into the diagonal
- * blocks pblock. */
+ * h^2 K v0 into the right-hand side b, their blocks added to the diagonal
+ * blocks pblock (the springs' part, from build_rhs). */
 void spn__contact_system(spn_world *w, double h, spn_vec3 *b, double *pblock);
 /* ap += A_contacts p; returns p . A_contacts p. */
 double spn__contact_apply(const spn_world *w, double h, const spn_vec3 *p, spn_vec3 *ap);
